@@ -1,0 +1,81 @@
+//! What a planner sees at one instant: the static map and the forecasts of the moving obstacles.
+
+use trust_geometry::StaticMap;
+use trust_predict::Forecast;
+
+use crate::error::{check_finite, check_finite_vec};
+use crate::{PlanError, Vec3};
+
+/// The world as one planning call sees it: the static map plus forecasts of moving obstacles, all made
+/// at time `t0` (s). Cheap to build (it only borrows), so build one per planning cycle.
+#[derive(Debug, Clone, Copy)]
+pub struct Scene<'a> {
+    /// Static obstacles and map bounds.
+    pub map: &'a StaticMap,
+    /// Forecasts of the moving obstacles (each carries its own `t0`; usually equal to `Scene::t0`).
+    pub forecasts: &'a [Forecast],
+    /// Time at which the scene was observed (s).
+    pub t0: f64,
+}
+
+impl<'a> Scene<'a> {
+    /// A validated scene: `t0` finite and every forecast finite.
+    pub fn new(map: &'a StaticMap, forecasts: &'a [Forecast], t0: f64) -> Result<Self, PlanError> {
+        check_finite("scene.t0", t0)?;
+        for (i, f) in forecasts.iter().enumerate() {
+            check_finite_vec(&format!("scene.forecasts[{i}].p0"), &f.p0)?;
+            check_finite_vec(&format!("scene.forecasts[{i}].v0"), &f.v0)?;
+            check_finite(&format!("scene.forecasts[{i}].t0"), f.t0)?;
+        }
+        Ok(Scene { map, forecasts, t0 })
+    }
+
+    /// Signed distance from `p` to the static map (`+∞` for an empty map).
+    pub fn static_clearance(&self, p: &Vec3) -> f64 {
+        self.map.signed_distance(p)
+    }
+
+    /// Smallest signed distance from `p` to the moving obstacles as forecast at absolute time `t`
+    /// (`+∞` without forecasts).
+    pub fn dynamic_clearance(&self, p: &Vec3, t: f64) -> f64 {
+        self.forecasts
+            .iter()
+            .map(|f| f.signed_distance(p, t))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Smallest signed distance from `p` to anything at absolute time `t`.
+    pub fn clearance(&self, p: &Vec3, t: f64) -> f64 {
+        self.static_clearance(p).min(self.dynamic_clearance(p, t))
+    }
+
+    /// `Ok` if `p` is inside the map bounds, else [`PlanError::OutOfBounds`] naming `field`.
+    pub fn check_in_bounds(&self, field: &str, p: &Vec3) -> Result<(), PlanError> {
+        let b = self.map.bounds();
+        if b.contains(p) {
+            Ok(())
+        } else {
+            Err(PlanError::OutOfBounds {
+                field: field.to_string(),
+                point: [p.x, p.y, p.z],
+                min: [b.min.x, b.min.y, b.min.z],
+                max: [b.max.x, b.max.y, b.max.z],
+            })
+        }
+    }
+
+    /// `Ok` if `p` keeps at least `needed` metres from the static map, else [`PlanError::InCollision`].
+    pub fn check_static_free(&self, field: &str, p: &Vec3, needed: f64) -> Result<(), PlanError> {
+        let clearance = self.static_clearance(p);
+        if clearance >= needed {
+            Ok(())
+        } else {
+            Err(PlanError::InCollision {
+                field: field.to_string(),
+                point: [p.x, p.y, p.z],
+                clearance,
+                needed,
+            })
+        }
+    }
+}

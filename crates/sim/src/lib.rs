@@ -1,0 +1,7 @@
+//! # trust-sim — closed-loop simulator and experiment harness (not built yet)
+//!
+//! This crate will assemble the paper's baselines 1–3 and TRUST-Planner from the `trust-core` traits,
+//! fly them in closed loop among maneuvering obstacles (paper Sec. IV-D), and write the reports of the
+//! experiments. It is filled by the simulator and ablation issues; today it exports nothing, so that
+//! nothing pretends to work.
+#![warn(missing_docs)]

@@ -1,0 +1,241 @@
+//! Tidy rules, enforced as ordinary tests (rust-analyzer style): the dependency direction of
+//! ARCHITECTURE.md, crate-level docs, and workspace lint inheritance.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("tests crate lives one level below the workspace root")
+        .to_path_buf()
+}
+
+/// One workspace member: its manifest and where it lives.
+struct Member {
+    dir: PathBuf,
+    manifest: toml::Table,
+}
+
+impl Member {
+    fn name(&self) -> &str {
+        self.manifest["package"]["name"]
+            .as_str()
+            .expect("package.name")
+    }
+
+    /// Names of our own crates (`trust-*`) this member depends on, in any dependency table.
+    fn internal_deps(&self, table: &str) -> Vec<String> {
+        self.manifest
+            .get(table)
+            .and_then(|t| t.as_table())
+            .map(|t| {
+                t.keys()
+                    .filter(|k| k.starts_with("trust-"))
+                    .cloned()
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+}
+
+fn members() -> Vec<Member> {
+    let root = workspace_root();
+    let text = std::fs::read_to_string(root.join("Cargo.toml")).expect("root Cargo.toml");
+    let root_manifest: toml::Table = text.parse().expect("root Cargo.toml parses");
+    root_manifest["workspace"]["members"]
+        .as_array()
+        .expect("workspace.members")
+        .iter()
+        .map(|m| {
+            let dir = root.join(m.as_str().expect("member path"));
+            let text = std::fs::read_to_string(dir.join("Cargo.toml")).expect("member manifest");
+            Member {
+                dir,
+                manifest: text.parse().expect("member manifest parses"),
+            }
+        })
+        .collect()
+}
+
+/// The allowed internal dependencies of each library crate (design.md §2):
+/// `geometry ← predict ← core ← {lbfgs, minco, topo-prm} ← manager ← sim ← xtask`.
+/// `lbfgs` depends on nothing of ours; `minco` and `topo-prm` never depend on each other.
+fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
+    BTreeMap::from([
+        ("trust-geometry", &[][..]),
+        ("trust-predict", &["trust-geometry"][..]),
+        ("trust-core", &["trust-geometry", "trust-predict"][..]),
+        ("trust-lbfgs", &[][..]),
+        (
+            "trust-minco",
+            &[
+                "trust-geometry",
+                "trust-predict",
+                "trust-core",
+                "trust-lbfgs",
+            ][..],
+        ),
+        (
+            "trust-topo-prm",
+            &["trust-geometry", "trust-predict", "trust-core"][..],
+        ),
+        (
+            "trust-manager",
+            &[
+                "trust-geometry",
+                "trust-predict",
+                "trust-core",
+                "trust-lbfgs",
+                "trust-minco",
+                "trust-topo-prm",
+            ][..],
+        ),
+        (
+            "trust-sim",
+            &[
+                "trust-geometry",
+                "trust-predict",
+                "trust-core",
+                "trust-lbfgs",
+                "trust-minco",
+                "trust-topo-prm",
+                "trust-manager",
+            ][..],
+        ),
+    ])
+}
+
+#[test]
+fn library_crates_respect_the_dependency_direction() {
+    let allowed = allowed();
+    let mut violations = Vec::new();
+    for m in members() {
+        let Some(ok) = allowed.get(m.name()) else {
+            continue; // xtask and the tests crate may use anything.
+        };
+        // Normal and build dependencies define the architecture; dev-dependencies may not break it
+        // either (a test of minco must not pull in topo-prm), except that crates may test against
+        // crates further down the chain.
+        for table in ["dependencies", "build-dependencies", "dev-dependencies"] {
+            for dep in m.internal_deps(table) {
+                if !ok.contains(&dep.as_str()) {
+                    violations.push(format!("{} [{table}] depends on {dep}", m.name()));
+                }
+            }
+        }
+    }
+    assert!(
+        violations.is_empty(),
+        "dependency rules of ARCHITECTURE.md broken:\n{}",
+        violations.join("\n")
+    );
+}
+
+#[test]
+fn every_crate_inherits_workspace_lints() {
+    let offenders: Vec<String> = members()
+        .iter()
+        .filter(|m| {
+            m.manifest
+                .get("lints")
+                .and_then(|l| l.get("workspace"))
+                .and_then(|w| w.as_bool())
+                != Some(true)
+        })
+        .map(|m| m.name().to_string())
+        .collect();
+    assert!(
+        offenders.is_empty(),
+        "crates without `[lints] workspace = true`: {offenders:?}"
+    );
+}
+
+#[test]
+fn library_crates_have_crate_docs_and_warn_on_missing_docs() {
+    let mut offenders = Vec::new();
+    for m in members() {
+        let lib = m.dir.join("src/lib.rs");
+        let Ok(text) = std::fs::read_to_string(&lib) else {
+            continue; // binary-only crate
+        };
+        let doc_lines = text
+            .lines()
+            .take_while(|l| l.starts_with("//!") || l.trim().is_empty())
+            .filter(|l| l.starts_with("//!"))
+            .count();
+        if doc_lines < 3 {
+            offenders.push(format!(
+                "{}: crate docs must say what it is, when to use it and which paper section it implements ({doc_lines} lines of `//!`)",
+                m.name()
+            ));
+        }
+        if !text.contains("#![warn(missing_docs)]") && !text.contains("#![deny(missing_docs)]") {
+            offenders.push(format!("{}: lacks #![warn(missing_docs)]", m.name()));
+        }
+    }
+    assert!(offenders.is_empty(), "{}", offenders.join("\n"));
+}
+
+#[test]
+fn dependency_versions_come_from_the_workspace() {
+    let mut offenders = Vec::new();
+    for m in members() {
+        for table in ["dependencies", "dev-dependencies", "build-dependencies"] {
+            let Some(deps) = m.manifest.get(table).and_then(|t| t.as_table()) else {
+                continue;
+            };
+            for (name, spec) in deps {
+                let inherited = spec
+                    .get("workspace")
+                    .and_then(|w| w.as_bool())
+                    .unwrap_or(false);
+                if !inherited {
+                    offenders.push(format!("{} [{table}] {name}", m.name()));
+                }
+            }
+        }
+    }
+    assert!(
+        offenders.is_empty(),
+        "dependencies must use `name.workspace = true` (versions live in the root Cargo.toml): {offenders:?}"
+    );
+}
+
+#[test]
+fn no_todo_or_unimplemented_in_sources() {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            return;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                if p.file_name().is_some_and(|n| n == "target") {
+                    continue;
+                }
+                walk(&p, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    let mut files = Vec::new();
+    for m in members() {
+        walk(&m.dir, &mut files);
+    }
+    let this_file = Path::new(file!()).file_name().unwrap();
+    let needles = [concat!("todo", "!("), concat!("unimplemented", "!(")];
+    let offenders: Vec<String> = files
+        .iter()
+        .filter(|f| f.file_name() != Some(this_file))
+        .filter_map(|f| {
+            let text = std::fs::read_to_string(f).ok()?;
+            needles
+                .iter()
+                .any(|n| text.contains(n))
+                .then(|| f.display().to_string())
+        })
+        .collect();
+    assert!(offenders.is_empty(), "placeholders left in: {offenders:?}");
+}
