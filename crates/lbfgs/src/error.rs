@@ -1,0 +1,64 @@
+//! The crate's single error type.
+
+use thiserror::Error;
+
+/// Misuse of the solver: invalid parameters or an invalid start.
+///
+/// Every variant names the offending field (or vector entry) and value and says what was expected.
+/// A solve that merely fails to converge is *not* an error: it returns a [`crate::Report`] whose
+/// [`crate::Termination`] says why it stopped.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum LbfgsError {
+    /// A field of [`crate::LbfgsParams`] is out of its valid range.
+    #[error("invalid LbfgsParams: {field} = {value}, expected {expected}")]
+    InvalidParam {
+        /// Name of the field (e.g. `"memory"`).
+        field: &'static str,
+        /// The offending value (integer fields are shown as their exact `f64` value).
+        value: f64,
+        /// What the field must satisfy (e.g. `"an integer >= 1"`).
+        expected: &'static str,
+    },
+    /// A solver was requested for a problem with no variables.
+    #[error("dimension = 0, expected at least 1 variable")]
+    ZeroDimension,
+    /// The start point has a different length than the dimension the solver was built for.
+    #[error("x has length {len}, expected {expected} (the solver's dimension)")]
+    DimensionMismatch {
+        /// Length of the `x` passed to `minimize`.
+        len: usize,
+        /// Dimension the solver was built for.
+        expected: usize,
+    },
+    /// An entry of the start point is NaN or infinite.
+    #[error("start point x[{index}] = {value}, expected a finite number")]
+    NonFiniteStart {
+        /// Index of the first non-finite entry.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
+    /// The cost function returned NaN or an infinity at the start point.
+    #[error("cost at the start point = {value}, expected a finite number")]
+    NonFiniteStartCost {
+        /// The returned cost.
+        value: f64,
+    },
+    /// The cost function wrote NaN or an infinity into the gradient at the start point.
+    #[error("gradient at the start point g[{index}] = {value}, expected a finite number")]
+    NonFiniteStartGradient {
+        /// Index of the first non-finite gradient entry.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
+}
+
+/// Index and value of the first non-finite entry of `v`, if any.
+pub(crate) fn first_non_finite(v: &[f64]) -> Option<(usize, f64)> {
+    v.iter()
+        .copied()
+        .enumerate()
+        .find(|(_, value)| !value.is_finite())
+}
