@@ -76,11 +76,15 @@ mod tests {
     fn trajectory_and_path_agree_on_a_straight_line() {
         let mut c = [Vec3::zeros(); 6];
         c[1] = Vec3::new(2.0, 0.0, 0.0);
-        let tr = PolyTraj::new(0.0, vec![1.0, 1.0], vec![c, {
-            let mut d = c;
-            d[0] = Vec3::new(2.0, 0.0, 0.0);
-            d
-        }])
+        let tr = PolyTraj::new(
+            0.0,
+            vec![1.0, 1.0],
+            vec![c, {
+                let mut d = c;
+                d[0] = Vec3::new(2.0, 0.0, 0.0);
+                d
+            }],
+        )
         .unwrap();
         let path = GuidePath::new(vec![Vec3::zeros(), Vec3::new(4.0, 0.0, 0.0)]).unwrap();
         assert_relative_eq!(Curve::length(&tr), 4.0, epsilon = 1e-9);

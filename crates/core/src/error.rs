@@ -23,7 +23,9 @@ pub enum PlanError {
         expected: String,
     },
     /// A point that must lie in free space lies inside (or too close to) an obstacle.
-    #[error("`{field}` at {point:?} is in collision (clearance {clearance:.3} m, needed {needed:.3} m)")]
+    #[error(
+        "`{field}` at {point:?} is in collision (clearance {clearance:.3} m, needed {needed:.3} m)"
+    )]
     InCollision {
         /// Which point (`start`, `goal`, ...).
         field: String,

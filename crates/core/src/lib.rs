@@ -43,8 +43,8 @@ pub use scene::Scene;
 pub use solution::{CostBreakdown, RankingWeights, Solution, SolveStats, SolveStatus};
 pub use state::{Limits, State};
 pub use traits::{
-    HomotopyChecker, InitialGuess, PathFrontend, PathQuery, SearchResult, SearchStats,
-    TrajRequest, TrajectoryBackend,
+    HomotopyChecker, InitialGuess, PathFrontend, PathQuery, SearchResult, SearchStats, TrajRequest,
+    TrajectoryBackend,
 };
 pub use traj::{Derivative, Piece, PolyTraj, eval_piece};
 

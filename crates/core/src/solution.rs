@@ -82,9 +82,9 @@ impl SolveStatus {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SolveStats {
     /// Optimizer iterations.
-    pub iterations: usize,
+    pub iteration_count: usize,
     /// Cost-and-gradient evaluations.
-    pub evaluations: usize,
+    pub evaluation_count: usize,
     /// Wall-clock time of the whole `optimize` call (monotonic clock).
     pub elapsed: Duration,
     /// How it ended.

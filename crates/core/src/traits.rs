@@ -161,8 +161,8 @@ impl TrajRequest<'_> {
 ///             traj: PolyTraj::hold(req.start.t, req.start.p, 1.0)?,
 ///             costs: CostBreakdown { ht: 1.0, total: 1.0, ..CostBreakdown::default() },
 ///             stats: SolveStats {
-///                 iterations: 0,
-///                 evaluations: 0,
+///                 iteration_count: 0,
+///                 evaluation_count: 0,
 ///                 elapsed: Duration::ZERO,
 ///                 status: SolveStatus::Converged,
 ///             },
@@ -213,6 +213,10 @@ pub trait HomotopyChecker: Send + Sync {
     /// Whether `a` and `b` can be deformed into each other without crossing an obstacle. Returns
     /// [`PlanError::Unsupported`] when the curves lack what the checker needs (e.g. TVD on untimed
     /// paths).
-    fn equivalent(&self, a: &dyn Curve, b: &dyn Curve, scene: &Scene<'_>)
-    -> Result<bool, PlanError>;
+    fn equivalent(
+        &self,
+        a: &dyn Curve,
+        b: &dyn Curve,
+        scene: &Scene<'_>,
+    ) -> Result<bool, PlanError>;
 }

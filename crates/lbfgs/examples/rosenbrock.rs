@@ -25,11 +25,11 @@ fn main() -> Result<(), LbfgsError> {
 
         let worst = x.iter().fold(0.0f64, |m, xi| m.max((xi - 1.0).abs()));
         println!(
-            "  stopped: {:?} after {} iterations, {} evaluations; cost {:.3e}, ‖g‖∞ {:.3e}, \
+            "  stopped: {:?} after {} iteration_count, {} evaluations; cost {:.3e}, ‖g‖∞ {:.3e}, \
              max |x − 1| {:.3e}",
             report.termination,
-            report.iterations,
-            report.evaluations,
+            report.iteration_count,
+            report.evaluation_count,
             report.cost,
             report.grad_inf_norm,
             worst

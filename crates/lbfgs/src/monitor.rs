@@ -8,7 +8,7 @@ pub struct Progress<'a> {
     /// Number of completed iterations (1 at the first call).
     pub iteration: usize,
     /// Number of cost evaluations so far, the one at the start point included.
-    pub evaluations: usize,
+    pub evaluation_count: usize,
     /// Cost at the current point.
     pub cost: f64,
     /// `‖g‖∞` at the current point.
@@ -39,7 +39,7 @@ impl Monitor for () {}
 /// Cancels the solve at the first iteration that ends at or after a deadline.
 ///
 /// The deadline is checked once per iteration, so a solve overruns it by at most one iteration
-/// (one line search, at most `max_linesearch` evaluations).
+/// (one line search, at most `max_linesearch` evaluation_count).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Deadline {
     /// The instant after which the solve is cancelled.

@@ -53,9 +53,9 @@ pub struct Report {
     /// Cost at the returned point (always finite).
     pub cost: f64,
     /// Number of completed iterations (accepted steps).
-    pub iterations: usize,
+    pub iteration_count: usize,
     /// Number of cost evaluations, the one at the start point included.
-    pub evaluations: usize,
+    pub evaluation_count: usize,
     /// Why the solve stopped.
     pub termination: Termination,
     /// `‖g‖∞` at the returned point.

@@ -91,8 +91,8 @@ impl Lbfgs {
         let end = self.iterate(x, &mut evaluator, start_cost, monitor);
         Ok(Report {
             cost: end.cost,
-            iterations: end.iterations,
-            evaluations: evaluator.count(),
+            iteration_count: end.iteration_count,
+            evaluation_count: evaluator.count(),
             termination: end.termination,
             grad_inf_norm: inf_norm(&self.g),
         })
@@ -114,22 +114,22 @@ impl Lbfgs {
         if let Some(first) = self.past_costs.first_mut() {
             *first = cost;
         }
-        let mut iterations = 0;
-        let end = |cost, iterations, termination| End {
+        let mut iteration_count = 0;
+        let end = |cost, iteration_count, termination| End {
             cost,
-            iterations,
+            iteration_count,
             termination,
         };
         if self.gradient_converged(x) {
-            return end(cost, iterations, Termination::Converged);
+            return end(cost, iteration_count, Termination::Converged);
         }
         loop {
             if evaluator.exhausted() {
-                return end(cost, iterations, Termination::MaxEvaluations);
+                return end(cost, iteration_count, Termination::MaxEvaluations);
             }
             let Some(initial_step) = self.search_direction() else {
                 let not_descent = Termination::LineSearchFailed(LineSearchFailure::NotDescent);
-                return end(cost, iterations, not_descent);
+                return end(cost, iteration_count, not_descent);
             };
             let step = match self.line_search(x, evaluator, cost, initial_step) {
                 SearchOutcome::Accepted {
@@ -140,25 +140,25 @@ impl Lbfgs {
                     step
                 }
                 SearchOutcome::Stopped { cost, termination } => {
-                    return end(cost, iterations, termination);
+                    return end(cost, iteration_count, termination);
                 }
             };
-            iterations += 1;
+            iteration_count += 1;
             let cautious_factor = self.params.cautious_factor;
             self.memory
                 .push_if_cautious(x, &self.x_prev, &self.g, &self.g_prev, cautious_factor);
 
             let keep_going = monitor.keep_going(&Progress {
-                iteration: iterations,
-                evaluations: evaluator.count(),
+                iteration: iteration_count,
+                evaluation_count: evaluator.count(),
                 cost,
                 grad_inf_norm: inf_norm(&self.g),
                 step,
                 x,
                 gradient: &self.g,
             });
-            if let Some(termination) = self.stopping_test(x, iterations, cost, keep_going) {
-                return end(cost, iterations, termination);
+            if let Some(termination) = self.stopping_test(x, iteration_count, cost, keep_going) {
+                return end(cost, iteration_count, termination);
             }
         }
     }
@@ -231,18 +231,18 @@ impl Lbfgs {
     fn stopping_test(
         &mut self,
         x: &[f64],
-        iterations: usize,
+        iteration_count: usize,
         cost: f64,
         keep_going: bool,
     ) -> Option<Termination> {
         let max_iterations = self.params.max_iterations;
         if self.gradient_converged(x) {
             Some(Termination::Converged)
-        } else if self.cost_stalled(iterations, cost) {
+        } else if self.cost_stalled(iteration_count, cost) {
             Some(Termination::CostStalled)
         } else if !keep_going {
             Some(Termination::Cancelled)
-        } else if max_iterations != 0 && iterations >= max_iterations {
+        } else if max_iterations != 0 && iteration_count >= max_iterations {
             Some(Termination::MaxIterations)
         } else {
             None
@@ -255,7 +255,7 @@ impl Lbfgs {
     }
 
     /// The cost-decrease test `|f_{k−past} − f_k| / max(1, |f_k|) <= delta` after iteration `k`
-    /// (never true before `past` iterations); also records `f_k`.
+    /// (never true before `past` iteration_count); also records `f_k`.
     fn cost_stalled(&mut self, iteration: usize, cost: f64) -> bool {
         let past = self.params.past;
         if past == 0 {
@@ -289,7 +289,7 @@ impl Lbfgs {
 /// How an iteration loop ended; `x` and the solver's gradient hold the final point.
 struct End {
     cost: f64,
-    iterations: usize,
+    iteration_count: usize,
     termination: Termination,
 }
 
@@ -400,6 +400,6 @@ mod tests {
             )
             .unwrap();
         assert_eq!(report.termination, Termination::Converged);
-        assert_eq!(report.evaluations, 1);
+        assert_eq!(report.evaluation_count, 1);
     }
 }

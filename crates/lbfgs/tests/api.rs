@@ -121,8 +121,8 @@ fn start_at_the_optimum_converges_with_one_evaluation() {
         report,
         Report {
             cost: 0.0,
-            iterations: 0,
-            evaluations: 1,
+            iteration_count: 0,
+            evaluation_count: 1,
             termination: Termination::Converged,
             grad_inf_norm: 0.0,
         }
@@ -199,7 +199,7 @@ proptest! {
         let f = |x: &[f64], g: &mut [f64]| quadratic(n, &a, &b, x, g);
 
         // Default parameters: the cost is within 1e-5 (relative) of the minimum. The cost-stall
-        // test (relative decrease <= delta = 1e-6 over 3 iterations) can stop a few `delta` short:
+        // test (relative decrease <= delta = 1e-6 over 3 iteration_count) can stop a few `delta` short:
         // the largest gap over 1000 cases was 2.8e-6.
         let mut x = start[..n].to_vec();
         let (_, report) = solve(&mut x, LbfgsParams::default(), f);
@@ -387,7 +387,7 @@ proptest! {
         let mut solver = Lbfgs::new(n, params).unwrap();
         let report = solver.minimize(&mut x, f, &mut ()).unwrap();
         prop_assert!(calls.get() <= budget);
-        prop_assert_eq!(report.evaluations, calls.get());
+        prop_assert_eq!(report.evaluation_count, calls.get());
         if report.termination != Termination::Converged {
             prop_assert_eq!(report.termination, Termination::MaxEvaluations);
             prop_assert_eq!(calls.get(), budget);
@@ -408,7 +408,7 @@ fn iteration_budget_is_respected() {
     };
     let (_, report) = solve(&mut x, params, rosenbrock);
     assert_eq!(report.termination, Termination::MaxIterations);
-    assert_eq!(report.iterations, 5);
+    assert_eq!(report.iteration_count, 5);
 }
 
 #[test]
@@ -419,17 +419,17 @@ fn closure_monitor_cancels_and_sees_every_iteration() {
         assert_eq!(rosenbrock(p.x, &mut g), p.cost);
         assert_eq!(p.gradient, g);
         assert!(p.step > 0.0);
-        seen.push((p.iteration, p.evaluations, p.cost));
+        seen.push((p.iteration, p.evaluation_count, p.cost));
         p.iteration < 3
     });
     let mut solver = Lbfgs::new(2, LbfgsParams::default()).unwrap();
     let mut x = rosenbrock_start(2);
     let report = solver.minimize(&mut x, rosenbrock, &mut monitor).unwrap();
     assert_eq!(report.termination, Termination::Cancelled);
-    assert_eq!(report.iterations, 3);
+    assert_eq!(report.iteration_count, 3);
     assert_eq!(seen.len(), 3);
     assert_eq!(seen.iter().map(|s| s.0).collect::<Vec<_>>(), vec![1, 2, 3]);
-    assert_eq!(seen[2].1, report.evaluations);
+    assert_eq!(seen[2].1, report.evaluation_count);
     assert_eq!(seen[2].2, report.cost);
     assert!(
         seen.windows(2).all(|w| w[1].2 < w[0].2),
@@ -448,7 +448,7 @@ fn monitor_is_called_once_per_iteration_until_convergence() {
     let mut x = rosenbrock_start(10);
     let report = solver.minimize(&mut x, rosenbrock, &mut monitor).unwrap();
     assert!(report.termination.is_success());
-    assert_eq!(calls, report.iterations);
+    assert_eq!(calls, report.iteration_count);
 }
 
 #[test]
@@ -458,7 +458,7 @@ fn expired_deadline_cancels_after_one_iteration() {
     let mut x = rosenbrock_start(2);
     let report = solver.minimize(&mut x, rosenbrock, &mut deadline).unwrap();
     assert_eq!(report.termination, Termination::Cancelled);
-    assert_eq!(report.iterations, 1);
+    assert_eq!(report.iteration_count, 1);
 
     let mut generous = Deadline::after(Duration::from_secs(3600));
     let mut x = rosenbrock_start(2);
