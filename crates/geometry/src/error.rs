@@ -1,0 +1,138 @@
+//! The crate's single error type.
+
+use thiserror::Error;
+
+/// Invalid input to a constructor or builder of this crate.
+///
+/// Every variant names the offending field and value and says what was expected.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum GeometryError {
+    /// A number that must be finite was NaN or infinite.
+    #[error("{field} must be finite, got {value}")]
+    NonFinite {
+        /// Name of the field (e.g. `"sphere.center.x"`).
+        field: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// A size (radius, half-height, clearance, …) was negative.
+    #[error("{field} must be >= 0, got {value}")]
+    Negative {
+        /// Name of the field.
+        field: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// A quantity that must be strictly positive (e.g. a voxel resolution) was zero or negative.
+    #[error("{field} must be > 0, got {value}")]
+    NonPositive {
+        /// Name of the field.
+        field: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// A box whose minimum exceeds its maximum along some axis.
+    #[error("{field}: min.{axis} = {min} exceeds max.{axis} = {max}; expected min <= max")]
+    InvertedBox {
+        /// Name of the box (e.g. `"bounds"`).
+        field: String,
+        /// The axis (`'x'`, `'y'` or `'z'`).
+        axis: char,
+        /// Minimum along that axis.
+        min: f64,
+        /// Maximum along that axis.
+        max: f64,
+    },
+    /// Bounds with zero extent along some axis (zero volume) where a volume is required.
+    #[error("{field}: zero extent along {axis} (min = max = {value}); expected a positive volume")]
+    EmptyBounds {
+        /// Name of the box (e.g. `"bounds"`).
+        field: String,
+        /// The axis (`'x'`, `'y'` or `'z'`).
+        axis: char,
+        /// The common min/max value along that axis.
+        value: f64,
+    },
+    /// A voxel grid would exceed [`crate::MAX_VOXELS`] voxels.
+    #[error(
+        "voxel grid of {nx} x {ny} x {nz} = {count} voxels exceeds the limit of {limit}; \
+         use a coarser resolution or smaller bounds"
+    )]
+    GridTooLarge {
+        /// Voxels along x.
+        nx: usize,
+        /// Voxels along y.
+        ny: usize,
+        /// Voxels along z.
+        nz: usize,
+        /// Their product (saturating).
+        count: u128,
+        /// The limit.
+        limit: usize,
+    },
+    /// Voxel grid data whose length does not match its dimensions.
+    #[error("{field} has length {len}, expected {expected} (= nx * ny * nz)")]
+    LengthMismatch {
+        /// Name of the field.
+        field: String,
+        /// Its length.
+        len: usize,
+        /// The expected length.
+        expected: usize,
+    },
+}
+
+impl GeometryError {
+    pub(crate) fn non_finite(field: impl Into<String>, value: f64) -> Self {
+        Self::NonFinite {
+            field: field.into(),
+            value,
+        }
+    }
+}
+
+/// Checks that `value` is finite.
+pub(crate) fn check_finite(field: &str, value: f64) -> Result<f64, GeometryError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(GeometryError::non_finite(field, value))
+    }
+}
+
+/// Checks that `value` is finite and `>= 0`.
+pub(crate) fn check_non_negative(field: &str, value: f64) -> Result<f64, GeometryError> {
+    check_finite(field, value)?;
+    if value < 0.0 {
+        Err(GeometryError::Negative {
+            field: field.into(),
+            value,
+        })
+    } else {
+        Ok(value)
+    }
+}
+
+/// Checks that `value` is finite and `> 0`.
+pub(crate) fn check_positive(field: &str, value: f64) -> Result<f64, GeometryError> {
+    check_finite(field, value)?;
+    if value > 0.0 {
+        Ok(value)
+    } else {
+        Err(GeometryError::NonPositive {
+            field: field.into(),
+            value,
+        })
+    }
+}
+
+/// Checks that every component of `v` is finite; the field name gets `.x`/`.y`/`.z` appended.
+pub(crate) fn check_vec(field: &str, v: &crate::Vec3) -> Result<(), GeometryError> {
+    for (i, axis) in ['x', 'y', 'z'].into_iter().enumerate() {
+        if !v[i].is_finite() {
+            return Err(GeometryError::non_finite(format!("{field}.{axis}"), v[i]));
+        }
+    }
+    Ok(())
+}

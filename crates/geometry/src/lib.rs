@@ -1,0 +1,47 @@
+//! Geometry for TRUST-Planner: analytic obstacle shapes, static maps and the distance queries the
+//! planner needs.
+//!
+//! * Shapes — [`Sphere`], vertical [`Cylinder`], axis-aligned [`AaBox`] and the [`Shape`] enum —
+//!   with exact signed distances and gradients. The closed forms are also public free functions
+//!   ([`sphere_sdf`], [`cylinder_sdf`], [`cylinder_sdf_with_size_gradient`], [`box_sdf`]) so that
+//!   moving obstacles with time-varying radius (`trust-predict`) and the collision costs of the
+//!   trajectory optimizer (`trust-minco`, the static-map penalty and the DDF cost of paper eq.
+//!   design-of-Io) reuse them.
+//! * [`StaticMap`] — the static part of the world (paper Sec. III: the map the front end samples
+//!   and checks visibility in, and the back end keeps clear of): bounds, shapes in a BVH, and an
+//!   optional voxel [`Esdf`] built from a point cloud (the dense static clouds of experiment E4).
+//!   Queries: signed distance and gradient, point freedom with a clearance, segment line of sight
+//!   with a clearance, and AABB broad phase.
+//! * [`Esdf`], [`edt_1d`], [`edt_3d`] — exact Euclidean distance transforms (Felzenszwalb &
+//!   Huttenlocher) and a trilinearly interpolated signed distance field.
+//!
+//! Use this crate whenever something needs to know how far a point or segment is from static
+//! obstacles. All public math is `f64` and nalgebra ([`Vec3`]); parry3d-f64 (glam) is used inside
+//! for the BVH and the segment–shape distance queries and never appears in the API.
+//!
+//! Signs and conventions: distances are negative inside obstacles; gradients are unit outward
+//! directions, defined (never NaN) at non-differentiable points as documented in [`shapes`]; a map
+//! with no obstacles reports `f64::INFINITY` with a zero gradient.
+#![warn(missing_docs)]
+
+mod aabb;
+mod error;
+pub mod esdf;
+mod map;
+mod parry_conv;
+pub mod shapes;
+
+/// The public vector type: `nalgebra::Vector3<f64>`.
+pub type Vec3 = nalgebra::Vector3<f64>;
+
+pub use aabb::Aabb;
+pub use error::GeometryError;
+pub use esdf::{
+    EdtScratch, Esdf, MAX_VOXELS, checked_voxel_count, edt_1d, edt_1d_with_scratch, edt_3d,
+    voxel_index,
+};
+pub use map::{DEFAULT_RESOLUTION, StaticMap};
+pub use shapes::{
+    AaBox, Cylinder, CylinderSdf, Shape, Sphere, box_sdf, cylinder_sdf,
+    cylinder_sdf_with_size_gradient, sphere_sdf,
+};
