@@ -12,7 +12,10 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "cargo xtask", about = "Automation for the TRUST-Planner workspace")]
+#[command(
+    name = "cargo xtask",
+    about = "Automation for the TRUST-Planner workspace"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Cmd,
@@ -28,7 +31,9 @@ fn main() -> Result<()> {
     let cli = Cli::parse();
     let root = workspace_root()?;
     match cli.command {
-        Cmd::Ci => run(Command::new("bash").arg(root.join(".ci/run")).current_dir(&root)),
+        Cmd::Ci => run(Command::new("bash")
+            .arg(root.join(".ci/run"))
+            .current_dir(&root)),
     }
 }
 
