@@ -1,0 +1,33 @@
+//! Cross-check tool: reads ONE JSON object on stdin,
+//! `{"head": [p, v, a], "tail": [p, v, a], "waypoints": [[x, y, z], …], "durations": [T_1, …]}`,
+//! and prints ONE JSON object with the MINCO s = 3 coefficients, the jerk energy and its
+//! gradients: `{"coeffs": [[c0, …, c5] per piece], "energy": E, "grad_waypoints": […],
+//! "grad_durations": […], "grad_tail": [[pos], [vel], [acc]]}`.
+//!
+//! ```text
+//! echo '{"head": [[0,0,0],[0,0,0],[0,0,0]], "tail": [[1,0,0],[0,0,0],[0,0,0]],
+//!        "waypoints": [], "durations": [1]}' | cargo run -p trust-minco --example minco_eval
+//! ```
+//!
+//! Errors (bad JSON, wrong lengths, invalid numbers) go to stderr with exit status 1.
+
+use std::io::Read;
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let mut input = String::new();
+    if let Err(e) = std::io::stdin().read_to_string(&mut input) {
+        eprintln!("minco_eval: cannot read stdin: {e}");
+        return ExitCode::FAILURE;
+    }
+    match trust_minco::eval_json(&input) {
+        Ok(output) => {
+            println!("{output}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("minco_eval: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,81 @@
+//! The original MINCO backend (fixed terminal state, per-piece durations): the paper's baseline in
+//! Table Sim-A-2.
+
+use std::time::Instant;
+
+use trust_core::{PlanError, Scene, Solution, SolveStats, TrajRequest, TrajectoryBackend};
+
+use super::init::initial_trajectory;
+use super::objective::MincoObjective;
+use super::params::MincoParams;
+use super::solve::{run_lbfgs, solve_status, validate_request};
+
+/// MINCO (Wang et al., 2022) as the paper compares it: the trajectory ends **at rest at the end
+/// of the guide** (or of the warm-start trajectory); the inner waypoints and every piece duration
+/// are free ([`MincoObjective`]). Same costs, budgets and guarantees as
+/// [`crate::backend::UtfMinco`].
+#[derive(Debug, Clone, Default)]
+pub struct Minco {
+    params: MincoParams,
+}
+
+impl Minco {
+    /// A backend with validated parameters.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] naming the first invalid field (`params.…`).
+    pub fn new(params: MincoParams) -> Result<Self, PlanError> {
+        params.validate("params")?;
+        Ok(Self { params })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &MincoParams {
+        &self.params
+    }
+}
+
+impl TrajectoryBackend for Minco {
+    fn name(&self) -> &str {
+        "minco"
+    }
+
+    fn optimize(&self, req: &TrajRequest<'_>, scene: &Scene<'_>) -> Result<Solution, PlanError> {
+        let started = Instant::now();
+        validate_request(req, scene)?;
+        let p = &self.params;
+        let init = initial_trajectory(&req.initial, &req.start, &req.limits, &p.pieces);
+        let n = init.pieces();
+        let mut f = MincoObjective::new(
+            scene,
+            &req.start,
+            init.end_position,
+            req.goal,
+            req.limits,
+            p,
+            n,
+        )?;
+        let mut x = vec![0.0; f.dimension()];
+        let durations = vec![init.total_duration / n as f64; n];
+        f.encode(&init.waypoints, &durations, &mut x)?;
+        let report = run_lbfgs(
+            self.name(),
+            |x, g| f.eval(x, g),
+            &mut x,
+            &p.solver,
+            req.deadline,
+        )?;
+        let mut g = vec![0.0; x.len()];
+        f.eval(&x, &mut g);
+        Ok(Solution {
+            traj: f.trajectory()?,
+            costs: f.breakdown(),
+            stats: SolveStats {
+                iteration_count: report.iteration_count,
+                evaluation_count: report.evaluation_count + 1,
+                elapsed: started.elapsed(),
+                status: solve_status(report.termination),
+            },
+        })
+    }
+}

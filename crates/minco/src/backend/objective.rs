@@ -1,0 +1,464 @@
+//! The objective `J` of paper eq. unconstrained-optimization as a function of the decision
+//! vector, with its analytic gradient (eqs. analytical-gradients and analytical-gradients-I-to-S):
+//! [`UtfMincoObjective`] over `(P, p_f, v_f, τ)` and [`MincoObjective`] over `(P, τ_1..τ_n)`.
+
+use trust_core::{CostBreakdown, Limits, PlanError, PolyTraj, Scene, State, Vec3};
+
+use super::params::PieceParams;
+use super::time_map::{positive_time, positive_time_inverse};
+use crate::costs::{
+    CostWeights, PenaltyIntegrand, PenaltyParams, PiecewiseView, TerminalCost, TrapezoidIntegrator,
+};
+use crate::error::MincoError;
+use crate::minco::{BoundaryState, MincoGrad, MincoS3};
+
+/// What both objectives share: MINCO, the sampled penalties, the jerk energy and the adjoint
+/// propagation, with all buffers preallocated.
+#[derive(Debug, Clone)]
+struct ObjectiveCore<'a> {
+    minco: MincoS3,
+    integrator: TrapezoidIntegrator,
+    penalties: PenaltyIntegrand<'a>,
+    weights: CostWeights,
+    head: BoundaryState,
+    t_start: f64,
+    tail: BoundaryState,
+    waypoints: Vec<Vec3>,
+    durations: Vec<f64>,
+    grad_c: Vec<Vec3>,
+    grad_t: Vec<f64>,
+    grad: MincoGrad,
+    /// The cost terms of the last finite evaluation.
+    last: CostBreakdown,
+}
+
+impl<'a> ObjectiveCore<'a> {
+    fn new(
+        scene: &Scene<'a>,
+        start: &State,
+        limits: Limits,
+        weights: &CostWeights,
+        penalty: &PenaltyParams,
+        pieces: usize,
+    ) -> Result<Self, PlanError> {
+        let minco = MincoS3::new(pieces).map_err(component)?;
+        Ok(Self {
+            minco,
+            integrator: TrapezoidIntegrator::new(penalty.samples_per_piece),
+            penalties: PenaltyIntegrand::new(scene.forecasts, scene.map, limits, weights, penalty),
+            weights: weights.clone(),
+            head: [start.p, start.v, start.a],
+            t_start: start.t,
+            tail: [start.p, Vec3::zeros(), Vec3::zeros()],
+            waypoints: vec![Vec3::zeros(); pieces - 1],
+            durations: vec![1.0; pieces],
+            grad_c: vec![Vec3::zeros(); 6 * pieces],
+            grad_t: vec![0.0; pieces],
+            grad: MincoGrad::new(pieces),
+            last: CostBreakdown::default(),
+        })
+    }
+
+    fn pieces(&self) -> usize {
+        self.durations.len()
+    }
+
+    /// Solves MINCO for the current `tail`, `waypoints`, `durations`; returns the weighted
+    /// `λ_o I_o + λ_d I_d + λ_e I_e` and the unweighted `[I_o, I_d, I_e]`, and leaves the
+    /// gradient in `self.grad`.
+    fn evaluate(&mut self) -> Result<(f64, [f64; 3]), MincoError> {
+        self.minco
+            .solve(&self.head, &self.tail, &self.waypoints, &self.durations)?;
+        self.grad_c.fill(Vec3::zeros());
+        self.grad_t.fill(0.0);
+        self.penalties.reset_integrals();
+        let view = PiecewiseView {
+            t_start: self.t_start,
+            coeffs: self.minco.coeffs(),
+            durations: self.minco.durations(),
+        };
+        let sampled = self.integrator.integrate(
+            &view,
+            &mut self.penalties,
+            &mut self.grad_c,
+            &mut self.grad_t,
+        )?;
+        let energy = self.minco.accumulate_energy_grad(
+            self.weights.energy,
+            &mut self.grad_c,
+            &mut self.grad_t,
+        )?;
+        self.minco
+            .propagate_grad(&self.grad_c, &self.grad_t, &mut self.grad)?;
+        let integrals = self.penalties.integrals();
+        Ok((
+            sampled + self.weights.energy * energy,
+            [integrals.obstacle(), integrals.feasibility(), energy],
+        ))
+    }
+
+    fn trajectory(&self) -> Result<PolyTraj, PlanError> {
+        if !self.minco.is_solved() {
+            return Err(component(MincoError::NotSolved {
+                operation: "trajectory",
+            }));
+        }
+        PolyTraj::new(
+            self.t_start,
+            self.minco.durations().to_vec(),
+            self.minco.to_pieces(),
+        )
+    }
+}
+
+fn component(e: MincoError) -> PlanError {
+    PlanError::Component {
+        component: "trust-minco".into(),
+        source: Box::new(e),
+    }
+}
+
+/// Writes `v` at `x[3i..3i+3]`.
+#[inline]
+fn put(x: &mut [f64], i: usize, v: &Vec3) {
+    x[3 * i..3 * i + 3].copy_from_slice(v.as_slice());
+}
+
+/// Reads `x[3i..3i+3]`.
+#[inline]
+fn get(x: &[f64], i: usize) -> Vec3 {
+    Vec3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2])
+}
+
+/// `J` and `∇J` of UTF-MINCO (paper Sec. III-D) over the decision vector
+/// `x = [q_1, …, q_{n−1}, p_f, v_f, τ]` (`3(n−1) + 7` entries): inner waypoints, free terminal
+/// position and velocity (terminal acceleration fixed at 0), and `τ` with
+/// `T_Σ = n·T_min + T(τ)` ([`positive_time`]), uniform `T_i = T_Σ/n`.
+///
+/// `J = λ_t T_Σ + λ_s H_s(p_f, v_f) + λ_o I_o + λ_d I_d + λ_e I_e` and, per eq.
+/// analytical-gradients, `∂J/∂P = ∂I/∂P`, `∂J/∂S = ∂H/∂S + ∂I/∂S` (tail rows of the adjoint, eq.
+/// analytical-gradients-I-to-S) and `∂J/∂T_Σ = λ_t + (1/n) Σ_i ∂I/∂T_i`, chained through `dT/dτ`.
+///
+/// ```
+/// use trust_core::{Limits, Scene, StaticMap, State, Aabb, Vec3};
+/// use trust_minco::backend::{UtfMincoObjective, UtfMincoParams};
+///
+/// let map = StaticMap::empty(Aabb::new(Vec3::zeros(), Vec3::repeat(10.0))?)?;
+/// let scene = Scene::new(&map, &[], 0.0)?;
+/// let start = State::at_rest(0.0, Vec3::new(1.0, 1.0, 1.0));
+/// let goal = Vec3::new(8.0, 1.0, 1.0);
+/// let mut f = UtfMincoObjective::new(&scene, &start, goal, Limits::default(), &UtfMincoParams::default(), 3)?;
+/// let mut x = vec![0.0; f.dimension()];
+/// let waypoints = [Vec3::new(3.0, 1.0, 1.0), Vec3::new(5.0, 1.0, 1.0)];
+/// f.encode(&waypoints, &goal, &Vec3::zeros(), 2.0, &mut x)?;
+/// let mut g = vec![0.0; f.dimension()];
+/// let j = f.eval(&x, &mut g);
+/// assert!(j.is_finite() && g.iter().all(|v| v.is_finite()));
+/// # Ok::<(), trust_core::PlanError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct UtfMincoObjective<'a> {
+    core: ObjectiveCore<'a>,
+    terminal: TerminalCost,
+    min_total: f64,
+}
+
+impl<'a> UtfMincoObjective<'a> {
+    /// The objective for `pieces` pieces from `start` toward `goal` in `scene`.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] if `pieces == 0` or the parameters are invalid.
+    pub fn new(
+        scene: &Scene<'a>,
+        start: &State,
+        goal: Vec3,
+        limits: Limits,
+        params: &super::UtfMincoParams,
+        pieces: usize,
+    ) -> Result<Self, PlanError> {
+        check_pieces(pieces)?;
+        params.validate("params")?;
+        Ok(Self {
+            core: ObjectiveCore::new(
+                scene,
+                start,
+                limits,
+                &params.weights,
+                &params.penalty,
+                pieces,
+            )?,
+            terminal: TerminalCost::new(goal, &start.p, &params.penalty),
+            min_total: min_total(&params.pieces, pieces),
+        })
+    }
+
+    /// Number of pieces `n`.
+    pub fn pieces(&self) -> usize {
+        self.core.pieces()
+    }
+
+    /// Length of the decision vector, `3(n−1) + 7`.
+    pub fn dimension(&self) -> usize {
+        3 * (self.pieces() - 1) + 7
+    }
+
+    /// The terminal cost `H_s` in use (its `α` follows the schedule of eq. design-of-Hs).
+    pub fn terminal(&self) -> &TerminalCost {
+        &self.terminal
+    }
+
+    /// Writes the decision vector for the given waypoints, terminal state and total duration
+    /// (clamped to just above the minimum `n·T_min`).
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] for wrong lengths.
+    pub fn encode(
+        &self,
+        waypoints: &[Vec3],
+        end_position: &Vec3,
+        end_velocity: &Vec3,
+        total_duration: f64,
+        x: &mut [f64],
+    ) -> Result<(), PlanError> {
+        let n = self.pieces();
+        check_len("waypoints", n - 1, waypoints.len())?;
+        check_len("x", self.dimension(), x.len())?;
+        for (i, w) in waypoints.iter().enumerate() {
+            put(x, i, w);
+        }
+        put(x, n - 1, end_position);
+        put(x, n, end_velocity);
+        x[3 * n + 3] = positive_time_inverse(total_duration - self.min_total);
+        Ok(())
+    }
+
+    /// Total duration `T_Σ` encoded in `x`.
+    pub fn total_duration(&self, x: &[f64]) -> f64 {
+        self.min_total + positive_time(x[x.len() - 1]).0
+    }
+
+    /// `J(x)`; writes `∇J` into `g`. Returns `+∞` (with `g` zeroed) where MINCO cannot be solved
+    /// or the cost is not finite, so that a line search backs off; never NaN.
+    ///
+    /// `x` and `g` must be [`dimension`](Self::dimension) long; otherwise the result is `+∞`.
+    pub fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        let n = self.pieces();
+        if x.len() != self.dimension() || g.len() != self.dimension() {
+            g.fill(0.0);
+            return f64::INFINITY;
+        }
+        for (i, w) in self.core.waypoints.iter_mut().enumerate() {
+            *w = get(x, i);
+        }
+        let (p_f, v_f) = (get(x, n - 1), get(x, n));
+        let (t_map, dt_dtau) = positive_time(x[3 * n + 3]);
+        let total = self.min_total + t_map;
+        self.core.durations.fill(total / n as f64);
+        self.core.tail = [p_f, v_f, Vec3::zeros()];
+        let Ok((integral, terms)) = self.core.evaluate() else {
+            g.fill(0.0);
+            return f64::INFINITY;
+        };
+        let w = &self.core.weights;
+        let (hs, hs_p, hs_v) = self.terminal.eval(&p_f, &v_f);
+        let cost = w.time * total + w.terminal * hs + integral;
+        let grad = &self.core.grad;
+        for (i, gw) in grad.waypoints.iter().enumerate() {
+            put(g, i, gw);
+        }
+        put(g, n - 1, &(grad.tail[0] + hs_p * w.terminal));
+        put(g, n, &(grad.tail[1] + hs_v * w.terminal));
+        g[3 * n + 3] = (w.time + grad.uniform_total_duration()) * dt_dtau;
+        finish(cost, g, &mut self.core.last, [total, hs], terms)
+    }
+
+    /// The unweighted cost terms and `J` at the last finite evaluation.
+    pub fn breakdown(&self) -> CostBreakdown {
+        self.core.last
+    }
+
+    /// The trajectory of the last evaluation (starts at `start.t`).
+    ///
+    /// # Errors
+    /// If no evaluation has succeeded yet.
+    pub fn trajectory(&self) -> Result<PolyTraj, PlanError> {
+        self.core.trajectory()
+    }
+}
+
+/// `J` and `∇J` of the original MINCO formulation (fixed terminal state, free per-piece
+/// durations; the paper's baseline in Table Sim-A-2) over `x = [q_1, …, q_{n−1}, τ_1, …, τ_n]`
+/// (`3(n−1) + n` entries), `T_i = T_min + T(τ_i)`.
+///
+/// `J = λ_t Σ T_i + λ_s H_s(tail) + λ_o I_o + λ_d I_d + λ_e I_e`; `H_s` is a constant here.
+/// `∂J/∂T_i = λ_t + ∂I/∂T_i` (MINCO's duration gradient plus the explicit terms of eqs. dI-b and
+/// dI-c), chained through `dT_i/dτ_i`.
+#[derive(Debug, Clone)]
+pub struct MincoObjective<'a> {
+    core: ObjectiveCore<'a>,
+    terminal_cost: f64,
+    min_duration: f64,
+}
+
+impl<'a> MincoObjective<'a> {
+    /// The objective for `pieces` pieces from `start` to the fixed terminal `end` (at rest).
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] if `pieces == 0` or the parameters are invalid.
+    pub fn new(
+        scene: &Scene<'a>,
+        start: &State,
+        end: Vec3,
+        goal: Vec3,
+        limits: Limits,
+        params: &super::MincoParams,
+        pieces: usize,
+    ) -> Result<Self, PlanError> {
+        check_pieces(pieces)?;
+        params.validate("params")?;
+        let mut core = ObjectiveCore::new(
+            scene,
+            start,
+            limits,
+            &params.weights,
+            &params.penalty,
+            pieces,
+        )?;
+        core.tail = [end, Vec3::zeros(), Vec3::zeros()];
+        let terminal = TerminalCost::new(goal, &start.p, &params.penalty);
+        Ok(Self {
+            core,
+            terminal_cost: terminal.eval(&end, &Vec3::zeros()).0,
+            min_duration: params.pieces.min_piece_duration_s,
+        })
+    }
+
+    /// Number of pieces `n`.
+    pub fn pieces(&self) -> usize {
+        self.core.pieces()
+    }
+
+    /// Length of the decision vector, `3(n−1) + n`.
+    pub fn dimension(&self) -> usize {
+        4 * self.pieces() - 3
+    }
+
+    /// Writes the decision vector for the given waypoints and piece durations (each clamped to
+    /// just above `T_min`).
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] for wrong lengths.
+    pub fn encode(
+        &self,
+        waypoints: &[Vec3],
+        durations: &[f64],
+        x: &mut [f64],
+    ) -> Result<(), PlanError> {
+        let n = self.pieces();
+        check_len("waypoints", n - 1, waypoints.len())?;
+        check_len("durations", n, durations.len())?;
+        check_len("x", self.dimension(), x.len())?;
+        for (i, w) in waypoints.iter().enumerate() {
+            put(x, i, w);
+        }
+        for (xi, t) in x[3 * (n - 1)..].iter_mut().zip(durations) {
+            *xi = positive_time_inverse(t - self.min_duration);
+        }
+        Ok(())
+    }
+
+    /// `J(x)`; writes `∇J` into `g`. Returns `+∞` (with `g` zeroed) where MINCO cannot be solved
+    /// or the cost is not finite; never NaN.
+    ///
+    /// `x` and `g` must be [`dimension`](Self::dimension) long; otherwise the result is `+∞`.
+    pub fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        let n = self.pieces();
+        if x.len() != self.dimension() || g.len() != self.dimension() {
+            g.fill(0.0);
+            return f64::INFINITY;
+        }
+        for (i, w) in self.core.waypoints.iter_mut().enumerate() {
+            *w = get(x, i);
+        }
+        let taus = &x[3 * (n - 1)..];
+        for (d, &tau) in self.core.durations.iter_mut().zip(taus) {
+            *d = self.min_duration + positive_time(tau).0;
+        }
+        let total: f64 = self.core.durations.iter().sum();
+        let Ok((integral, terms)) = self.core.evaluate() else {
+            g.fill(0.0);
+            return f64::INFINITY;
+        };
+        let w = &self.core.weights;
+        let cost = w.time * total + w.terminal * self.terminal_cost + integral;
+        let grad = &self.core.grad;
+        for (i, gw) in grad.waypoints.iter().enumerate() {
+            put(g, i, gw);
+        }
+        for ((gi, &tau), dj) in g[3 * (n - 1)..].iter_mut().zip(taus).zip(&grad.durations) {
+            *gi = (w.time + dj) * positive_time(tau).1;
+        }
+        let hs = self.terminal_cost;
+        finish(cost, g, &mut self.core.last, [total, hs], terms)
+    }
+
+    /// The unweighted cost terms and `J` at the last finite evaluation.
+    pub fn breakdown(&self) -> CostBreakdown {
+        self.core.last
+    }
+
+    /// The trajectory of the last evaluation (starts at `start.t`).
+    ///
+    /// # Errors
+    /// If no evaluation has succeeded yet.
+    pub fn trajectory(&self) -> Result<PolyTraj, PlanError> {
+        self.core.trajectory()
+    }
+}
+
+/// Shared end of `eval`: reject non-finite results, record the breakdown.
+fn finish(
+    cost: f64,
+    g: &mut [f64],
+    last: &mut CostBreakdown,
+    [ht, hs]: [f64; 2],
+    [io, id, ie]: [f64; 3],
+) -> f64 {
+    if !cost.is_finite() || g.iter().any(|v| !v.is_finite()) {
+        g.fill(0.0);
+        return f64::INFINITY;
+    }
+    *last = CostBreakdown {
+        ht,
+        hs,
+        io,
+        id,
+        ie,
+        total: cost,
+    };
+    cost
+}
+
+fn min_total(params: &PieceParams, pieces: usize) -> f64 {
+    params.min_piece_duration_s * pieces as f64
+}
+
+fn check_pieces(pieces: usize) -> Result<(), PlanError> {
+    if pieces == 0 {
+        Err(PlanError::invalid("pieces", pieces, "an integer >= 1"))
+    } else {
+        Ok(())
+    }
+}
+
+fn check_len(field: &str, expected: usize, got: usize) -> Result<(), PlanError> {
+    if expected == got {
+        Ok(())
+    } else {
+        Err(PlanError::invalid(
+            field,
+            format!("{got} entries"),
+            format!("{expected} entries"),
+        ))
+    }
+}

@@ -1,0 +1,223 @@
+//! Parameters of the two backends.
+
+use serde::{Deserialize, Serialize};
+use trust_core::{PlanError, check_positive};
+use trust_lbfgs::LbfgsParams;
+
+use crate::costs::{CostWeights, PenaltyParams};
+
+/// How many pieces a trajectory gets and how short a piece may become.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PieceParams {
+    /// Target length of one piece along the initial guess (m); the piece count is
+    /// `ceil(length / target)` clamped to `[min_pieces, max_pieces]`.
+    pub target_piece_length_m: f64,
+    /// Fewest pieces (≥ 1).
+    pub min_pieces: usize,
+    /// Most pieces (≥ `min_pieces`).
+    pub max_pieces: usize,
+    /// Lower bound of every piece duration (s): durations are `T_min + T(τ)` with the positive
+    /// map [`crate::backend::positive_time`].
+    pub min_piece_duration_s: f64,
+}
+
+impl Default for PieceParams {
+    /// Ours (the paper gives no values):
+    /// - `target_piece_length_m = 3`: the E2 path (about 50 m) gets 16–18 pieces, the size of the
+    ///   reference's representative problem (16 pieces);
+    /// - `min_pieces = 2`, `max_pieces = 32`: at least one free waypoint; the cost stays within
+    ///   the O(n) budget of design.md §6;
+    /// - `min_piece_duration_s = 0.02`: keeps MINCO's `T⁵` pivot above 3e-9 and gives a hover
+    ///   (start on the goal) a non-degenerate duration when `H_t` pushes every duration down.
+    fn default() -> Self {
+        Self {
+            target_piece_length_m: 3.0,
+            min_pieces: 2,
+            max_pieces: 32,
+            min_piece_duration_s: 0.02,
+        }
+    }
+}
+
+impl PieceParams {
+    /// Checks every field; errors name `{prefix}.{field}`.
+    pub fn validate(&self, prefix: &str) -> Result<(), PlanError> {
+        check_positive(
+            &format!("{prefix}.target_piece_length_m"),
+            self.target_piece_length_m,
+        )?;
+        if self.min_pieces == 0 {
+            return Err(PlanError::invalid(
+                format!("{prefix}.min_pieces"),
+                self.min_pieces,
+                "an integer >= 1",
+            ));
+        }
+        if self.max_pieces < self.min_pieces {
+            return Err(PlanError::invalid(
+                format!("{prefix}.max_pieces"),
+                self.max_pieces,
+                format!("an integer >= min_pieces ({})", self.min_pieces),
+            ));
+        }
+        check_positive(
+            &format!("{prefix}.min_piece_duration_s"),
+            self.min_piece_duration_s,
+        )?;
+        Ok(())
+    }
+
+    /// The piece count for a path of `length` metres: `ceil(length / target)` clamped to
+    /// `[min_pieces, max_pieces]` (`min_pieces` for a zero or non-finite length).
+    pub fn piece_count(&self, length: f64) -> usize {
+        let raw = if length.is_finite() && length > 0.0 {
+            (length / self.target_piece_length_m)
+                .ceil()
+                .min(self.max_pieces as f64) as usize
+        } else {
+            0
+        };
+        raw.clamp(self.min_pieces, self.max_pieces).max(1)
+    }
+}
+
+/// Budget and settings of the L-BFGS solve.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverParams {
+    /// Most cost evaluations per solve (0: only `lbfgs.max_evaluations` limits). The
+    /// smaller non-zero of the two applies.
+    pub max_evaluations: usize,
+    /// The L-BFGS settings.
+    pub lbfgs: LbfgsParams,
+}
+
+impl Default for SolverParams {
+    /// `max_evaluations = 1000` (ours: a hard cap of about 1000 × 20 µs = 20 ms per solve on this
+    /// machine, twice the paper's ~10 ms per trajectory); `lbfgs`: LBFGS-Lite's defaults
+    /// (memory 8, `g_epsilon = 1e-5`, `past = 3`, `delta = 1e-6`; see [`LbfgsParams`]), which the
+    /// reference measured to reach an equal or lower cost than GCOPTER's own settings.
+    fn default() -> Self {
+        Self {
+            max_evaluations: 1000,
+            lbfgs: LbfgsParams::default(),
+        }
+    }
+}
+
+impl SolverParams {
+    /// Checks the L-BFGS settings.
+    pub fn validate(&self, prefix: &str) -> Result<(), PlanError> {
+        self.lbfgs.validate().map_err(|e| PlanError::InvalidInput {
+            field: format!("{prefix}.lbfgs"),
+            value: e.to_string(),
+            expected: "valid L-BFGS parameters".into(),
+        })
+    }
+
+    /// The L-BFGS parameters with the effective evaluation budget.
+    pub fn effective_lbfgs(&self) -> LbfgsParams {
+        let mut p = self.lbfgs.clone();
+        p.max_evaluations = match (self.max_evaluations, p.max_evaluations) {
+            (0, m) | (m, 0) => m,
+            (a, b) => a.min(b),
+        };
+        p
+    }
+}
+
+/// Parameters of [`crate::backend::UtfMinco`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct UtfMincoParams {
+    /// `λ` of eq. design-of-J.
+    pub weights: CostWeights,
+    /// Shapes of the cost terms.
+    pub penalty: PenaltyParams,
+    /// Piece count and minimum duration.
+    pub pieces: PieceParams,
+    /// L-BFGS budget and settings.
+    pub solver: SolverParams,
+}
+
+impl UtfMincoParams {
+    /// Checks every field; errors name `{prefix}.{field}` (e.g. `params.weights.time`).
+    pub fn validate(&self, prefix: &str) -> Result<(), PlanError> {
+        self.weights.validate(&format!("{prefix}.weights"))?;
+        self.penalty.validate(&format!("{prefix}.penalty"))?;
+        self.pieces.validate(&format!("{prefix}.pieces"))?;
+        self.solver.validate(&format!("{prefix}.solver"))
+    }
+}
+
+/// Parameters of [`crate::backend::Minco`]. The same fields as [`UtfMincoParams`]; the terminal
+/// weight `λ_s` only scales a constant there (the terminal is fixed).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct MincoParams {
+    /// `λ` of eq. design-of-J.
+    pub weights: CostWeights,
+    /// Shapes of the cost terms.
+    pub penalty: PenaltyParams,
+    /// Piece count and minimum duration.
+    pub pieces: PieceParams,
+    /// L-BFGS budget and settings.
+    pub solver: SolverParams,
+}
+
+impl MincoParams {
+    /// Checks every field; errors name `{prefix}.{field}`.
+    pub fn validate(&self, prefix: &str) -> Result<(), PlanError> {
+        self.weights.validate(&format!("{prefix}.weights"))?;
+        self.penalty.validate(&format!("{prefix}.penalty"))?;
+        self.pieces.validate(&format!("{prefix}.pieces"))?;
+        self.solver.validate(&format!("{prefix}.solver"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn piece_count_is_clamped() {
+        let p = PieceParams::default();
+        assert_eq!(p.piece_count(0.0), 2);
+        assert_eq!(p.piece_count(f64::NAN), 2);
+        assert_eq!(p.piece_count(50.0), 17);
+        assert_eq!(p.piece_count(1e9), 32);
+    }
+
+    #[test]
+    fn budget_takes_the_smaller_limit() {
+        let mut s = SolverParams::default();
+        assert_eq!(s.effective_lbfgs().max_evaluations, 1000);
+        s.lbfgs.max_evaluations = 50;
+        assert_eq!(s.effective_lbfgs().max_evaluations, 50);
+        s.max_evaluations = 0;
+        assert_eq!(s.effective_lbfgs().max_evaluations, 50);
+    }
+
+    #[test]
+    fn validation_names_nested_fields() {
+        let mut p = UtfMincoParams::default();
+        p.validate("params").unwrap();
+        p.pieces.max_pieces = 1;
+        let e = p.validate("params").unwrap_err().to_string();
+        assert!(e.contains("params.pieces.max_pieces"), "{e}");
+        let mut p = MincoParams::default();
+        p.solver.lbfgs.memory = 0;
+        let e = p.validate("params").unwrap_err().to_string();
+        assert!(
+            e.contains("params.solver.lbfgs") && e.contains("memory"),
+            "{e}"
+        );
+        let json = r#"{"weights": {"time": 5.0}, "pieces": {"max_pieces": 8}}"#;
+        let p: UtfMincoParams = serde_json::from_str(json).unwrap();
+        assert_eq!(p.weights.time, 5.0);
+        assert_eq!(p.weights.obstacle, 1e4);
+        assert_eq!(p.pieces.max_pieces, 8);
+        assert!(serde_json::from_str::<UtfMincoParams>(r#"{"kappa": 3}"#).is_err());
+    }
+}

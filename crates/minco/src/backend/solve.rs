@@ -1,0 +1,111 @@
+//! What both backends share around the objective: request validation, the L-BFGS run with its
+//! budgets, and the mapping of the solver's outcome to a [`SolveStatus`].
+
+use std::time::Instant;
+
+use trust_core::{
+    InitialGuess, PlanError, Scene, SolveStatus, TrajRequest, check_finite, check_finite_vec,
+};
+use trust_lbfgs::{Deadline, Lbfgs, Report, Termination};
+
+use super::params::SolverParams;
+
+/// Maps an L-BFGS [`Termination`] to the planner's [`SolveStatus`]:
+/// `Converged → Converged`, `CostStalled → Stalled`, `MaxIterations → IterationLimit`,
+/// `MaxEvaluations → EvaluationLimit`, `Cancelled → TimeLimit` (the backends cancel only on the
+/// request's deadline), `LineSearchFailed(_) → LineSearchFailed` (also for any future variant).
+pub fn solve_status(termination: Termination) -> SolveStatus {
+    match termination {
+        Termination::Converged => SolveStatus::Converged,
+        Termination::CostStalled => SolveStatus::Stalled,
+        Termination::MaxIterations => SolveStatus::IterationLimit,
+        Termination::MaxEvaluations => SolveStatus::EvaluationLimit,
+        Termination::Cancelled => SolveStatus::TimeLimit,
+        _ => SolveStatus::LineSearchFailed,
+    }
+}
+
+/// Checks a trajectory request against a scene, as both backends do before optimizing:
+/// every number finite (fields named `request.…`, `scene.…`), every forecast valid, start and
+/// goal inside the map bounds ([`PlanError::OutOfBounds`]), the start not inside a static
+/// obstacle ([`PlanError::InCollision`]). A start inside a moving obstacle's forecast is allowed
+/// (the optimizer pushes the trajectory out as fast as the limits allow).
+pub fn validate_request(req: &TrajRequest<'_>, scene: &Scene<'_>) -> Result<(), PlanError> {
+    req.validate()?;
+    check_finite("scene.t0", scene.t0)?;
+    for (i, f) in scene.forecasts.iter().enumerate() {
+        f.validate().map_err(|e| PlanError::InvalidInput {
+            field: format!("scene.forecasts[{i}]"),
+            value: e.to_string(),
+            expected: "a valid forecast".into(),
+        })?;
+    }
+    match req.initial {
+        InitialGuess::Guide(path) => {
+            if path.points.is_empty() {
+                return Err(PlanError::invalid(
+                    "request.initial.points",
+                    "[]",
+                    "at least one point",
+                ));
+            }
+            for (i, p) in path.points.iter().enumerate() {
+                check_finite_vec(&format!("request.initial.points[{i}]"), p)?;
+            }
+        }
+        // `PolyTraj` is validated when built or deserialized.
+        InitialGuess::WarmStart(_) => {}
+    }
+    scene.check_in_bounds("request.start.p", &req.start.p)?;
+    scene.check_in_bounds("request.goal", &req.goal)?;
+    scene.check_static_free("request.start.p", &req.start.p, 0.0)?;
+    Ok(())
+}
+
+/// Runs L-BFGS on `f` from `x` with the evaluation budget of `solver` and the optional deadline.
+pub(crate) fn run_lbfgs<F>(
+    component: &str,
+    f: F,
+    x: &mut [f64],
+    solver: &SolverParams,
+    deadline: Option<Instant>,
+) -> Result<Report, PlanError>
+where
+    F: FnMut(&[f64], &mut [f64]) -> f64,
+{
+    let wrap = |e: trust_lbfgs::LbfgsError| PlanError::Component {
+        component: component.into(),
+        source: Box::new(e),
+    };
+    let mut lbfgs = Lbfgs::new(x.len(), solver.effective_lbfgs()).map_err(wrap)?;
+    match deadline {
+        Some(at) => lbfgs.minimize(x, f, &mut Deadline::new(at)),
+        None => lbfgs.minimize(x, f, &mut ()),
+    }
+    .map_err(wrap)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use trust_lbfgs::LineSearchFailure;
+
+    #[test]
+    fn statuses_map_one_to_one() {
+        assert_eq!(solve_status(Termination::Converged), SolveStatus::Converged);
+        assert_eq!(solve_status(Termination::CostStalled), SolveStatus::Stalled);
+        assert_eq!(
+            solve_status(Termination::MaxIterations),
+            SolveStatus::IterationLimit
+        );
+        assert_eq!(
+            solve_status(Termination::MaxEvaluations),
+            SolveStatus::EvaluationLimit
+        );
+        assert_eq!(solve_status(Termination::Cancelled), SolveStatus::TimeLimit);
+        assert_eq!(
+            solve_status(Termination::LineSearchFailed(LineSearchFailure::TrialLimit)),
+            SolveStatus::LineSearchFailed
+        );
+    }
+}

@@ -1,0 +1,85 @@
+//! The UTF-MINCO backend (paper Sec. III-D): uniform durations, free terminal position and
+//! velocity, one total duration.
+
+use std::time::Instant;
+
+use trust_core::{PlanError, Scene, Solution, SolveStats, TrajRequest, TrajectoryBackend};
+
+use super::init::initial_trajectory;
+use super::objective::UtfMincoObjective;
+use super::params::UtfMincoParams;
+use super::solve::{run_lbfgs, solve_status, validate_request};
+
+/// UTF-MINCO: minimizes `J = λ · [H_t, H_s, I_o, I_d, I_e]` (paper eq. design-of-J) over the
+/// inner waypoints, the free terminal position and velocity and the total duration
+/// ([`UtfMincoObjective`]) with L-BFGS.
+///
+/// - Initial guess: [`crate::backend::initial_trajectory`] (guide path resampled by arc length, or
+///   a previous trajectory sampled at uniform times).
+/// - Budget: `params.solver.max_evaluations` and the request's deadline (checked once per
+///   iteration); the status says which stopped the solve.
+/// - The returned trajectory starts at `req.start` (position, velocity, acceleration, time) and
+///   is finite; the cost breakdown is evaluated at it.
+#[derive(Debug, Clone, Default)]
+pub struct UtfMinco {
+    params: UtfMincoParams,
+}
+
+impl UtfMinco {
+    /// A backend with validated parameters.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] naming the first invalid field (`params.…`).
+    pub fn new(params: UtfMincoParams) -> Result<Self, PlanError> {
+        params.validate("params")?;
+        Ok(Self { params })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &UtfMincoParams {
+        &self.params
+    }
+}
+
+impl TrajectoryBackend for UtfMinco {
+    fn name(&self) -> &str {
+        "utf-minco"
+    }
+
+    fn optimize(&self, req: &TrajRequest<'_>, scene: &Scene<'_>) -> Result<Solution, PlanError> {
+        let started = Instant::now();
+        validate_request(req, scene)?;
+        let p = &self.params;
+        let init = initial_trajectory(&req.initial, &req.start, &req.limits, &p.pieces);
+        let mut f =
+            UtfMincoObjective::new(scene, &req.start, req.goal, req.limits, p, init.pieces())?;
+        let mut x = vec![0.0; f.dimension()];
+        f.encode(
+            &init.waypoints,
+            &init.end_position,
+            &init.end_velocity,
+            init.total_duration,
+            &mut x,
+        )?;
+        let report = run_lbfgs(
+            self.name(),
+            |x, g| f.eval(x, g),
+            &mut x,
+            &p.solver,
+            req.deadline,
+        )?;
+        // Re-evaluate at the returned point: the breakdown and the trajectory belong to it.
+        let mut g = vec![0.0; x.len()];
+        f.eval(&x, &mut g);
+        Ok(Solution {
+            traj: f.trajectory()?,
+            costs: f.breakdown(),
+            stats: SolveStats {
+                iteration_count: report.iteration_count,
+                evaluation_count: report.evaluation_count + 1,
+                elapsed: started.elapsed(),
+                status: solve_status(report.termination),
+            },
+        })
+    }
+}

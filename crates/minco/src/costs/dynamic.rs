@@ -1,0 +1,236 @@
+//! The moving-obstacle penalty `I_o` through the dynamic distance field (paper eqs. design-of-Io
+//! and gradients-of-Io).
+
+use trust_core::{Aabb, Forecast, Vec3};
+
+use super::integrate::{Integrand, SampleGrad, SampleState};
+use super::smooth::smoothed_l1;
+
+/// The DDF violation `φ_o` of one forecast at `(p, t)` and its partial derivatives
+/// `(φ, ∂φ/∂p, ∂φ/∂t)`.
+///
+/// With `d` the forecast's signed distance ([`Forecast::distance_and_gradients`]), `c` the extra
+/// `clearance`, `d' = d − c` and `R = radius(t) + c`:
+/// `φ = −d' (2R + d')`. For a sphere this is exactly the paper's signed squared distance
+/// `R² − ‖p − p_o(t)‖²` (positive inside the inflated obstacle); for a cylinder it is the same
+/// expression of the cylinder's signed distance and radius, which keeps the sphere's scale and is
+/// monotone in `d` (`R + d' ≥ 0` everywhere). `∂φ/∂t` is the obstacle part (b) of eq.
+/// gradients-of-Io: centre motion and radius growth, `∂φ/∂d'·∂d/∂t + ∂φ/∂R·Ṙ`.
+#[inline]
+pub fn ddf_violation(forecast: &Forecast, p: &Vec3, t: f64, clearance: f64) -> (f64, Vec3, f64) {
+    let (d, d_p, d_t) = forecast.distance_and_gradients(p, t);
+    let dd = d - clearance;
+    let r = forecast.radius(t) + clearance;
+    let phi = -dd * (2.0 * r + dd);
+    let phi_d = -2.0 * (r + dd);
+    let phi_r = -2.0 * dd;
+    (
+        phi,
+        d_p * phi_d,
+        phi_d * d_t + phi_r * forecast.radius_rate(t),
+    )
+}
+
+/// Axis-aligned box that contains every point within `margin` of the inflated obstacle at any
+/// time of `[t_a, t_b]` (broad phase). Never fails; non-finite input gives a non-finite box that
+/// intersects nothing.
+#[inline]
+pub fn swept_box(forecast: &Forecast, t_a: f64, t_b: f64, margin: f64) -> Aabb {
+    let (ca, cb) = (forecast.center(t_a), forecast.center(t_b));
+    let t_max = t_a.max(t_b);
+    let r = forecast.radius(t_max) + margin;
+    let half = Vec3::new(r, r, forecast.vertical_half_extent(t_max) + margin);
+    Aabb {
+        min: ca.inf(&cb) - half,
+        max: ca.sup(&cb) + half,
+    }
+}
+
+/// `I_o` for moving obstacles: `L_o = Σ_O f_max(φ_o)` (paper eq. design-of-Io) with
+/// [`ddf_violation`] and [`smoothed_l1`].
+///
+/// Broad phase: per trajectory and then per piece, only forecasts whose [`swept_box`] over the
+/// time window (inflated by the clearance) meets the box of the samples are evaluated; the
+/// others have `φ < 0` at every sample, so the result is the same as evaluating all of them.
+#[derive(Debug, Clone)]
+pub struct DynamicObstacleTerm<'a> {
+    forecasts: &'a [Forecast],
+    clearance: f64,
+    smoothing: f64,
+    near_trajectory: Vec<usize>,
+    near_piece: Vec<usize>,
+}
+
+impl<'a> DynamicObstacleTerm<'a> {
+    /// The penalty against `forecasts` with extra `clearance` (m) and smoothing `μ`.
+    pub fn new(forecasts: &'a [Forecast], clearance: f64, smoothing: f64) -> Self {
+        Self {
+            forecasts,
+            clearance,
+            smoothing,
+            near_trajectory: Vec::with_capacity(forecasts.len()),
+            near_piece: Vec::with_capacity(forecasts.len()),
+        }
+    }
+
+    /// Indices of the forecasts that survived the broad phase of the current piece.
+    pub fn candidates(&self) -> &[usize] {
+        &self.near_piece
+    }
+
+    /// `L_o` at one node without broad phase: adds `weight · ∂L_o` into `grad` and returns the
+    /// unweighted `L_o` over the forecasts listed in `indices`.
+    fn accumulate(
+        &self,
+        indices: impl Iterator<Item = usize>,
+        s: &SampleState,
+        grad: &mut SampleGrad,
+        weight: f64,
+    ) -> f64 {
+        let mut total = 0.0;
+        for o in indices {
+            let (phi, phi_p, phi_t) = ddf_violation(&self.forecasts[o], &s.p, s.t, self.clearance);
+            if phi <= 0.0 {
+                continue;
+            }
+            let (value, slope) = smoothed_l1(phi, self.smoothing);
+            total += value;
+            let k = weight * slope;
+            grad.p += phi_p * k;
+            grad.t += phi_t * k;
+        }
+        total
+    }
+
+    /// Broad phase for the whole trajectory.
+    pub(crate) fn begin_trajectory_impl(&mut self, t_begin: f64, t_end: f64, samples_box: &Aabb) {
+        self.near_trajectory.clear();
+        for (o, f) in self.forecasts.iter().enumerate() {
+            if swept_box(f, t_begin, t_end, self.clearance).intersects(samples_box) {
+                self.near_trajectory.push(o);
+            }
+        }
+    }
+
+    /// Broad phase for one piece; `true` if any forecast survived.
+    pub(crate) fn begin_piece_impl(
+        &mut self,
+        t_begin: f64,
+        t_end: f64,
+        samples_box: &Aabb,
+    ) -> bool {
+        self.near_piece.clear();
+        for &o in &self.near_trajectory {
+            if swept_box(&self.forecasts[o], t_begin, t_end, self.clearance).intersects(samples_box)
+            {
+                self.near_piece.push(o);
+            }
+        }
+        !self.near_piece.is_empty()
+    }
+
+    /// `L_o` at one node over the current piece's candidates, gradient scaled by `weight`.
+    pub(crate) fn sample_weighted(
+        &self,
+        s: &SampleState,
+        grad: &mut SampleGrad,
+        weight: f64,
+    ) -> f64 {
+        self.accumulate(self.near_piece.iter().copied(), s, grad, weight)
+    }
+
+    /// `L_o` at one node over **all** forecasts (no broad phase), gradient added into `grad`.
+    /// Used to check the broad phase; prefer integrating the term.
+    pub fn sample_all(&self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
+        self.accumulate(0..self.forecasts.len(), s, grad, 1.0)
+    }
+}
+
+impl Integrand for DynamicObstacleTerm<'_> {
+    fn begin_trajectory(&mut self, t_begin: f64, t_end: f64, samples_box: &Aabb) {
+        self.begin_trajectory_impl(t_begin, t_end, samples_box);
+    }
+
+    fn begin_piece(&mut self, _piece: usize, t_begin: f64, t_end: f64, samples_box: &Aabb) -> bool {
+        self.begin_piece_impl(t_begin, t_end, samples_box)
+    }
+
+    fn sample(&mut self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
+        self.sample_weighted(s, grad, 1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use proptest::prelude::*;
+    use trust_core::ObstacleShape;
+
+    fn forecast(cylinder: bool) -> Forecast {
+        let shape = if cylinder {
+            ObstacleShape::Cylinder { half_height: 1.5 }
+        } else {
+            ObstacleShape::Sphere
+        };
+        Forecast::new(
+            shape,
+            Vec3::new(1.0, 2.0, 3.0),
+            Vec3::new(0.5, -1.0, 0.2),
+            0.5,
+            0.8,
+            0.2,
+            0.3,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn sphere_violation_is_the_signed_squared_distance() {
+        let f = forecast(false);
+        let (p, t, c) = (Vec3::new(1.3, 1.9, 3.4), 1.0, 0.1);
+        let r = f.radius(t) + c;
+        let (phi, _, _) = ddf_violation(&f, &p, t, c);
+        assert_relative_eq!(
+            phi,
+            r * r - (p - f.center(t)).norm_squared(),
+            epsilon = 1e-12
+        );
+    }
+
+    proptest! {
+        #[test]
+        fn violation_gradients_match_finite_differences(
+            px in -1.0..3.0f64, py in 0.0..4.0f64, pz in 1.0..5.0f64,
+            t in 0.6..2.0f64, cylinder in any::<bool>(),
+        ) {
+            let f = forecast(cylinder);
+            let p = Vec3::new(px, py, pz);
+            let c = 0.1;
+            let (_, gp, gt) = ddf_violation(&f, &p, t, c);
+            let h = 1e-6;
+            for d in 0..3 {
+                let mut hi = p;
+                let mut lo = p;
+                hi[d] += h;
+                lo[d] -= h;
+                let fd = (ddf_violation(&f, &hi, t, c).0 - ddf_violation(&f, &lo, t, c).0) / (2.0 * h);
+                prop_assert!((fd - gp[d]).abs() < 1e-4 * (1.0 + fd.abs()), "p[{d}]: {fd} vs {}", gp[d]);
+            }
+            let fd = (ddf_violation(&f, &p, t + h, c).0 - ddf_violation(&f, &p, t - h, c).0) / (2.0 * h);
+            prop_assert!((fd - gt).abs() < 1e-4 * (1.0 + fd.abs()), "t: {fd} vs {gt}");
+        }
+
+        #[test]
+        fn swept_box_contains_the_obstacle(t_a in 0.0..3.0f64, dt in 0.0..2.0f64, u in 0.0..1.0f64, cylinder in any::<bool>()) {
+            let f = forecast(cylinder);
+            let t = t_a + u * dt;
+            let b = swept_box(&f, t_a, t_a + dt, 0.1);
+            let c = f.center(t);
+            let r = f.radius(t) + 0.1;
+            for corner in [Vec3::new(r, r, f.vertical_half_extent(t) + 0.1), Vec3::new(-r, -r, -f.vertical_half_extent(t) - 0.1)] {
+                prop_assert!(b.inflated(1e-9).contains(&(c + corner)));
+            }
+        }
+    }
+}

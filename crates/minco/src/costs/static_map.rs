@@ -1,0 +1,99 @@
+//! The static-map obstacle penalty (part of `I_o`).
+
+use trust_core::{Aabb, StaticMap, Vec3};
+
+use super::integrate::{Integrand, SampleGrad, SampleState};
+use super::smooth::smoothed_l1;
+
+/// Static-map penalty `L_s = Σ_shapes f_max(c − d_shape(p)) + f_max(c − d_esdf(p))`: the smoothed
+/// violation of the clearance `c` by each analytic shape of the [`StaticMap`] and by its voxel
+/// ESDF (if any), with the closed-form signed distances of `trust-geometry`.
+///
+/// Summing over shapes (instead of penalizing the map's minimum distance) keeps the cost smooth
+/// where two shapes are equally near; where only one shape violates the clearance — the usual
+/// case — both agree. Broad phase: per piece, the map's BVH ([`StaticMap::shapes_near`]) lists
+/// the shapes whose boxes meet the samples' box inflated by `c`; the others cannot violate the
+/// clearance at any sample.
+#[derive(Debug, Clone)]
+pub struct StaticObstacleTerm<'a> {
+    map: &'a StaticMap,
+    clearance: f64,
+    smoothing: f64,
+    near: Vec<usize>,
+    use_esdf: bool,
+}
+
+impl<'a> StaticObstacleTerm<'a> {
+    /// The penalty against `map` with `clearance` (m) and smoothing `μ`.
+    pub fn new(map: &'a StaticMap, clearance: f64, smoothing: f64) -> Self {
+        Self {
+            map,
+            clearance,
+            smoothing,
+            near: Vec::new(),
+            use_esdf: false,
+        }
+    }
+
+    /// Broad phase for one piece; `true` if anything may be violated.
+    pub(crate) fn begin_piece_impl(&mut self, samples_box: &Aabb) -> bool {
+        self.near.clear();
+        self.use_esdf = false;
+        if self.map.has_no_obstacles() {
+            return false;
+        }
+        if !(samples_box.min.iter().chain(samples_box.max.iter())).all(|x| x.is_finite()) {
+            // Non-finite samples: let the sample evaluation report a non-finite cost.
+            self.near.extend(0..self.map.shapes().len());
+            self.use_esdf = self.map.esdf().is_some();
+            return true;
+        }
+        self.map
+            .shapes_near(&samples_box.inflated(self.clearance), &mut self.near);
+        self.use_esdf = self.map.esdf().is_some_and(|e| e.occupied_count() > 0);
+        self.use_esdf || !self.near.is_empty()
+    }
+
+    /// Unweighted `L_s` at one node; adds `weight · ∂L_s/∂p` into `grad`.
+    pub(crate) fn sample_weighted(
+        &self,
+        s: &SampleState,
+        grad: &mut SampleGrad,
+        weight: f64,
+    ) -> f64 {
+        let shapes = self.map.shapes();
+        let mut total = 0.0;
+        let mut add = |(d, g): (f64, Vec3)| {
+            let (value, slope) = smoothed_l1(self.clearance - d, self.smoothing);
+            if slope != 0.0 || value != 0.0 {
+                total += value;
+                grad.p -= g * (weight * slope);
+            }
+        };
+        for &i in &self.near {
+            add(shapes[i].distance_and_gradient(&s.p));
+        }
+        if self.use_esdf
+            && let Some(esdf) = self.map.esdf()
+        {
+            add(esdf.distance_and_gradient(&s.p));
+        }
+        total
+    }
+}
+
+impl Integrand for StaticObstacleTerm<'_> {
+    fn begin_piece(
+        &mut self,
+        _piece: usize,
+        _t_begin: f64,
+        _t_end: f64,
+        samples_box: &Aabb,
+    ) -> bool {
+        self.begin_piece_impl(samples_box)
+    }
+
+    fn sample(&mut self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
+        self.sample_weighted(s, grad, 1.0)
+    }
+}
