@@ -5,11 +5,18 @@
 //!
 //! Commands:
 //! - `ci`: runs `.ci/run`, exactly what CI runs.
+//! - `experiment e1`: paper Fig. Sim-A-1-1(c), DEV-PRM vs V-PRM distinct paths per CPU ms over the
+//!   number of dynamic obstacles; writes `out/e1/results.json` and `out/e1/report.md`.
+//! - `experiment e2`: paper Table Sim-A-2, UTF-MINCO vs MINCO on the static and dynamic 50×20×10 m
+//!   scenes; writes `out/e2/results.json` and `out/e2/report.md`.
 
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
-use clap::{Parser, Subcommand};
+use clap::{Parser, Subcommand, ValueEnum};
+use serde_json::Value;
 
 #[derive(Parser)]
 #[command(
@@ -23,29 +30,187 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
-    /// Run `.ci/run` (format, clippy, tests, rustdoc, benchmark smoke runs).
+    /// Run `.ci/run` (format, clippy, tests, rustdoc, benchmark and example smoke runs).
     Ci,
+    /// Reproduce one of the paper's experiments (release build) and write a report under `out/`.
+    Experiment {
+        /// Which experiment.
+        name: Experiment,
+        /// Trials per configuration (E1: random scenes per obstacle count; E2: timing repetitions).
+        #[arg(long, default_value_t = 50)]
+        trials: usize,
+        /// Base seed (E1).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Output directory.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Experiment {
+    /// DEV-PRM vs V-PRM path-finding efficiency (paper Fig. Sim-A-1-1(c)).
+    E1,
+    /// UTF-MINCO vs MINCO on static and dynamic scenes (paper Table Sim-A-2).
+    E2,
 }
 
 fn main() -> Result<()> {
     let cli = Cli::parse();
     let root = workspace_root()?;
     match cli.command {
-        Cmd::Ci => run(Command::new("bash")
-            .arg(root.join(".ci/run"))
-            .current_dir(&root)),
+        Cmd::Ci => run_status(
+            Command::new("bash")
+                .arg(root.join(".ci/run"))
+                .current_dir(&root),
+        ),
+        Cmd::Experiment {
+            name,
+            trials,
+            seed,
+            out,
+        } => {
+            if trials == 0 {
+                bail!("--trials must be at least 1");
+            }
+            let out = root.join(out);
+            match name {
+                Experiment::E1 => experiment_e1(&root, trials, seed, &out.join("e1")),
+                Experiment::E2 => experiment_e2(&root, trials, &out.join("e2")),
+            }
+        }
     }
 }
 
-fn workspace_root() -> Result<std::path::PathBuf> {
-    let manifest_dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+/// Obstacle counts of paper Fig. Sim-A-1-1(c).
+const E1_OBSTACLE_COUNTS: [usize; 5] = [2, 5, 10, 15, 20];
+
+fn experiment_e1(root: &Path, trials: usize, seed: u64, out: &Path) -> Result<()> {
+    let mut rows = Vec::new();
+    for (i, k) in E1_OBSTACLE_COUNTS.iter().enumerate() {
+        eprintln!(
+            "[{}/{}] E1 with {k} dynamic obstacles, {trials} scenes",
+            i + 1,
+            E1_OBSTACLE_COUNTS.len()
+        );
+        let json = cargo_example_json(
+            root,
+            "trust-topo-prm",
+            "prm_efficiency",
+            &[
+                "--obstacles",
+                &k.to_string(),
+                "--trials",
+                &trials.to_string(),
+                "--seed",
+                &seed.to_string(),
+            ],
+        )?;
+        rows.push(json);
+    }
+    let mut md = String::from(
+        "# E1 — DEV-PRM vs V-PRM (paper Fig. Sim-A-1-1(c))\n\n\
+         20×20×10 m scenes with k random dynamic obstacles, 20 ms budget per planner; distinct paths \
+         judged by one common checker for both planners.\n\n\
+         | k | V-PRM paths | V-PRM ms | V-PRM paths/ms | DEV-PRM paths | DEV-PRM ms | DEV-PRM paths/ms | ratio |\n\
+         |---|---|---|---|---|---|---|---|\n",
+    );
+    for r in &rows {
+        let f = |path: &[&str]| -> String {
+            let mut v = r;
+            for p in path {
+                v = &v[*p];
+            }
+            v.as_f64()
+                .map(|x| format!("{x:.3}"))
+                .unwrap_or_else(|| "?".into())
+        };
+        writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            r["obstacles"],
+            f(&["vprm", "distinct_paths_mean"]),
+            f(&["vprm", "cpu_ms_mean"]),
+            f(&["vprm", "paths_per_ms"]),
+            f(&["devprm", "distinct_paths_mean"]),
+            f(&["devprm", "cpu_ms_mean"]),
+            f(&["devprm", "paths_per_ms"]),
+            f(&["ratio"]),
+        )?;
+    }
+    md.push_str("\nPaper, k = 10: V-PRM 0.186, DEV-PRM 0.338 paths/ms (ratio 1.82).\n");
+    if let Some(checker) = rows.first().and_then(|r| r.get("checker")) {
+        writeln!(md, "\nCommon checker: {checker}.")?;
+    }
+    write_outputs(out, &Value::Array(rows), &md)
+}
+
+fn experiment_e2(root: &Path, trials: usize, out: &Path) -> Result<()> {
+    eprintln!("E2: UTF-MINCO vs MINCO, {trials} repetitions per case");
+    let json = cargo_example_json(
+        root,
+        "trust-minco",
+        "e2_compare",
+        &["--repeats", &trials.to_string()],
+    )?;
+    let md = format!(
+        "# E2 — UTF-MINCO vs MINCO (paper Table Sim-A-2)\n\n```json\n{}\n```\n\n\
+         Paper: UTF-MINCO 8.98 ms / 7.08 s (static), 9.71 ms / 6.47 s (dynamic); \
+         MINCO 7.77 ms / 7.09 s, 8.52 ms / 6.72 s (collides in the dynamic case).\n",
+        serde_json::to_string_pretty(&json)?
+    );
+    write_outputs(out, &json, &md)
+}
+
+fn write_outputs(out: &Path, json: &Value, md: &str) -> Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    std::fs::write(
+        out.join("results.json"),
+        serde_json::to_string_pretty(json)?,
+    )?;
+    std::fs::write(out.join("report.md"), md)?;
+    println!("{md}");
+    eprintln!("wrote {}", out.display());
+    Ok(())
+}
+
+/// Runs `cargo run --release -p PACKAGE --example EXAMPLE -- ARGS` and parses its stdout as JSON.
+fn cargo_example_json(root: &Path, package: &str, example: &str, args: &[&str]) -> Result<Value> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let output = Command::new(cargo)
+        .current_dir(root)
+        .args([
+            "run",
+            "--quiet",
+            "--release",
+            "-p",
+            package,
+            "--example",
+            example,
+            "--",
+        ])
+        .args(args)
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .with_context(|| format!("failed to start cargo for example {example}"))?;
+    if !output.status.success() {
+        bail!("example {example} failed with {}", output.status);
+    }
+    let stdout = String::from_utf8(output.stdout).context("example output is not UTF-8")?;
+    serde_json::from_str(stdout.trim())
+        .with_context(|| format!("example {example} did not print one JSON object: {stdout}"))
+}
+
+fn workspace_root() -> Result<PathBuf> {
+    let manifest_dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     manifest_dir
         .parent()
         .map(|p| p.to_path_buf())
         .context("xtask must live one level below the workspace root")
 }
 
-fn run(cmd: &mut Command) -> Result<()> {
+fn run_status(cmd: &mut Command) -> Result<()> {
     let status = cmd
         .status()
         .with_context(|| format!("failed to start {cmd:?}"))?;

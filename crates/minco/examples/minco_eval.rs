@@ -11,7 +11,7 @@
 //!
 //! Errors (bad JSON, wrong lengths, invalid numbers) go to stderr with exit status 1.
 
-use std::io::Read;
+use std::io::{Read, Write};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -22,8 +22,16 @@ fn main() -> ExitCode {
     }
     match trust_minco::eval_json(&input) {
         Ok(output) => {
-            println!("{output}");
-            ExitCode::SUCCESS
+            // A closed pipe (`| head`) is not worth a panic backtrace.
+            let mut stdout = std::io::stdout().lock();
+            match writeln!(stdout, "{output}").and_then(|()| stdout.flush()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("minco_eval: cannot write stdout: {e}");
+                    ExitCode::FAILURE
+                }
+            }
         }
         Err(e) => {
             eprintln!("minco_eval: {e}");
