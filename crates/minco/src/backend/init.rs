@@ -128,10 +128,10 @@ pub fn rest_to_rest_time(length: f64, limits: &Limits) -> f64 {
 
 /// Builds the initial guess for a vehicle in state `start`: the piece count from the guess's
 /// length ([`PieceParams::piece_count`]), then
-/// - [`InitialGuess::Guide`]: the duration `T` of a [`SpeedProfile`] along the path from the
-///   start speed `start_speed` (the start velocity's component along the path's first segment);
-///   the waypoints are the profile's positions at the uniform times `iT/n`; the terminal is the
-///   path's end, at rest;
+/// - [`InitialGuess::Guide`]: a [`SpeedProfile`] along the path from the start velocity's
+///   component along the path's first segment; the waypoints are the profile's positions at the
+///   uniform times `iT_p/n` (`T_p` its duration); the terminal is the path's end, at rest; the
+///   duration is `T_p`, but at least the braking time `‖v_0‖/a_max`;
 /// - [`InitialGuess::WarmStart`]: the trajectory from `start.t` (clamped to its span) to its end,
 ///   sampled at `n + 1` uniform times; terminal position and velocity at its end; duration the
 ///   remaining time.
@@ -165,10 +165,12 @@ fn from_guide(
         .find(|d| d.norm() > 0.0)
         .map_or(Vec3::zeros(), |d| d.normalize());
     let profile = SpeedProfile::new(length, start_velocity.dot(&direction), limits);
-    let total = profile.duration();
+    // At least the time to brake from the start speed: a (nearly) zero-length guide with a moving
+    // start would otherwise begin with a duration near 0, where the positive time map is flat.
+    let total = profile.duration().max(start_velocity.norm() / limits.a_max);
     let waypoints = (1..n)
         .map(|i| {
-            let s = profile.distance_at(total * i as f64 / n as f64);
+            let s = profile.distance_at(profile.duration() * i as f64 / n as f64);
             if length > 0.0 {
                 path.point_at_fraction(s / length)
             } else {
@@ -304,6 +306,23 @@ mod tests {
                 .all(|w| *w == Vec3::new(1.0, 2.0, 3.0))
         );
         assert!(init.total_duration > 0.0);
+    }
+
+    #[test]
+    fn moving_start_on_a_point_guide_gets_the_braking_time() {
+        let path = GuidePath::new(vec![Vec3::new(1.0, 2.0, 3.0)]).unwrap();
+        let start = State {
+            v: Vec3::new(0.0, 6.0, 0.0),
+            ..State::at_rest(0.0, path.start())
+        };
+        let limits = Limits::default();
+        let init = initial_trajectory(
+            &InitialGuess::Guide(&path),
+            &start,
+            &limits,
+            &PieceParams::default(),
+        );
+        assert_relative_eq!(init.total_duration, 6.0 / limits.a_max);
     }
 
     #[test]

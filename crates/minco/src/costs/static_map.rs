@@ -97,3 +97,73 @@ impl Integrand for StaticObstacleTerm<'_> {
         self.sample_weighted(s, grad, 1.0)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use trust_core::Aabb;
+
+    fn state(p: Vec3) -> SampleState {
+        SampleState {
+            piece: 0,
+            index: 0,
+            t: 0.0,
+            weight: 1.0,
+            p,
+            v: Vec3::zeros(),
+            a: Vec3::zeros(),
+            j: Vec3::zeros(),
+        }
+    }
+
+    /// The ESDF path (point clouds): positive penalty near the wall, analytic gradient equal to
+    /// the finite difference inside one voxel (the trilinear interpolant is smooth there).
+    #[test]
+    fn esdf_penalty_and_gradient() {
+        let bounds = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::new(4.0, 4.0, 4.0),
+        };
+        let wall: Vec<Vec3> = (0..40)
+            .flat_map(|i| {
+                (0..40).map(move |k| Vec3::new(2.05, 0.05 + 0.1 * i as f64, 0.05 + 0.1 * k as f64))
+            })
+            .collect();
+        let map = StaticMap::new(bounds)
+            .and_then(|m| m.with_point_cloud(&wall, 0.1))
+            .expect("valid cloud");
+        let mut term = StaticObstacleTerm::new(&map, 0.3, 1e-2);
+        let p = Vec3::new(1.873, 1.234, 2.017);
+        let samples = Aabb { min: p, max: p };
+        assert!(term.begin_piece(0, 0.0, 1.0, &samples));
+        let mut g = SampleGrad::ZERO;
+        let value = term.sample(&state(p), &mut g);
+        assert!(value > 0.0, "within 0.3 m of the wall");
+        let h = 1e-6;
+        for d in 0..3 {
+            let (mut hi, mut lo) = (p, p);
+            hi[d] += h;
+            lo[d] -= h;
+            let fd = (term.sample(&state(hi), &mut SampleGrad::default())
+                - term.sample(&state(lo), &mut SampleGrad::default()))
+                / (2.0 * h);
+            assert_relative_eq!(g.p[d], fd, epsilon = 1e-6, max_relative = 1e-6);
+        }
+    }
+
+    #[test]
+    fn empty_map_is_skipped() {
+        let map = StaticMap::empty(Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::repeat(1.0),
+        })
+        .expect("bounds");
+        let mut term = StaticObstacleTerm::new(&map, 0.3, 1e-2);
+        let b = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::repeat(1.0),
+        };
+        assert!(!term.begin_piece(0, 0.0, 1.0, &b));
+    }
+}
