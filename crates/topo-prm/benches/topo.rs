@@ -1,0 +1,122 @@
+//! Criterion benches: one DEV-PRM search and one V-PRM search on an E1 scene (K = 10), one TVD check
+//! between two trajectories among the same obstacles, and the roadmap's cone segment test against
+//! `trust_predict::Pdc`'s.
+//!
+//! `cargo bench -p trust-topo-prm` for medians; `cargo bench -p trust-topo-prm -- --test` runs each
+//! once (CI smoke mode).
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use rand::SeedableRng;
+
+use trust_core::{PathFrontend, PolyTraj, Rng, Scene, Vec3};
+use trust_topo_prm::{DevPrm, DevPrmParams, Vprm, VprmParams, scenes, tvd};
+
+fn world() -> scenes::RandomScene {
+    scenes::random_dynamic_scene(
+        10,
+        &scenes::SceneParams::default(),
+        &mut Rng::seed_from_u64(42),
+    )
+    .expect("default scene params are valid")
+}
+
+fn bench_frontends(c: &mut Criterion) {
+    let w = world();
+    let scene = Scene::new(&w.map, &w.forecasts, 0.0).expect("valid scene");
+    let devprm = DevPrm::new(DevPrmParams {
+        budget_ms: 20.0,
+        ..DevPrmParams::default()
+    })
+    .expect("valid params");
+    let vprm = Vprm::new(VprmParams {
+        budget_ms: 20.0,
+        ..VprmParams::default()
+    })
+    .expect("valid params");
+    c.bench_function("devprm_search_e1_k10", |b| {
+        let mut rng = Rng::seed_from_u64(7);
+        b.iter(|| {
+            black_box(
+                devprm
+                    .search(&w.query, &scene, &mut rng)
+                    .expect("valid query"),
+            )
+        });
+    });
+    c.bench_function("vprm_search_e1_k10", |b| {
+        let mut rng = Rng::seed_from_u64(7);
+        b.iter(|| {
+            black_box(
+                vprm.search(&w.query, &scene, &mut rng)
+                    .expect("valid query"),
+            )
+        });
+    });
+}
+
+/// A straight constant-velocity trajectory from `a` to `b` over `duration` seconds.
+fn straight(a: Vec3, b: Vec3, duration: f64) -> PolyTraj {
+    let mut piece = [Vec3::zeros(); 6];
+    piece[0] = a;
+    piece[1] = (b - a) / duration;
+    PolyTraj::new(0.0, vec![duration], vec![piece]).expect("valid trajectory")
+}
+
+fn bench_tvd(c: &mut Criterion) {
+    let w = world();
+    let scene = Scene::new(&w.map, &w.forecasts, 0.0).expect("valid scene");
+    let (s, g) = (w.query.start.p, w.query.goal);
+    let side = Vec3::new(0.0, 0.0, 2.0);
+    let t1 = straight(s, g + side, 2.0);
+    let t2 = straight(s, g - side, 2.0);
+    c.bench_function("tvd_check_2s_dt005_k10", |b| {
+        b.iter(|| black_box(tvd::equivalent(&t1, &t2, &scene, 0.05).expect("timed curves")));
+    });
+}
+
+/// 1000 random segments against one moving-sphere PDC: our `cone::Cone` versus `trust_predict::Pdc`
+/// (the reason the roadmap keeps its own copy of the geometry).
+fn bench_cone_tests(c: &mut Criterion) {
+    use rand::Rng as _;
+    let f = trust_core::Forecast::sphere(
+        Vec3::new(10.0, 10.0, 5.0),
+        Vec3::new(2.0, -1.0, 0.0),
+        0.0,
+        1.0,
+        0.0,
+        0.2,
+    )
+    .expect("valid forecast");
+    let cone = trust_topo_prm::cone::Cone::from_forecast(&f, 0.0, 2.0);
+    let pdc = trust_predict::Pdc::over_window(&f, 0.0, 2.0).expect("valid window");
+    let mut rng = Rng::seed_from_u64(3);
+    let mut point = || {
+        Vec3::new(
+            rng.random_range(0.0..20.0),
+            rng.random_range(0.0..20.0),
+            rng.random_range(3.0..7.0),
+        )
+    };
+    let segments: Vec<(Vec3, Vec3)> = (0..1000).map(|_| (point(), point())).collect();
+    c.bench_function("cone_segment_clear_x1000", |b| {
+        b.iter(|| {
+            segments
+                .iter()
+                .filter(|(p, q)| cone.segment_clear(p, q, 0.1))
+                .count()
+        });
+    });
+    c.bench_function("predict_pdc_segment_clear_x1000", |b| {
+        b.iter(|| {
+            segments
+                .iter()
+                .filter(|(p, q)| pdc.segment_clear(p, q, 0.1))
+                .count()
+        });
+    });
+}
+
+criterion_group!(benches, bench_frontends, bench_tvd, bench_cone_tests);
+criterion_main!(benches);

@@ -1,0 +1,243 @@
+//! [`DevPrm`]: the Dynamic Enhanced Visible PRM of TRUST-Planner (paper Sec. III-B, Algorithm 2).
+//!
+//! V-PRM plus three enhancements:
+//! 1. visibility against the predictive directional cones (PDCs, eq. PDC) of all forecasts over the
+//!    query horizon `T_h`, so paths avoid where moving obstacles may be;
+//! 2. obstacle-aware samples on the PDC surfaces, on slices along the predicted velocity, inserted
+//!    before the random samples (`ConstructRoadMap(G, P_PDC)`);
+//! 3. the goal guidance surface (GGS): paths end on the sphere of radius
+//!    `r_des = ‖p_s − p_g‖ − T_h·v_max` around the goal, or at the goal when `r_des <= 0`.
+//!
+//! The roadmap is searched by a beam search (bounded-width best-first expansion of partial paths by
+//! estimated length) and then `TopoPathSelect` (shortcut, UVD-against-PDC pruning, K-shortest with a
+//! length ratio). Each enhancement can be switched off for ablations.
+//!
+//! Details the paper leaves open, as implemented here:
+//! * the cones span `[query.start.t, query.start.t + query.horizon_s]`;
+//! * a cone that contains the start (or the goal, when paths end there) cannot be avoided in space
+//!   and is ignored by the roadmap — the trajectory backend handles it in time;
+//! * the time budget `t_max` covers the roadmap construction (obstacle-aware and random samples);
+//!   the search and selection that follow are bounded by counts (`max_expansions`,
+//!   `keep_raw_paths`), as in Fast-Planner;
+//! * the sampling box spans the start and the point of the GGS nearest to it, and samples inside the
+//!   GGS ball are rejected.
+
+use serde::{Deserialize, Serialize};
+
+use trust_core::{PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult, Vec3};
+
+use crate::prm::{ConeMode, GraphSearch, PrmSetup, SurfaceSampling, run};
+use crate::vprm::check_common;
+
+/// Parameters of [`DevPrm`]. The V-PRM part defaults to Fast-Planner's values (see
+/// [`crate::VprmParams`]); the paper gives no values for the rest, so they are ours, as stated.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DevPrmParams {
+    /// Sampling-box inflation (m), as in V-PRM. Fast-Planner: (1.0, 3.5, 1.0).
+    pub inflate: Vec3,
+    /// Samples closer than this to an obstacle (static or PDC) are rejected (m). Fast-Planner: 0.3.
+    pub clearance: f64,
+    /// Resolution (m): edge threshold and UVD/shortcut step. Fast-Planner: 0.1.
+    pub resolution: f64,
+    /// Time budget `t_max` of the roadmap construction (ms). Fast-Planner's 5 ms (E1 uses 20 ms).
+    pub budget_ms: f64,
+    /// Random-sample budget `N_max`. Fast-Planner's 2000.
+    pub max_samples: usize,
+    /// Width of the beam search (partial paths kept per level). Ours: 16.
+    pub beam_width: usize,
+    /// The search stops after this many raw paths. Fast-Planner: 300.
+    pub max_raw_paths: usize,
+    /// Raw paths kept (shortest first) for shortcutting. Fast-Planner: 25.
+    pub keep_raw_paths: usize,
+    /// At most this many paths are returned. Fast-Planner: 6.
+    pub max_paths: usize,
+    /// Paths longer than this times the shortest are dropped. Fast-Planner: 5.5.
+    pub length_ratio: f64,
+    /// The search stops after this many partial-path expansions. Ours: 100 000.
+    pub max_expansions: usize,
+    /// Test visibility against the PDCs of all forecasts (enhancement 1). Default `true`.
+    pub pdc: bool,
+    /// Insert obstacle-aware samples on PDC surfaces before random sampling (enhancement 2; needs
+    /// `pdc`). Default `true`.
+    pub obstacle_aware_samples: bool,
+    /// Slices along each PDC's predicted velocity. Ours: 3 (start, middle and end of the horizon).
+    pub slices: usize,
+    /// Samples on each slice. Ours: 8 (every 45°).
+    pub samples_per_slice: usize,
+    /// Signed distance of the obstacle-aware samples from the PDC surface (m); must be at least
+    /// `clearance`. Ours: 0.5 (the 0.3 m clearance plus two resolutions).
+    pub surface_offset: f64,
+    /// End paths on the goal guidance surface (enhancement 3). Default `true`.
+    pub goal_guidance_surface: bool,
+}
+
+impl Default for DevPrmParams {
+    fn default() -> Self {
+        DevPrmParams {
+            inflate: Vec3::new(1.0, 3.5, 1.0),
+            clearance: 0.3,
+            resolution: 0.1,
+            budget_ms: 5.0,
+            max_samples: 2000,
+            beam_width: 16,
+            max_raw_paths: 300,
+            keep_raw_paths: 25,
+            max_paths: 6,
+            length_ratio: 5.5,
+            max_expansions: 100_000,
+            pdc: true,
+            obstacle_aware_samples: true,
+            slices: 3,
+            samples_per_slice: 8,
+            surface_offset: 0.5,
+            goal_guidance_surface: true,
+        }
+    }
+}
+
+impl DevPrmParams {
+    /// Checks every field.
+    pub fn validate(&self) -> Result<(), PlanError> {
+        self.setup().map(|_| ())
+    }
+
+    fn setup(&self) -> Result<PrmSetup, PlanError> {
+        let budget = check_common(
+            "devprm",
+            &self.inflate,
+            self.clearance,
+            self.resolution,
+            self.budget_ms,
+            self.max_raw_paths,
+            self.keep_raw_paths,
+            self.max_paths,
+            self.length_ratio,
+            self.max_expansions,
+        )?;
+        if self.beam_width == 0 {
+            return Err(PlanError::invalid("devprm.beam_width", 0, ">= 1"));
+        }
+        if self.obstacle_aware_samples {
+            if self.slices == 0 {
+                return Err(PlanError::invalid("devprm.slices", 0, ">= 1"));
+            }
+            if self.samples_per_slice == 0 {
+                return Err(PlanError::invalid("devprm.samples_per_slice", 0, ">= 1"));
+            }
+            if !(self.surface_offset.is_finite() && self.surface_offset >= self.clearance) {
+                return Err(PlanError::invalid(
+                    "devprm.surface_offset",
+                    self.surface_offset,
+                    format!("a finite number >= devprm.clearance ({})", self.clearance),
+                ));
+            }
+        }
+        Ok(PrmSetup {
+            inflate: self.inflate,
+            clearance: self.clearance,
+            resolution: self.resolution,
+            budget,
+            max_samples: self.max_samples,
+            search: GraphSearch::Beam {
+                width: self.beam_width,
+            },
+            max_raw_paths: self.max_raw_paths,
+            keep_raw_paths: self.keep_raw_paths,
+            max_paths: self.max_paths,
+            length_ratio: self.length_ratio,
+            max_expansions: self.max_expansions,
+            cones: if self.pdc {
+                ConeMode::Predictive
+            } else {
+                ConeMode::Ignore
+            },
+            surface_sampling: (self.pdc && self.obstacle_aware_samples).then_some(
+                SurfaceSampling {
+                    slices: self.slices,
+                    per_slice: self.samples_per_slice,
+                    offset: self.surface_offset,
+                },
+            ),
+            goal_surface: self.goal_guidance_surface,
+        })
+    }
+}
+
+/// DEV-PRM as a [`PathFrontend`] (`"dev-prm"`). Paths end on the GGS, or at the goal when it is
+/// within reach (`r_des <= 0`) or the GGS is switched off.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct DevPrm {
+    params: DevPrmParams,
+}
+
+impl DevPrm {
+    /// A planner with validated parameters.
+    pub fn new(params: DevPrmParams) -> Result<Self, PlanError> {
+        params.validate()?;
+        Ok(DevPrm { params })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &DevPrmParams {
+        &self.params
+    }
+}
+
+impl PathFrontend for DevPrm {
+    fn name(&self) -> &str {
+        "dev-prm"
+    }
+
+    fn search(
+        &self,
+        query: &PathQuery,
+        scene: &Scene<'_>,
+        rng: &mut Rng,
+    ) -> Result<SearchResult, PlanError> {
+        run(&self.params.setup()?, query, scene, rng)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_bad_values_are_named() {
+        assert!(DevPrmParams::default().validate().is_ok());
+        let e = DevPrmParams {
+            surface_offset: 0.1,
+            ..DevPrmParams::default()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("devprm.surface_offset"), "{e}");
+        assert!(
+            DevPrm::new(DevPrmParams {
+                beam_width: 0,
+                ..DevPrmParams::default()
+            })
+            .is_err()
+        );
+        // Switched-off enhancements do not need their parameters.
+        assert!(
+            DevPrmParams {
+                obstacle_aware_samples: false,
+                slices: 0,
+                ..DevPrmParams::default()
+            }
+            .validate()
+            .is_ok()
+        );
+    }
+
+    #[test]
+    fn params_deserialize_strictly() {
+        let p: DevPrmParams = serde_json::from_str(r#"{"beam_width": 4, "pdc": false}"#).unwrap();
+        assert_eq!(p.beam_width, 4);
+        assert!(!p.pdc);
+        assert!(serde_json::from_str::<DevPrmParams>(r#"{"beam": 4}"#).is_err());
+    }
+}

@@ -1,0 +1,283 @@
+//! The pipeline V-PRM and DEV-PRM share: validate → region and obstacles → roadmap (obstacle-aware
+//! samples, then random samples under a time and sample budget) → graph search → shortcut →
+//! `TopoPathSelect`.
+
+use std::time::{Duration, Instant};
+
+use trust_core::{
+    Aabb, GuidePath, PathQuery, PlanError, Rng, Scene, SearchResult, SearchStats, Vec3,
+    check_finite, check_finite_vec, check_non_negative,
+};
+
+use crate::cone::Cone;
+use crate::ggs::Terminal;
+use crate::roadmap::{RoadmapBuilder, RoadmapParams};
+use crate::sampling::SamplingBox;
+use crate::search::{
+    SearchLimits, beam_paths, depth_first_paths, keep_fewest_nodes, keep_shortest,
+};
+use crate::select::{prune_equivalent, select_short_paths};
+use crate::shortcut::shortcut;
+use crate::uvd::{UvdScratch, polylines_equivalent_among};
+use crate::visibility::Obstacles;
+
+/// Start and goal closer than this (m) are treated as the same point: the answer is the path
+/// `[start, goal]` without any sampling.
+pub const COINCIDENT_M: f64 = 1e-9;
+
+/// Margin (m) added around the sampling region when selecting the cones that can matter.
+const REGION_MARGIN_M: f64 = 1.0;
+
+/// Validates a path query against a scene, as every frontend of this crate does first:
+/// [`PathQuery::validate`], finite forecasts with non-negative sizes, start and goal inside the map
+/// bounds ([`PlanError::OutOfBounds`]) and not inside a static obstacle ([`PlanError::InCollision`]).
+pub fn check_query(query: &PathQuery, scene: &Scene<'_>) -> Result<(), PlanError> {
+    query.validate()?;
+    check_finite("scene.t0", scene.t0)?;
+    for (i, f) in scene.forecasts.iter().enumerate() {
+        check_finite_vec(&format!("scene.forecasts[{i}].p0"), &f.p0)?;
+        check_finite_vec(&format!("scene.forecasts[{i}].v0"), &f.v0)?;
+        check_finite(&format!("scene.forecasts[{i}].t0"), f.t0)?;
+        check_non_negative(&format!("scene.forecasts[{i}].r_o"), f.r_o)?;
+        check_non_negative(&format!("scene.forecasts[{i}].r_safe"), f.r_safe)?;
+        check_non_negative(&format!("scene.forecasts[{i}].mu"), f.mu)?;
+        if let trust_core::ObstacleShape::Cylinder { half_height } = f.shape {
+            check_non_negative(
+                &format!("scene.forecasts[{i}].shape.half_height"),
+                half_height,
+            )?;
+        }
+    }
+    scene.check_in_bounds("query.start.p", &query.start.p)?;
+    scene.check_in_bounds("query.goal", &query.goal)?;
+    scene.check_static_free("query.start.p", &query.start.p, 0.0)?;
+    scene.check_static_free("query.goal", &query.goal, 0.0)?;
+    Ok(())
+}
+
+/// The answer for coincident start and goal: one zero-length path `[start, goal]`.
+pub(crate) fn coincident_result(
+    query: &PathQuery,
+    since: Instant,
+) -> Result<SearchResult, PlanError> {
+    Ok(SearchResult {
+        paths: vec![GuidePath::new(vec![query.start.p, query.goal])?],
+        stats: SearchStats {
+            elapsed: since.elapsed(),
+            ..SearchStats::default()
+        },
+    })
+}
+
+/// How the moving obstacles enter the roadmap's visibility test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ConeMode {
+    /// Ignored.
+    Ignore,
+    /// Frozen where they are at the query time (an occupancy-map snapshot).
+    Frozen,
+    /// Predictive directional cones over the query horizon.
+    Predictive,
+}
+
+/// Graph search of the pipeline.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum GraphSearch {
+    /// Fast-Planner's DFS; the raw paths with the fewest nodes are kept.
+    DepthFirst,
+    /// Algorithm 2's beam search; the shortest raw paths are kept.
+    Beam { width: usize },
+}
+
+/// Obstacle-aware sampling on cone surfaces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SurfaceSampling {
+    pub slices: usize,
+    pub per_slice: usize,
+    pub offset: f64,
+}
+
+/// Everything the pipeline needs (validated by the frontends' params).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PrmSetup {
+    pub inflate: Vec3,
+    pub clearance: f64,
+    pub resolution: f64,
+    pub budget: Duration,
+    pub max_samples: usize,
+    pub search: GraphSearch,
+    pub max_raw_paths: usize,
+    pub keep_raw_paths: usize,
+    pub max_paths: usize,
+    pub length_ratio: f64,
+    pub max_expansions: usize,
+    pub cones: ConeMode,
+    pub surface_sampling: Option<SurfaceSampling>,
+    pub goal_surface: bool,
+}
+
+/// Intersection of two boxes, or `None` if they do not meet.
+fn intersection(a: &Aabb, b: &Aabb) -> Option<Aabb> {
+    let min = a.min.sup(&b.min);
+    let max = a.max.inf(&b.max);
+    (0..3)
+        .all(|i| min[i] <= max[i])
+        .then_some(Aabb { min, max })
+}
+
+/// The axis-aligned box of the oriented sampling box plus `extra` points.
+fn box_aabb(b: &SamplingBox, extra: &[Vec3]) -> Aabb {
+    let mut corners = Vec::with_capacity(8 + extra.len());
+    for sx in [-1.0, 1.0] {
+        for sy in [-1.0, 1.0] {
+            for sz in [-1.0, 1.0] {
+                corners.push(b.point(&Vec3::new(sx, sy, sz)));
+            }
+        }
+    }
+    corners.extend_from_slice(extra);
+    Aabb::from_points(&corners).unwrap_or(Aabb {
+        min: b.center,
+        max: b.center,
+    })
+}
+
+/// Runs the pipeline.
+pub(crate) fn run(
+    setup: &PrmSetup,
+    query: &PathQuery,
+    scene: &Scene<'_>,
+    rng: &mut Rng,
+) -> Result<SearchResult, PlanError> {
+    let since = Instant::now();
+    check_query(query, scene)?;
+    let start = query.start.p;
+    if (query.goal - start).norm() <= COINCIDENT_M {
+        return coincident_result(query, since);
+    }
+    let deadline = since + setup.budget;
+
+    let terminal = if setup.goal_surface {
+        Terminal::goal_guidance_surface(&start, &query.goal, query.horizon_s, query.limits.v_max)
+    } else {
+        Terminal::Point(query.goal)
+    };
+    let local_goal = terminal.nearest_point(&start);
+    let sampling = SamplingBox::between(&start, &local_goal, &setup.inflate);
+    let region = intersection(
+        &box_aabb(&sampling, &[start, local_goal]),
+        scene.map.bounds(),
+    )
+    .unwrap_or(Aabb {
+        min: start,
+        max: start,
+    });
+
+    // Obstacles: static map plus the cones that can touch the region; cones that swallow the start
+    // (or a goal point) cannot be avoided in space and are left to the trajectory backend.
+    let t_query = query.start.t;
+    let cones: Vec<Cone> = match setup.cones {
+        ConeMode::Ignore => Vec::new(),
+        ConeMode::Frozen => scene
+            .forecasts
+            .iter()
+            .map(|f| Cone::at_time(f, t_query))
+            .collect(),
+        ConeMode::Predictive => scene
+            .forecasts
+            .iter()
+            .map(|f| Cone::from_forecast(f, t_query, query.horizon_s))
+            .collect(),
+    };
+    let mut obstacles =
+        Obstacles::with_cones(scene.map, cones).restricted_to(&region.inflated(REGION_MARGIN_M));
+    let goal_point = match terminal {
+        Terminal::Point(g) => Some(g),
+        Terminal::Surface { .. } => None,
+    };
+    obstacles
+        .drop_cones(|c| c.contains(&start, 0.0) || goal_point.is_some_and(|g| c.contains(&g, 0.0)));
+
+    let params = RoadmapParams {
+        sample_clearance: setup.clearance,
+        edge_threshold: setup.resolution,
+        uvd_resolution: setup.resolution,
+        uvd_threshold: 0.0,
+    };
+    let mut builder = RoadmapBuilder::new(start, terminal, &obstacles, params, region);
+    let mut stats = SearchStats::default();
+
+    // Obstacle-aware samples first (Algorithm 2, ConstructRoadMap(G, P_PDC)).
+    if let Some(s) = setup.surface_sampling {
+        let mut samples = Vec::new();
+        for cone in obstacles.cones() {
+            cone.surface_samples(s.slices, s.per_slice, s.offset, &region, &mut samples);
+        }
+        for p in samples {
+            if Instant::now() >= deadline {
+                stats.budget_exhausted = true;
+                break;
+            }
+            builder.add_sample(p);
+            stats.sample_count += 1;
+        }
+    }
+    // Random samples until the time or sample budget runs out.
+    let mut random = 0;
+    while random < setup.max_samples {
+        if Instant::now() >= deadline {
+            stats.budget_exhausted = true;
+            break;
+        }
+        builder.add_sample(sampling.sample(rng));
+        random += 1;
+        stats.sample_count += 1;
+    }
+    if random >= setup.max_samples {
+        stats.budget_exhausted = true;
+    }
+    let graph = builder.finish();
+    stats.node_count = graph.alive_count();
+
+    let limits = SearchLimits {
+        max_raw_paths: setup.max_raw_paths,
+        max_expansions: setup.max_expansions,
+        deadline: None,
+    };
+    let raw = match setup.search {
+        GraphSearch::DepthFirst => {
+            let raw = depth_first_paths(&graph, &limits);
+            stats.raw_path_count = raw.len();
+            keep_fewest_nodes(raw, setup.keep_raw_paths)
+        }
+        GraphSearch::Beam { width } => {
+            let raw = beam_paths(&graph, width, &limits);
+            stats.raw_path_count = raw.len();
+            keep_shortest(&graph, raw, setup.keep_raw_paths)
+        }
+    };
+
+    let short: Vec<Vec<Vec3>> = raw
+        .iter()
+        .map(|nodes| {
+            shortcut(
+                &graph.path_points(nodes),
+                &obstacles,
+                setup.resolution,
+                setup.resolution,
+                &region,
+            )
+        })
+        .collect();
+    let mut scratch = UvdScratch::default();
+    let distinct = prune_equivalent(short, |a, b| {
+        polylines_equivalent_among(&obstacles, a, b, setup.resolution, 0.0, &mut scratch)
+    });
+    let selected = select_short_paths(distinct, setup.length_ratio, setup.max_paths);
+    let paths = selected
+        .into_iter()
+        .map(GuidePath::new)
+        .collect::<Result<Vec<_>, _>>()?;
+    stats.elapsed = since.elapsed();
+    Ok(SearchResult { paths, stats })
+}

@@ -1,0 +1,803 @@
+//! Uniform visibility deformation (UVD): the homotopy test of Fast-Planner's topological planner
+//! (Zhou et al., "Robust real-time UAV replanning using guided gradient-based optimization and
+//! topological paths", 2020), the spatial ancestor of the paper's TVD (Sec. III-A).
+//!
+//! Two curves are UVD-equivalent iff, after resampling both by arc-length fraction into
+//! `⌈max length / resolution⌉ + 1` points, every chord between matching points is visible. Unlike the
+//! anchor, the point count never divides by zero: curves shorter than one resolution step (or of zero
+//! length) are compared with two points (their ends).
+//!
+//! * [`equivalent`] — the free function over any [`Curve`] with a visibility closure.
+//! * [`Uvd`] — the [`HomotopyChecker`], against the static map and, with
+//!   [`UvdParams::pdc_horizon_s`], the predictive directional cones of all forecasts, so that it also
+//!   separates paths around moving obstacles.
+
+use serde::{Deserialize, Serialize};
+
+use trust_core::{
+    Aabb, Curve, HomotopyChecker, PlanError, Scene, Vec3, check_non_negative, check_positive,
+};
+
+use crate::cone::Cone;
+use crate::visibility::Obstacles;
+
+/// Upper bound on the resampled point count (guards against a tiny resolution on a huge curve).
+pub const MAX_POINTS: usize = 1 << 20;
+
+/// A borrowed polyline, so that slices of points can be compared without building a
+/// [`trust_core::GuidePath`].
+#[derive(Debug, Clone, Copy)]
+pub struct Polyline<'a>(pub &'a [Vec3]);
+
+impl Curve for Polyline<'_> {
+    fn length(&self) -> f64 {
+        polyline_length(self.0)
+    }
+
+    fn resample_by_arc_length(&self, count: usize, out: &mut Vec<Vec3>) {
+        resample_polyline(self.0, count, out);
+    }
+
+    fn time_span(&self) -> Option<(f64, f64)> {
+        None
+    }
+
+    fn position_at_time(&self, _t: f64) -> Option<Vec3> {
+        None
+    }
+}
+
+/// Length of a polyline (0 for fewer than two points).
+pub fn polyline_length(points: &[Vec3]) -> f64 {
+    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
+/// Writes `count` (at least 2) points evenly spaced by arc length along `points`, ends included, into
+/// `out` (cleared first). An empty polyline writes nothing; a zero-length one repeats its first point.
+pub fn resample_polyline(points: &[Vec3], count: usize, out: &mut Vec<Vec3>) {
+    out.clear();
+    if let Some(mut walker) = ArcWalker::new(points, count) {
+        out.extend(std::iter::from_fn(|| walker.next()));
+    }
+}
+
+/// Streams the points of [`resample_polyline`] one at a time, without a buffer.
+#[derive(Debug, Clone)]
+pub struct ArcWalker<'a> {
+    points: &'a [Vec3],
+    count: usize,
+    k: usize,
+    step: f64,
+    seg: usize,
+    seg_start: f64,
+    seg_len: f64,
+}
+
+impl<'a> ArcWalker<'a> {
+    /// A walker producing `count` (at least 2) points along `points`; `None` for an empty polyline.
+    pub fn new(points: &'a [Vec3], count: usize) -> Option<Self> {
+        points.first()?;
+        let count = count.max(2);
+        let total = polyline_length(points);
+        let step = if total > 0.0 && total.is_finite() {
+            total / (count - 1) as f64
+        } else {
+            0.0
+        };
+        Some(ArcWalker {
+            points,
+            count,
+            k: 0,
+            step,
+            seg: 0,
+            seg_start: 0.0,
+            seg_len: points.get(1).map_or(0.0, |p| (p - points[0]).norm()),
+        })
+    }
+
+    /// The next point, `None` after `count` points.
+    #[allow(clippy::should_implement_trait)]
+    pub fn next(&mut self) -> Option<Vec3> {
+        if self.k >= self.count {
+            return None;
+        }
+        let k = self.k;
+        self.k += 1;
+        let pts = self.points;
+        if self.step == 0.0 {
+            return Some(pts[0]);
+        }
+        if k + 1 == self.count {
+            return Some(pts[pts.len() - 1]);
+        }
+        let target = k as f64 * self.step;
+        while self.seg + 2 < pts.len() && self.seg_start + self.seg_len < target {
+            self.seg_start += self.seg_len;
+            self.seg += 1;
+            self.seg_len = (pts[self.seg + 1] - pts[self.seg]).norm();
+        }
+        let u = if self.seg_len > 0.0 {
+            ((target - self.seg_start) / self.seg_len).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        Some(pts[self.seg] + (pts[self.seg + 1] - pts[self.seg]) * u)
+    }
+}
+
+/// The number of matched points UVD uses for curves of lengths `len_a`, `len_b`:
+/// `⌈max(len_a, len_b) / resolution⌉ + 1`, at least 2 and at most [`MAX_POINTS`]. Never divides by
+/// zero: a non-positive or non-finite ratio gives 2.
+pub fn point_count(len_a: f64, len_b: f64, resolution: f64) -> usize {
+    let ratio = len_a.max(len_b) / resolution;
+    if ratio.is_finite() && ratio > 0.0 {
+        (ratio.ceil() as usize)
+            .saturating_add(1)
+            .clamp(2, MAX_POINTS)
+    } else {
+        2
+    }
+}
+
+/// Reusable buffers for [`equivalent_with`] and [`equivalent_among`].
+#[derive(Debug, Clone, Default)]
+pub struct UvdScratch {
+    a: Vec<Vec3>,
+    b: Vec<Vec3>,
+    near: Vec<usize>,
+    local: Vec<usize>,
+    levels: Vec<Vec<usize>>,
+    cum_a: Vec<f64>,
+    cum_b: Vec<f64>,
+    shapes: Vec<usize>,
+    map_relevant: bool,
+}
+
+/// UVD equivalence of two curves: resample both into [`point_count`] points by arc-length fraction and
+/// test every chord with `visible`. Errors if `resolution` is not finite and positive.
+pub fn equivalent(
+    a: &dyn Curve,
+    b: &dyn Curve,
+    resolution: f64,
+    visible: impl FnMut(&Vec3, &Vec3) -> bool,
+) -> Result<bool, PlanError> {
+    check_positive("uvd.resolution", resolution)?;
+    Ok(equivalent_with(
+        a,
+        b,
+        resolution,
+        &mut UvdScratch::default(),
+        visible,
+    ))
+}
+
+/// [`equivalent`] with caller-provided buffers and no validation (a bad `resolution` falls back to two
+/// points per curve).
+pub fn equivalent_with(
+    a: &dyn Curve,
+    b: &dyn Curve,
+    resolution: f64,
+    scratch: &mut UvdScratch,
+    visible: impl FnMut(&Vec3, &Vec3) -> bool,
+) -> bool {
+    let n = point_count(a.length(), b.length(), resolution);
+    a.resample_by_arc_length(n, &mut scratch.a);
+    b.resample_by_arc_length(n, &mut scratch.b);
+    chords_visible(&scratch.a, &scratch.b, visible)
+}
+
+/// UVD equivalence against an obstacle set, with a broad phase: every chord lies in the bounding box
+/// of the matched points, so only the cones (and static shapes) meeting that box are tested, and two
+/// curves with nothing in that box are equivalent without a single chord query. Same answer as
+/// [`equivalent_with`] with `obstacles.segment_clear(p, q, threshold)` as the closure.
+pub fn equivalent_among(
+    obstacles: &Obstacles<'_>,
+    a: &dyn Curve,
+    b: &dyn Curve,
+    resolution: f64,
+    threshold: f64,
+    scratch: &mut UvdScratch,
+) -> bool {
+    let n = point_count(a.length(), b.length(), resolution);
+    a.resample_by_arc_length(n, &mut scratch.a);
+    b.resample_by_arc_length(n, &mut scratch.b);
+    let (Some(ra), Some(rb)) = (Aabb::from_points(&scratch.a), Aabb::from_points(&scratch.b))
+    else {
+        return true;
+    };
+    if !gather_near(obstacles, &ra.union(&rb), threshold, scratch) {
+        return true;
+    }
+    matched_chords_clear(obstacles, threshold, scratch)
+}
+
+/// [`equivalent_among`] for polylines given by their vertices, by recursive subdivision of the matched
+/// index range: the chords of a range lie in the box of the two sub-polylines it covers, so a range
+/// whose box meets no obstacle is accepted without generating its points, and only ranges of at most
+/// 16 chords near an obstacle are tested chord by chord. Curves with nothing near them
+/// cost one box test.
+pub fn polylines_equivalent_among(
+    obstacles: &Obstacles<'_>,
+    a: &[Vec3],
+    b: &[Vec3],
+    resolution: f64,
+    threshold: f64,
+    scratch: &mut UvdScratch,
+) -> bool {
+    if a.is_empty() || b.is_empty() {
+        return true;
+    }
+    if !a.iter().chain(b).all(|p| p.iter().all(|x| x.is_finite())) {
+        return false;
+    }
+    let (Some(ra), Some(rb)) = (Aabb::from_points(a), Aabb::from_points(b)) else {
+        return true;
+    };
+    if !gather_near(obstacles, &ra.union(&rb), threshold, scratch) {
+        return true;
+    }
+    let mut cum_a = std::mem::take(&mut scratch.cum_a);
+    let mut cum_b = std::mem::take(&mut scratch.cum_b);
+    let ma = Metric::new(a, &mut cum_a);
+    let mb = Metric::new(b, &mut cum_b);
+    let n = point_count(ma.total, mb.total, resolution);
+    let walk = MatchedWalk {
+        a,
+        b,
+        cum_a: &cum_a,
+        cum_b: &cum_b,
+        step_a: ma.total / (n - 1) as f64,
+        step_b: mb.total / (n - 1) as f64,
+        last: n - 1,
+    };
+    let mut near = std::mem::take(&mut scratch.near);
+    let clear = range_clear(
+        obstacles,
+        threshold.max(0.0),
+        &walk,
+        0,
+        n - 1,
+        &near,
+        scratch,
+        0,
+    );
+    near.clear();
+    scratch.near = near;
+    scratch.cum_a = cum_a;
+    scratch.cum_b = cum_b;
+    clear
+}
+
+/// Length of a polyline with its cumulative vertex distances written to a buffer.
+struct Metric {
+    total: f64,
+}
+
+impl Metric {
+    fn new(points: &[Vec3], cum: &mut Vec<f64>) -> Self {
+        cum.clear();
+        let mut acc = 0.0;
+        cum.push(0.0);
+        for w in points.windows(2) {
+            acc += (w[1] - w[0]).norm();
+            cum.push(acc);
+        }
+        Metric { total: acc }
+    }
+}
+
+/// The matched points of two polylines by index (arc-length fraction `k / last`).
+struct MatchedWalk<'a> {
+    a: &'a [Vec3],
+    b: &'a [Vec3],
+    cum_a: &'a [f64],
+    cum_b: &'a [f64],
+    step_a: f64,
+    step_b: f64,
+    last: usize,
+}
+
+impl MatchedWalk<'_> {
+    fn point(points: &[Vec3], cum: &[f64], step: f64, k: usize, last: usize) -> Vec3 {
+        if k >= last || !step.is_finite() || step <= 0.0 {
+            return if k >= last && step > 0.0 {
+                points[points.len() - 1]
+            } else {
+                points[0]
+            };
+        }
+        let t = k as f64 * step;
+        // Segment i with cum[i] <= t < cum[i + 1].
+        let i = cum
+            .partition_point(|&c| c <= t)
+            .saturating_sub(1)
+            .min(points.len().saturating_sub(2));
+        if points.len() < 2 {
+            return points[0];
+        }
+        let len = cum[i + 1] - cum[i];
+        let u = if len > 0.0 {
+            ((t - cum[i]) / len).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        points[i] + (points[i + 1] - points[i]) * u
+    }
+
+    /// Calls `f` on the matched pairs `k0..=k1` in order, stopping at the first `false`; walks the
+    /// segments incrementally instead of searching for each point.
+    fn all_pairs(&self, k0: usize, k1: usize, mut f: impl FnMut(&Vec3, &Vec3) -> bool) -> bool {
+        let mut ca = SegmentCursor::new(self.a, self.cum_a, self.step_a, self.last);
+        let mut cb = SegmentCursor::new(self.b, self.cum_b, self.step_b, self.last);
+        (k0..=k1).all(|k| f(&ca.point(k), &cb.point(k)))
+    }
+
+    fn pair(&self, k: usize) -> (Vec3, Vec3) {
+        (
+            Self::point(self.a, self.cum_a, self.step_a, k, self.last),
+            Self::point(self.b, self.cum_b, self.step_b, k, self.last),
+        )
+    }
+
+    /// Box of the sub-polyline of `points` between matched indices `k0 <= k1`.
+    fn sub_box(points: &[Vec3], cum: &[f64], step: f64, k0: usize, k1: usize, last: usize) -> Aabb {
+        let p0 = Self::point(points, cum, step, k0, last);
+        let p1 = Self::point(points, cum, step, k1, last);
+        let mut bx = Aabb::from_segment(&p0, &p1);
+        let (t0, t1) = (k0 as f64 * step, k1 as f64 * step);
+        for (p, &c) in points.iter().zip(cum) {
+            if c > t0 && c < t1 {
+                bx.min = bx.min.inf(p);
+                bx.max = bx.max.sup(p);
+            }
+        }
+        bx
+    }
+
+    fn range_box(&self, k0: usize, k1: usize) -> Aabb {
+        Self::sub_box(self.a, self.cum_a, self.step_a, k0, k1, self.last).union(&Self::sub_box(
+            self.b,
+            self.cum_b,
+            self.step_b,
+            k0,
+            k1,
+            self.last,
+        ))
+    }
+}
+
+/// Forward-only evaluation of [`MatchedWalk::point`] for increasing indices.
+struct SegmentCursor<'a> {
+    points: &'a [Vec3],
+    cum: &'a [f64],
+    step: f64,
+    last: usize,
+    seg: usize,
+}
+
+impl<'a> SegmentCursor<'a> {
+    fn new(points: &'a [Vec3], cum: &'a [f64], step: f64, last: usize) -> Self {
+        SegmentCursor {
+            points,
+            cum,
+            step,
+            last,
+            seg: 0,
+        }
+    }
+
+    fn point(&mut self, k: usize) -> Vec3 {
+        let pts = self.points;
+        if k >= self.last || pts.len() < 2 || !self.step.is_finite() || self.step <= 0.0 {
+            return MatchedWalk::point(pts, self.cum, self.step, k, self.last);
+        }
+        let t = k as f64 * self.step;
+        while self.seg + 2 < pts.len() && self.cum[self.seg + 1] <= t {
+            self.seg += 1;
+        }
+        let i = self.seg;
+        let len = self.cum[i + 1] - self.cum[i];
+        let u = if len > 0.0 {
+            ((t - self.cum[i]) / len).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        pts[i] + (pts[i + 1] - pts[i]) * u
+    }
+}
+
+/// Whether the matched chords `k0..=k1` are clear of the cones in `parent` (indices into
+/// `obstacles.cones()`) and of the static map.
+#[allow(clippy::too_many_arguments)]
+fn range_clear(
+    obstacles: &Obstacles<'_>,
+    c: f64,
+    walk: &MatchedWalk<'_>,
+    k0: usize,
+    k1: usize,
+    parent: &[usize],
+    scratch: &mut UvdScratch,
+    depth: usize,
+) -> bool {
+    let tight = walk.range_box(k0, k1);
+    let bx = tight.inflated(c);
+    // Every chord of the range lies in the ball around the box centre through its corners: a cone at
+    // least `c` outside that ball cannot block any of them.
+    let center = tight.center();
+    let ball = 0.5 * tight.extent().norm();
+    let cones = obstacles.cones();
+    let mut local = scratch
+        .levels
+        .get_mut(depth)
+        .map(std::mem::take)
+        .unwrap_or_default();
+    local.clear();
+    local.extend(parent.iter().copied().filter(|&i| {
+        cones[i].aabb().intersects(&bx) && cones[i].signed_distance(&center) < ball + c
+    }));
+    let map = obstacles.map();
+    let map_relevant = scratch.map_relevant && {
+        map.esdf().is_some_and(|e| e.occupied_count() > 0) || {
+            map.shapes_near(&bx, &mut scratch.shapes);
+            !scratch.shapes.is_empty()
+        }
+    };
+    let pair_clear = |p: &Vec3, q: &Vec3| {
+        if p == q {
+            return true;
+        }
+        let seg_box = Aabb::from_segment(p, q);
+        local
+            .iter()
+            .all(|&i| cones[i].segment_clear_in_box(p, q, c, &seg_box))
+            && (!map_relevant || map.segment_clear(p, q, c))
+    };
+    let chord_clear = |k: usize| {
+        let (p, q) = walk.pair(k);
+        pair_clear(&p, &q)
+    };
+    let clear = if local.is_empty() && !map_relevant {
+        true
+    } else if k1 - k0 < CHORD_BLOCK {
+        walk.all_pairs(k0, k1, pair_clear)
+    } else {
+        // The middle chord first: paths in different classes are usually separated mid-way, so a
+        // blocked chord is found before the left half is swept.
+        let mid = k0 + (k1 - k0) / 2;
+        chord_clear(mid)
+            && range_clear(obstacles, c, walk, k0, mid, &local, scratch, depth + 1)
+            && range_clear(obstacles, c, walk, mid + 1, k1, &local, scratch, depth + 1)
+    };
+    if scratch.levels.len() <= depth {
+        scratch.levels.resize_with(depth + 1, Vec::new);
+    }
+    scratch.levels[depth] = local;
+    clear
+}
+
+/// Chords tested per block: the block's chords lie in the box of its end points, so obstacles that
+/// miss that box are skipped for the whole block.
+const CHORD_BLOCK: usize = 16;
+
+/// Collects into `scratch.near` the cones whose boxes meet `region` (grown by `threshold`); returns
+/// whether anything (a cone, a static shape or a voxel map) may block a chord inside `region`.
+fn gather_near(
+    obstacles: &Obstacles<'_>,
+    region: &Aabb,
+    threshold: f64,
+    scratch: &mut UvdScratch,
+) -> bool {
+    let region = region.inflated(threshold.max(0.0));
+    scratch.near.clear();
+    scratch.near.extend(
+        obstacles
+            .cones()
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.aabb().intersects(&region))
+            .map(|(i, _)| i),
+    );
+    let map = obstacles.map();
+    scratch.map_relevant = map.esdf().is_some_and(|e| e.occupied_count() > 0) || {
+        map.shapes_near(&region, &mut scratch.shapes);
+        !scratch.shapes.is_empty()
+    };
+    !scratch.near.is_empty() || scratch.map_relevant
+}
+
+/// Tests the chords between `scratch.a` and `scratch.b` against the gathered obstacles, block by block.
+fn matched_chords_clear(
+    obstacles: &Obstacles<'_>,
+    threshold: f64,
+    scratch: &mut UvdScratch,
+) -> bool {
+    let a = std::mem::take(&mut scratch.a);
+    let b = std::mem::take(&mut scratch.b);
+    let clear = a
+        .chunks(CHORD_BLOCK)
+        .zip(b.chunks(CHORD_BLOCK))
+        .all(|(pa, pb)| block_clear(obstacles, threshold, scratch, pa, pb));
+    scratch.a = a;
+    scratch.b = b;
+    clear
+}
+
+/// Tests one block of matched chords against the cones in `scratch.near` that meet the block's box
+/// (and the static map when it is relevant).
+fn block_clear(
+    obstacles: &Obstacles<'_>,
+    threshold: f64,
+    scratch: &mut UvdScratch,
+    pa: &[Vec3],
+    pb: &[Vec3],
+) -> bool {
+    if !pa.iter().chain(pb).all(|p| p.iter().all(|x| x.is_finite())) {
+        return false;
+    }
+    let c = threshold.max(0.0);
+    let (Some(ba), Some(bb)) = (Aabb::from_points(pa), Aabb::from_points(pb)) else {
+        return true;
+    };
+    let block = ba.union(&bb).inflated(c);
+    let cones = obstacles.cones();
+    scratch.local.clear();
+    scratch.local.extend(
+        scratch
+            .near
+            .iter()
+            .copied()
+            .filter(|&i| cones[i].aabb().intersects(&block)),
+    );
+    let map = obstacles.map();
+    let map_relevant = scratch.map_relevant && {
+        map.esdf().is_some_and(|e| e.occupied_count() > 0) || {
+            map.shapes_near(&block, &mut scratch.shapes);
+            !scratch.shapes.is_empty()
+        }
+    };
+    if scratch.local.is_empty() && !map_relevant {
+        return true;
+    }
+    let local = &scratch.local;
+    chords_visible(pa, pb, |p, q| {
+        let seg_box = Aabb::from_segment(p, q);
+        local
+            .iter()
+            .all(|&i| cones[i].segment_clear_in_box(p, q, c, &seg_box))
+            && (!map_relevant || map.segment_clear(p, q, c))
+    })
+}
+
+/// True if every chord between matching points is visible (pairs beyond the shorter slice are ignored;
+/// identical matched points count as visible without a query).
+pub fn chords_visible(
+    a: &[Vec3],
+    b: &[Vec3],
+    mut visible: impl FnMut(&Vec3, &Vec3) -> bool,
+) -> bool {
+    a.iter().zip(b).all(|(p, q)| p == q || visible(p, q))
+}
+
+/// Parameters of the [`Uvd`] checker.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct UvdParams {
+    /// Arc-length step of the matched points (m). Default 0.1 m: Fast-Planner's map resolution, which
+    /// its UVD uses as the step.
+    pub resolution: f64,
+    /// A chord is blocked if it comes closer than this to an obstacle (m). Default 0: Fast-Planner's
+    /// UVD visibility threshold.
+    pub clearance: f64,
+    /// When set, the predictive directional cones of all forecasts over this horizon (s, from
+    /// `scene.t0`) are obstacles too (`"uvd+pdc"`), so the checker sees moving obstacles. Cones that
+    /// contain the first or last point of either curve are ignored (both curves must cross them, so
+    /// they cannot separate the curves). Default `None`: the static map only, as in Fast-Planner.
+    pub pdc_horizon_s: Option<f64>,
+    /// See the moving obstacles frozen where they are at `scene.t0` (`"uvd+frozen"`; V-PRM's own
+    /// view with `VprmParams::freeze_forecasts`). Exclusive with `pdc_horizon_s`. Default `false`.
+    pub freeze_forecasts: bool,
+}
+
+impl Default for UvdParams {
+    fn default() -> Self {
+        UvdParams {
+            resolution: 0.1,
+            clearance: 0.0,
+            pdc_horizon_s: None,
+            freeze_forecasts: false,
+        }
+    }
+}
+
+impl UvdParams {
+    /// Checks every field.
+    pub fn validate(&self) -> Result<(), PlanError> {
+        check_positive("uvd.resolution", self.resolution)?;
+        check_non_negative("uvd.clearance", self.clearance)?;
+        if let Some(h) = self.pdc_horizon_s {
+            check_positive("uvd.pdc_horizon_s", h)?;
+            if self.freeze_forecasts {
+                return Err(PlanError::invalid(
+                    "uvd.freeze_forecasts",
+                    true,
+                    "false when uvd.pdc_horizon_s is set (frozen obstacles or their cones, not both)",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Uniform visibility deformation as a [`HomotopyChecker`] (paths and trajectories alike: both are
+/// matched by arc-length fraction).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Uvd {
+    params: UvdParams,
+}
+
+impl Uvd {
+    /// A checker with validated parameters.
+    pub fn new(params: UvdParams) -> Result<Self, PlanError> {
+        params.validate()?;
+        Ok(Uvd { params })
+    }
+
+    /// A checker that also treats the predictive directional cones over `horizon_s` as obstacles.
+    pub fn with_pdc(horizon_s: f64) -> Result<Self, PlanError> {
+        Uvd::new(UvdParams {
+            pdc_horizon_s: Some(horizon_s),
+            ..UvdParams::default()
+        })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &UvdParams {
+        &self.params
+    }
+
+    /// The obstacles this checker tests chords against for curves `a`, `b` in `scene`: the static map,
+    /// plus the frozen obstacles or their cones minus those containing an end of either curve.
+    pub fn obstacles<'s>(&self, a: &dyn Curve, b: &dyn Curve, scene: &Scene<'s>) -> Obstacles<'s> {
+        let cones: Vec<Cone> = match (self.params.pdc_horizon_s, self.params.freeze_forecasts) {
+            (Some(h), _) => scene
+                .forecasts
+                .iter()
+                .map(|f| Cone::from_forecast(f, scene.t0, h))
+                .collect(),
+            (None, true) => scene
+                .forecasts
+                .iter()
+                .map(|f| Cone::at_time(f, scene.t0))
+                .collect(),
+            (None, false) => return Obstacles::new(scene.map),
+        };
+        let mut obs = Obstacles::with_cones(scene.map, cones);
+        let mut ends = Vec::with_capacity(4);
+        let mut pts = Vec::with_capacity(2);
+        for c in [a, b] {
+            c.resample_by_arc_length(2, &mut pts);
+            ends.extend_from_slice(&pts);
+        }
+        let clearance = self.params.clearance;
+        obs.drop_cones(|cone| ends.iter().any(|p| cone.contains(p, clearance)));
+        obs
+    }
+}
+
+impl HomotopyChecker for Uvd {
+    fn name(&self) -> &str {
+        match (self.params.pdc_horizon_s, self.params.freeze_forecasts) {
+            (Some(_), _) => "uvd+pdc",
+            (None, true) => "uvd+frozen",
+            (None, false) => "uvd",
+        }
+    }
+
+    fn equivalent(
+        &self,
+        a: &dyn Curve,
+        b: &dyn Curve,
+        scene: &Scene<'_>,
+    ) -> Result<bool, PlanError> {
+        self.params.validate()?;
+        let obs = self.obstacles(a, b, scene);
+        Ok(equivalent_among(
+            &obs,
+            a,
+            b,
+            self.params.resolution,
+            self.params.clearance,
+            &mut UvdScratch::default(),
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use trust_core::{GuidePath, StaticMap};
+    use trust_geometry::{Shape, Sphere};
+
+    fn pillar_map() -> StaticMap {
+        let bounds =
+            Aabb::new(Vec3::new(-10.0, -10.0, -10.0), Vec3::new(10.0, 10.0, 10.0)).unwrap();
+        StaticMap::from_shapes(
+            bounds,
+            vec![Shape::from(Sphere::new(Vec3::zeros(), 1.0).unwrap())],
+        )
+        .unwrap()
+    }
+
+    fn path(points: &[[f64; 3]]) -> GuidePath {
+        GuidePath::new(points.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect()).unwrap()
+    }
+
+    #[test]
+    fn resample_matches_core_guide_path() {
+        let g = path(&[
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 2.0, 0.0],
+            [1.0, 2.0, 0.0],
+        ]);
+        let mut mine = Vec::new();
+        for count in [2, 3, 7, 31] {
+            resample_polyline(&g.points, count, &mut mine);
+            let theirs = g.resample(count);
+            for (p, q) in mine.iter().zip(&theirs) {
+                assert_relative_eq!(p, q, epsilon = 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn paths_around_opposite_sides_are_distinct() {
+        let map = pillar_map();
+        let scene = Scene::new(&map, &[], 0.0).unwrap();
+        let above = path(&[[-3.0, 0.0, 0.0], [0.0, 2.0, 0.0], [3.0, 0.0, 0.0]]);
+        let above2 = path(&[[-3.0, 0.0, 0.0], [0.0, 3.0, 0.0], [3.0, 0.0, 0.0]]);
+        let below = path(&[[-3.0, 0.0, 0.0], [0.0, -2.0, 0.0], [3.0, 0.0, 0.0]]);
+        let uvd = Uvd::default();
+        assert!(uvd.equivalent(&above, &above2, &scene).unwrap());
+        assert!(!uvd.equivalent(&above, &below, &scene).unwrap());
+        assert_eq!(uvd.name(), "uvd");
+    }
+
+    #[test]
+    fn paths_shorter_than_one_step_do_not_divide_by_zero() {
+        let map = pillar_map();
+        let scene = Scene::new(&map, &[], 0.0).unwrap();
+        let a = path(&[[5.0, 5.0, 5.0], [5.0, 5.0, 5.01]]);
+        let b = path(&[[5.0, 5.0, 5.0]]);
+        assert_eq!(point_count(0.01, 0.0, 0.1), 2);
+        assert_eq!(point_count(0.0, 0.0, 0.1), 2);
+        assert_eq!(point_count(1.0, 0.0, 0.0), 2);
+        assert_eq!(point_count(f64::NAN, 0.0, 0.1), 2);
+        assert!(Uvd::default().equivalent(&a, &b, &scene).unwrap());
+        assert!(Uvd::default().equivalent(&b, &b, &scene).unwrap());
+    }
+
+    #[test]
+    fn bad_resolution_is_an_error() {
+        let a = path(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]);
+        let e = equivalent(&a, &a, 0.0, |_, _| true)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("uvd.resolution"), "{e}");
+        assert!(
+            Uvd::new(UvdParams {
+                resolution: -1.0,
+                ..UvdParams::default()
+            })
+            .is_err()
+        );
+        assert!(Uvd::with_pdc(f64::NAN).is_err());
+    }
+
+    #[test]
+    fn params_reject_unknown_fields() {
+        assert!(serde_json::from_str::<UvdParams>(r#"{"resolution": 0.2}"#).is_ok());
+        assert!(serde_json::from_str::<UvdParams>(r#"{"resolutoin": 0.2}"#).is_err());
+    }
+}

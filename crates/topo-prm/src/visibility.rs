@@ -1,0 +1,172 @@
+//! What the roadmap "sees": the static map plus an optional set of swept obstacles ([`Cone`]s).
+//!
+//! V-PRM uses the static map (and, optionally, the moving obstacles frozen where they are now);
+//! DEV-PRM adds the predictive directional cones of all forecasts (paper Sec. III-B). Segment tests
+//! reject cones by bounding box before any exact test, and [`Obstacles::restricted_to`] keeps only
+//! the cones near a region so that a whole search pays for the relevant obstacles only.
+
+use trust_core::{Aabb, Forecast, StaticMap, Vec3};
+
+use crate::cone::Cone;
+
+/// The obstacle set of one search: static map ∪ cones.
+#[derive(Debug, Clone)]
+pub struct Obstacles<'a> {
+    map: &'a StaticMap,
+    cones: Vec<Cone>,
+}
+
+impl<'a> Obstacles<'a> {
+    /// Only the static map.
+    pub fn new(map: &'a StaticMap) -> Self {
+        Obstacles {
+            map,
+            cones: Vec::new(),
+        }
+    }
+
+    /// The static map and the given cones.
+    pub fn with_cones(map: &'a StaticMap, cones: Vec<Cone>) -> Self {
+        Obstacles { map, cones }
+    }
+
+    /// The static map and the predictive directional cones of `forecasts` over
+    /// `[t_start, t_start + horizon_s]`.
+    pub fn with_forecast_cones(
+        map: &'a StaticMap,
+        forecasts: &[Forecast],
+        t_start: f64,
+        horizon_s: f64,
+    ) -> Self {
+        let cones = forecasts
+            .iter()
+            .map(|f| Cone::from_forecast(f, t_start, horizon_s))
+            .collect();
+        Obstacles { map, cones }
+    }
+
+    /// The static map.
+    pub fn map(&self) -> &'a StaticMap {
+        self.map
+    }
+
+    /// The cones.
+    pub fn cones(&self) -> &[Cone] {
+        &self.cones
+    }
+
+    /// Drops every cone for which `drop` returns true (e.g. cones that contain the start); returns how
+    /// many were dropped.
+    pub fn drop_cones(&mut self, mut drop: impl FnMut(&Cone) -> bool) -> usize {
+        let before = self.cones.len();
+        self.cones.retain(|c| !drop(c));
+        before - self.cones.len()
+    }
+
+    /// A copy that keeps only the cones whose boxes meet `region` (the static map is kept whole).
+    pub fn restricted_to(&self, region: &Aabb) -> Obstacles<'a> {
+        Obstacles {
+            map: self.map,
+            cones: self
+                .cones
+                .iter()
+                .filter(|c| c.aabb().intersects(region))
+                .copied()
+                .collect(),
+        }
+    }
+
+    /// True if nothing (no cone box, no static shape box, no voxel map) meets `region`: every segment
+    /// inside it is then clear.
+    pub fn region_is_empty(&self, region: &Aabb, scratch: &mut Vec<usize>) -> bool {
+        if self.cones.iter().any(|c| c.aabb().intersects(region)) {
+            return false;
+        }
+        if self.map.esdf().is_some_and(|e| e.occupied_count() > 0) {
+            return false;
+        }
+        self.map.shapes_near(region, scratch);
+        scratch.is_empty()
+    }
+
+    /// Line of sight: every point of `[a, b]` keeps at least `threshold` from every obstacle.
+    pub fn segment_clear(&self, a: &Vec3, b: &Vec3, threshold: f64) -> bool {
+        if threshold.is_nan() || !a.iter().chain(b.iter()).all(|c| c.is_finite()) {
+            return false;
+        }
+        let c = threshold.max(0.0);
+        let seg_box = Aabb::from_segment(a, b);
+        self.cones
+            .iter()
+            .all(|cone| cone.segment_clear_in_box(a, b, c, &seg_box))
+            && self.map.segment_clear(a, b, c)
+    }
+
+    /// True if `p` keeps at least `clearance` from every obstacle.
+    pub fn is_free(&self, p: &Vec3, clearance: f64) -> bool {
+        self.cones.iter().all(|c| !c.contains(p, clearance)) && self.map.is_free(p, clearance)
+    }
+
+    /// Signed distance to the nearest obstacle (`+∞` when there is none).
+    pub fn clearance(&self, p: &Vec3) -> f64 {
+        self.distance_and_gradient(p).0
+    }
+
+    /// Signed distance to the nearest obstacle and its gradient (zero gradient when there is none).
+    pub fn distance_and_gradient(&self, p: &Vec3) -> (f64, Vec3) {
+        let mut best = self.map.distance_and_gradient(p);
+        for c in &self.cones {
+            let (d, g) = c.distance_and_gradient(p);
+            if d < best.0 {
+                best = (d, g);
+            }
+        }
+        best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use trust_geometry::{Shape, Sphere};
+
+    fn map() -> StaticMap {
+        let bounds =
+            Aabb::new(Vec3::new(-10.0, -10.0, -10.0), Vec3::new(10.0, 10.0, 10.0)).unwrap();
+        StaticMap::from_shapes(
+            bounds,
+            vec![Shape::from(
+                Sphere::new(Vec3::new(0.0, 5.0, 0.0), 1.0).unwrap(),
+            )],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn sees_map_and_cones() {
+        let m = map();
+        let cone = Cone::sphere(Vec3::zeros(), Vec3::x(), 1.0, 1.0);
+        let obs = Obstacles::with_cones(&m, vec![cone]);
+        let (a, b) = (Vec3::new(-5.0, -3.0, 0.0), Vec3::new(5.0, -3.0, 0.0));
+        assert!(obs.segment_clear(&a, &b, 0.1));
+        assert!(!obs.segment_clear(&Vec3::new(-5.0, 0.0, 0.0), &Vec3::new(5.0, 0.0, 0.0), 0.0));
+        assert!(!obs.segment_clear(&Vec3::new(-5.0, 5.0, 0.0), &Vec3::new(5.0, 5.0, 0.0), 0.0));
+        assert!(!obs.is_free(&Vec3::new(0.5, 0.0, 0.0), 0.0));
+        assert!((obs.clearance(&Vec3::new(0.5, 2.5, 0.0)) - 1.5).abs() < 1e-9);
+        let mut scratch = Vec::new();
+        let far = Aabb::new(Vec3::new(5.0, -9.0, -1.0), Vec3::new(6.0, -8.0, 1.0)).unwrap();
+        assert!(obs.region_is_empty(&far, &mut scratch));
+        assert!(obs.restricted_to(&far).cones().is_empty());
+        let near = Aabb::new(Vec3::new(-1.0, 4.0, -1.0), Vec3::new(1.0, 6.0, 1.0)).unwrap();
+        assert!(!obs.region_is_empty(&near, &mut scratch));
+    }
+
+    #[test]
+    fn empty_world_is_all_clear() {
+        let bounds = Aabb::new(Vec3::zeros(), Vec3::repeat(1.0)).unwrap();
+        let m = StaticMap::new(bounds).unwrap();
+        let obs = Obstacles::new(&m);
+        assert!(obs.segment_clear(&Vec3::zeros(), &Vec3::repeat(1.0), 0.3));
+        assert_eq!(obs.clearance(&Vec3::zeros()), f64::INFINITY);
+    }
+}

@@ -1,0 +1,255 @@
+//! [`Vprm`]: a faithful visibility PRM (Fast-Planner's topological planner, Zhou et al. 2020), the
+//! paper's comparison point in experiment E1 (Fig. Sim-A-1-1(c)).
+//!
+//! Guards and connectors over samples from a box between start and goal, UVD-redundant connectors,
+//! dead-end pruning, bounded depth-first search, shortcutting, equivalence pruning and K-shortest
+//! selection with a length ratio — against the static map, with moving obstacles (optionally) frozen
+//! where they are at the query time, as an occupancy map would show them. It never uses their motion.
+
+use std::time::Duration;
+
+use serde::{Deserialize, Serialize};
+
+use trust_core::{
+    PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult, Vec3, check_finite_vec,
+    check_non_negative, check_positive,
+};
+
+use crate::prm::{ConeMode, GraphSearch, PrmSetup, run};
+
+/// Parameters of [`Vprm`]. Defaults are Fast-Planner's (`topo_prm` launch parameters, see
+/// `reference/topo-prm.md`) unless stated otherwise.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct VprmParams {
+    /// Sampling-box inflation (m): along start→goal (added to half the distance), horizontal,
+    /// vertical. Fast-Planner: (1.0, 3.5, 1.0).
+    pub inflate: Vec3,
+    /// Samples closer than this to an obstacle are rejected (m). Fast-Planner: 0.3.
+    pub clearance: f64,
+    /// Map resolution (m): roadmap edges keep this distance from obstacles, and UVD and shortcutting
+    /// step by it. Fast-Planner: 0.1.
+    pub resolution: f64,
+    /// Time budget of the roadmap construction (ms, monotonic clock). Fast-Planner: 5 ms
+    /// (experiment E1 uses 20 ms).
+    pub budget_ms: f64,
+    /// Sample budget of the roadmap construction. Fast-Planner: 2000.
+    pub max_samples: usize,
+    /// The depth-first search stops after this many raw paths. Fast-Planner: 300.
+    pub max_raw_paths: usize,
+    /// Raw paths kept (fewest nodes first) for shortcutting. Fast-Planner: 25.
+    pub keep_raw_paths: usize,
+    /// At most this many paths are returned. Fast-Planner: 6 (`reserve_num`).
+    pub max_paths: usize,
+    /// Paths longer than this times the shortest are dropped. Fast-Planner: 5.5.
+    pub length_ratio: f64,
+    /// The search stops after this many node expansions. Ours (the anchor has no bound): 100 000, far
+    /// above what the 300-path bound needs on a pruned roadmap.
+    pub max_expansions: usize,
+    /// See moving obstacles as static obstacles where they are at the query time (their shape with
+    /// radius `radius(t)`), as Fast-Planner sees them in its occupancy map. Ours: `true`; `false`
+    /// plans against the static map alone.
+    pub freeze_forecasts: bool,
+}
+
+impl Default for VprmParams {
+    fn default() -> Self {
+        VprmParams {
+            inflate: Vec3::new(1.0, 3.5, 1.0),
+            clearance: 0.3,
+            resolution: 0.1,
+            budget_ms: 5.0,
+            max_samples: 2000,
+            max_raw_paths: 300,
+            keep_raw_paths: 25,
+            max_paths: 6,
+            length_ratio: 5.5,
+            max_expansions: 100_000,
+            freeze_forecasts: true,
+        }
+    }
+}
+
+/// Checks the fields V-PRM and DEV-PRM share; `prefix` names the params struct in errors.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn check_common(
+    prefix: &str,
+    inflate: &Vec3,
+    clearance: f64,
+    resolution: f64,
+    budget_ms: f64,
+    max_raw_paths: usize,
+    keep_raw_paths: usize,
+    max_paths: usize,
+    length_ratio: f64,
+    max_expansions: usize,
+) -> Result<Duration, PlanError> {
+    check_finite_vec(&format!("{prefix}.inflate"), inflate)?;
+    if inflate.iter().any(|x| *x < 0.0) {
+        return Err(PlanError::invalid(
+            format!("{prefix}.inflate"),
+            [inflate.x, inflate.y, inflate.z],
+            "non-negative components",
+        ));
+    }
+    check_non_negative(&format!("{prefix}.clearance"), clearance)?;
+    check_positive(&format!("{prefix}.resolution"), resolution)?;
+    check_positive(&format!("{prefix}.budget_ms"), budget_ms)?;
+    let budget = Duration::try_from_secs_f64(budget_ms / 1000.0).map_err(|_| {
+        PlanError::invalid(
+            format!("{prefix}.budget_ms"),
+            budget_ms,
+            "a duration representable in std::time::Duration",
+        )
+    })?;
+    for (name, value) in [
+        ("max_raw_paths", max_raw_paths),
+        ("keep_raw_paths", keep_raw_paths),
+        ("max_paths", max_paths),
+        ("max_expansions", max_expansions),
+    ] {
+        if value == 0 {
+            return Err(PlanError::invalid(
+                format!("{prefix}.{name}"),
+                value,
+                ">= 1",
+            ));
+        }
+    }
+    if !(length_ratio.is_finite() && length_ratio >= 1.0) {
+        return Err(PlanError::invalid(
+            format!("{prefix}.length_ratio"),
+            length_ratio,
+            "a finite number >= 1",
+        ));
+    }
+    Ok(budget)
+}
+
+impl VprmParams {
+    /// Checks every field.
+    pub fn validate(&self) -> Result<(), PlanError> {
+        self.budget().map(|_| ())
+    }
+
+    fn budget(&self) -> Result<Duration, PlanError> {
+        check_common(
+            "vprm",
+            &self.inflate,
+            self.clearance,
+            self.resolution,
+            self.budget_ms,
+            self.max_raw_paths,
+            self.keep_raw_paths,
+            self.max_paths,
+            self.length_ratio,
+            self.max_expansions,
+        )
+    }
+
+    fn setup(&self) -> Result<PrmSetup, PlanError> {
+        Ok(PrmSetup {
+            inflate: self.inflate,
+            clearance: self.clearance,
+            resolution: self.resolution,
+            budget: self.budget()?,
+            max_samples: self.max_samples,
+            search: GraphSearch::DepthFirst,
+            max_raw_paths: self.max_raw_paths,
+            keep_raw_paths: self.keep_raw_paths,
+            max_paths: self.max_paths,
+            length_ratio: self.length_ratio,
+            max_expansions: self.max_expansions,
+            cones: if self.freeze_forecasts {
+                ConeMode::Frozen
+            } else {
+                ConeMode::Ignore
+            },
+            surface_sampling: None,
+            goal_surface: false,
+        })
+    }
+}
+
+/// The visibility PRM of Fast-Planner as a [`PathFrontend`] (`"v-prm"`). Paths end at the goal.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Vprm {
+    params: VprmParams,
+}
+
+impl Vprm {
+    /// A planner with validated parameters.
+    pub fn new(params: VprmParams) -> Result<Self, PlanError> {
+        params.validate()?;
+        Ok(Vprm { params })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &VprmParams {
+        &self.params
+    }
+}
+
+impl PathFrontend for Vprm {
+    fn name(&self) -> &str {
+        "v-prm"
+    }
+
+    fn search(
+        &self,
+        query: &PathQuery,
+        scene: &Scene<'_>,
+        rng: &mut Rng,
+    ) -> Result<SearchResult, PlanError> {
+        run(&self.params.setup()?, query, scene, rng)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_bad_values_are_named() {
+        assert!(VprmParams::default().validate().is_ok());
+        let bad = VprmParams {
+            length_ratio: 0.5,
+            ..VprmParams::default()
+        };
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(e.contains("vprm.length_ratio") && e.contains("0.5"), "{e}");
+        let bad = VprmParams {
+            budget_ms: 1e300,
+            ..VprmParams::default()
+        };
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("vprm.budget_ms")
+        );
+        let bad = VprmParams {
+            inflate: Vec3::new(1.0, -1.0, 0.0),
+            ..VprmParams::default()
+        };
+        assert!(Vprm::new(bad).is_err());
+        let bad = VprmParams {
+            max_paths: 0,
+            ..VprmParams::default()
+        };
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("vprm.max_paths")
+        );
+    }
+
+    #[test]
+    fn params_deserialize_strictly() {
+        let p: VprmParams = serde_json::from_str(r#"{"budget_ms": 20.0}"#).unwrap();
+        assert_eq!(p.budget_ms, 20.0);
+        assert_eq!(p.max_samples, 2000);
+        assert!(serde_json::from_str::<VprmParams>(r#"{"budget": 20.0}"#).is_err());
+    }
+}
