@@ -19,13 +19,17 @@ pub struct Scene<'a> {
 }
 
 impl<'a> Scene<'a> {
-    /// A validated scene: `t0` finite and every forecast finite.
+    /// A validated scene: `t0` finite and every forecast valid (finite vectors and times, positive
+    /// size, non-negative margin and growth rate). The error names the forecast's index.
     pub fn new(map: &'a StaticMap, forecasts: &'a [Forecast], t0: f64) -> Result<Self, PlanError> {
         check_finite("scene.t0", t0)?;
         for (i, f) in forecasts.iter().enumerate() {
             check_finite_vec(&format!("scene.forecasts[{i}].p0"), &f.p0)?;
             check_finite_vec(&format!("scene.forecasts[{i}].v0"), &f.v0)?;
             check_finite(&format!("scene.forecasts[{i}].t0"), f.t0)?;
+            f.validate().map_err(|e| {
+                PlanError::invalid(format!("scene.forecasts[{i}]"), f, e.to_string())
+            })?;
         }
         Ok(Scene { map, forecasts, t0 })
     }
@@ -77,5 +81,72 @@ impl<'a> Scene<'a> {
                 needed,
             })
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use trust_geometry::{Aabb, Shape, Sphere};
+    use trust_predict::ObstacleShape;
+
+    fn map() -> StaticMap {
+        let bounds = Aabb::new(Vec3::zeros(), Vec3::new(10.0, 10.0, 5.0)).unwrap();
+        let pillar = Shape::Sphere(Sphere::new(Vec3::new(5.0, 5.0, 2.0), 1.0).unwrap());
+        StaticMap::from_shapes(bounds, vec![pillar]).unwrap()
+    }
+
+    fn ball(p0: Vec3, v0: Vec3) -> Forecast {
+        Forecast::new(ObstacleShape::Sphere, p0, v0, 0.0, 0.5, 0.0, 0.0).unwrap()
+    }
+
+    #[test]
+    fn clearance_combines_static_and_moving_obstacles() {
+        let map = map();
+        let forecasts = [ball(Vec3::new(1.0, 1.0, 1.0), Vec3::new(1.0, 0.0, 0.0))];
+        let scene = Scene::new(&map, &forecasts, 0.0).unwrap();
+        let p = Vec3::new(3.0, 1.0, 1.0);
+        // At t = 2 the ball is centred on p.
+        assert!((scene.dynamic_clearance(&p, 2.0) + 0.5).abs() < 1e-12);
+        assert!(scene.clearance(&p, 2.0) < 0.0);
+        assert!(scene.clearance(&p, 0.0) > 0.0);
+        let inside_pillar = Vec3::new(5.0, 5.0, 2.0);
+        assert!(
+            scene
+                .check_static_free("start", &inside_pillar, 0.0)
+                .is_err()
+        );
+        assert!(
+            scene
+                .check_in_bounds("goal", &Vec3::new(11.0, 0.0, 0.0))
+                .is_err()
+        );
+        assert!(
+            scene
+                .check_in_bounds("goal", &Vec3::new(9.0, 9.0, 4.0))
+                .is_ok()
+        );
+    }
+
+    #[test]
+    fn empty_scene_has_infinite_dynamic_clearance() {
+        let map = map();
+        let scene = Scene::new(&map, &[], 0.0).unwrap();
+        assert_eq!(scene.dynamic_clearance(&Vec3::zeros(), 1.0), f64::INFINITY);
+    }
+
+    #[test]
+    fn invalid_forecasts_are_named() {
+        let map = map();
+        let mut bad = ball(Vec3::zeros(), Vec3::zeros());
+        bad.r_o = -1.0;
+        let forecasts = [ball(Vec3::zeros(), Vec3::zeros()), bad];
+        let e = Scene::new(&map, &forecasts, 0.0).unwrap_err().to_string();
+        assert!(e.contains("scene.forecasts[1]"), "{e}");
+        let mut nan = ball(Vec3::zeros(), Vec3::zeros());
+        nan.v0.x = f64::NAN;
+        let e = Scene::new(&map, &[nan], 0.0).unwrap_err().to_string();
+        assert!(e.contains("scene.forecasts[0].v0"), "{e}");
+        assert!(Scene::new(&map, &[], f64::NAN).is_err());
     }
 }
