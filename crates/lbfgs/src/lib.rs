@@ -13,7 +13,7 @@
 //! - first trial step `1/‖g‖₂` for a steepest-descent direction, 1 otherwise;
 //! - Lewis–Overton line search: bisection once bracketed, doubling before, steps within
 //!   `[min_step, max_step]`; a NaN or infinite cost or gradient at a trial point shrinks the step;
-//! - stops on the relative gradient test, on relative cost decrease over `past` iteration_count, on
+//! - stops on the relative gradient test, on relative cost decrease over `past` iterations, on
 //!   iteration or evaluation budgets, or when a [`Monitor`] cancels.
 //!
 //! Failing to converge is a [`Termination`] value in the [`Report`], never an `Err`; on any

@@ -39,7 +39,7 @@ impl Monitor for () {}
 /// Cancels the solve at the first iteration that ends at or after a deadline.
 ///
 /// The deadline is checked once per iteration, so a solve overruns it by at most one iteration
-/// (one line search, at most `max_linesearch` evaluation_count).
+/// (one line search, at most `max_linesearch` evaluations).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Deadline {
     /// The instant after which the solve is cancelled.

@@ -255,7 +255,7 @@ impl Lbfgs {
     }
 
     /// The cost-decrease test `|f_{k−past} − f_k| / max(1, |f_k|) <= delta` after iteration `k`
-    /// (never true before `past` iteration_count); also records `f_k`.
+    /// (never true before `past` iterations); also records `f_k`.
     fn cost_stalled(&mut self, iteration: usize, cost: f64) -> bool {
         let past = self.params.past;
         if past == 0 {
