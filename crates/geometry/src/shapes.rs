@@ -40,6 +40,7 @@ fn side(x: f64) -> f64 {
 ///
 /// The gradient is `(p - center) / |p - center|`, or `+z` at the centre. Derivatives with respect
 /// to the other arguments follow directly: `∂d/∂center = -gradient`, `∂d/∂radius = -1`.
+#[inline]
 pub fn sphere_sdf(center: &Vec3, radius: f64, p: &Vec3) -> (f64, Vec3) {
     let d = p - center;
     let n = d.norm();
@@ -80,6 +81,7 @@ pub struct CylinderSdf {
 /// Writing `ρ = |(p - c)_xy|`, `a = |p_z - c_z|`, `dr = ρ - radius`, `dz = a - half_height`:
 /// outside (`dr > 0` or `dz > 0`) the distance is `|(max(dr,0), max(dz,0))|`; inside it is
 /// `max(dr, dz)` (ties go to the side wall).
+#[inline]
 pub fn cylinder_sdf_with_size_gradient(
     center: &Vec3,
     radius: f64,

@@ -7,7 +7,11 @@
 //!   `T_i = 0.5 s`). C++ anchor (GCOPTER): 17.2 µs.
 //! - `cost_eval/representative_16x17_free`: the same without obstacles (broad phase only).
 //! - `solve/utf_minco_e2_dynamic`, `solve/minco_e2_dynamic`, `solve/utf_minco_e2_static`: one
-//!   complete `optimize` call on the E2 scenes (target for UTF-MINCO dynamic: ≤ 1 ms median).
+//!   complete cold `optimize` call on the E2 scenes from the guide path (target for UTF-MINCO
+//!   dynamic: ≤ 1 ms median).
+//! - `solve/utf_minco_e2_dynamic_warm`, `solve/utf_minco_e2_static_warm`: the manager's common
+//!   case, a re-solve one replanning period (0.1 s) later from the state the previous solution
+//!   reaches then, warm-started from that solution (`InitialGuess::WarmStart`).
 //!
 //! Smoke mode: `cargo bench -p trust-minco --bench backend -- --test`.
 
@@ -15,8 +19,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use trust_core::{
-    Aabb, Forecast, InitialGuess, Limits, Scene, State, StaticMap, TrajRequest, TrajectoryBackend,
-    Vec3,
+    Aabb, Forecast, InitialGuess, Limits, PolyTraj, Scene, State, StaticMap, TrajRequest,
+    TrajectoryBackend, Vec3,
 };
 use trust_minco::backend::{Minco, UtfMinco, UtfMincoObjective, UtfMincoParams};
 use trust_minco::scenes::{E2Case, e2_dynamic, e2_static};
@@ -94,7 +98,10 @@ fn bench_cost_eval(c: &mut Criterion) {
     group.finish();
 }
 
-fn solve(case: &E2Case, backend: &dyn TrajectoryBackend) -> f64 {
+/// Replanning period of the warm re-solve benchmarks (s).
+const REPLAN_PERIOD_S: f64 = 0.1;
+
+fn solve(case: &E2Case, backend: &dyn TrajectoryBackend) -> PolyTraj {
     let guide = case.guide();
     let req = TrajRequest {
         start: case.start,
@@ -107,6 +114,26 @@ fn solve(case: &E2Case, backend: &dyn TrajectoryBackend) -> f64 {
         .optimize(&req, &case.scene())
         .expect("E2 solves")
         .traj
+}
+
+/// Re-solves `REPLAN_PERIOD_S` after the start of `previous`, warm-started from it.
+fn warm_resolve(case: &E2Case, backend: &dyn TrajectoryBackend, previous: &PolyTraj) -> f64 {
+    let t = previous.t_start() + REPLAN_PERIOD_S;
+    let req = TrajRequest {
+        start: previous.state(t),
+        goal: case.goal,
+        limits: case.limits,
+        initial: InitialGuess::WarmStart(previous),
+        deadline: None,
+    };
+    let scene = Scene {
+        t0: t,
+        ..case.scene()
+    };
+    backend
+        .optimize(&req, &scene)
+        .expect("E2 re-solves")
+        .traj
         .duration()
 }
 
@@ -116,13 +143,21 @@ fn bench_solve(c: &mut Criterion) {
     let mut group = c.benchmark_group("solve");
     group.sample_size(20);
     group.bench_function("utf_minco_e2_dynamic", |b| {
-        b.iter(|| black_box(solve(&dynamic, &utf)))
+        b.iter(|| black_box(solve(&dynamic, &utf).duration()))
     });
     group.bench_function("minco_e2_dynamic", |b| {
-        b.iter(|| black_box(solve(&dynamic, &minco)))
+        b.iter(|| black_box(solve(&dynamic, &minco).duration()))
     });
     group.bench_function("utf_minco_e2_static", |b| {
-        b.iter(|| black_box(solve(&stat, &utf)))
+        b.iter(|| black_box(solve(&stat, &utf).duration()))
+    });
+    let previous = solve(&dynamic, &utf);
+    group.bench_function("utf_minco_e2_dynamic_warm", |b| {
+        b.iter(|| black_box(warm_resolve(&dynamic, &utf, &previous)))
+    });
+    let previous = solve(&stat, &utf);
+    group.bench_function("utf_minco_e2_static_warm", |b| {
+        b.iter(|| black_box(warm_resolve(&stat, &utf, &previous)))
     });
     group.finish();
 }

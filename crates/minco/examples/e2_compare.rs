@@ -1,31 +1,80 @@
 //! Experiment E2 (paper Table Sim-A-2): UTF-MINCO vs MINCO on the static and dynamic E2 scenes.
 //!
-//! Runs each backend `R` times per case (first argument, default 20) and prints one JSON object:
-//! per case and method the median CPU time of one `optimize` call (`cpu_ms`, wall clock of a
-//! single-threaded call), the trajectory duration, whether it stays clear of every obstacle at
-//! dense times (every 5 ms, `Scene::clearance ≥ 0`, forecasts included), the minimum clearance,
-//! the solve status and evaluation count, and the largest speed and acceleration.
+//! Runs each backend `N` times per case (`--repeats N`, default 20) and prints one JSON object on
+//! stdout (progress goes to stderr): per case and method the median CPU time of one `optimize`
+//! call (`cpu_ms`, wall clock of a single-threaded call), the trajectory duration, whether it
+//! stays clear of every obstacle at dense times (every 5 ms, `Scene::clearance ≥ 0`, forecasts
+//! included), the minimum clearance, the solve status and evaluation count, and the largest speed
+//! and acceleration. `warm_resolve` is the manager's common case: the same request 0.1 s later,
+//! from the state the first solution reaches then, warm-started from that solution (median over
+//! the repeats, collision check of the re-solved trajectory).
 //!
 //! ```text
-//! cargo run --release -p trust-minco --example e2_compare -- 50
+//! cargo run --release -p trust-minco --example e2_compare -- --repeats 50
 //! ```
 //!
 //! Paper (C++ on an i9-13980HX): UTF-MINCO 8.98 ms / 7.08 s static, 9.71 ms / 6.47 s dynamic;
 //! MINCO 7.77 / 7.09 and 8.52 / 6.72 (MINCO collides in the dynamic case).
 
 use serde_json::{Map, Value, json};
-use trust_core::{InitialGuess, PlanError, Solution, TrajRequest, TrajectoryBackend};
+use trust_core::{
+    InitialGuess, PlanError, PolyTraj, Scene, Solution, TrajRequest, TrajectoryBackend,
+};
 use trust_minco::backend::{Minco, UtfMinco};
 use trust_minco::scenes::{E2Case, e2_dynamic, e2_static};
 
+/// Replanning period of the warm re-solve (s).
+const REPLAN_PERIOD_S: f64 = 0.1;
+
 /// Dense collision check: smallest clearance every `dt` seconds along the trajectory.
-fn min_clearance(case: &E2Case, solution: &Solution, dt: f64) -> Result<f64, PlanError> {
+fn min_clearance(case: &E2Case, traj: &PolyTraj, dt: f64) -> Result<f64, PlanError> {
     let scene = case.scene();
     let mut worst = f64::INFINITY;
-    solution
-        .traj
-        .for_each_sample(dt, |t, s| worst = worst.min(scene.clearance(&s.p, t)))?;
+    traj.for_each_sample(dt, |t, s| worst = worst.min(scene.clearance(&s.p, t)))?;
     Ok(worst)
+}
+
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values.get(values.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// Re-solves `REPLAN_PERIOD_S` later from where `previous` is then, warm-started from it.
+fn warm_resolve(
+    case: &E2Case,
+    backend: &dyn TrajectoryBackend,
+    previous: &PolyTraj,
+    repeats: usize,
+) -> Result<Value, PlanError> {
+    let t = previous.t_start() + REPLAN_PERIOD_S;
+    let req = TrajRequest {
+        start: previous.state(t),
+        goal: case.goal,
+        limits: case.limits,
+        initial: InitialGuess::WarmStart(previous),
+        deadline: None,
+    };
+    let scene = Scene {
+        t0: t,
+        ..case.scene()
+    };
+    let mut times = Vec::with_capacity(repeats);
+    let mut last = None;
+    for _ in 0..repeats.max(1) {
+        let solution = backend.optimize(&req, &scene)?;
+        times.push(solution.stats.elapsed.as_secs_f64() * 1e3);
+        last = Some(solution);
+    }
+    let solution = last.expect("at least one run");
+    let clearance = min_clearance(case, &solution.traj, 0.005)?;
+    Ok(json!({
+        "cpu_ms": median(times),
+        "duration_s": solution.traj.duration(),
+        "collision_free": clearance >= 0.0,
+        "min_clearance_m": clearance,
+        "status": format!("{:?}", solution.stats.status),
+        "evaluations": solution.stats.evaluation_count,
+    }))
 }
 
 fn run(case: &E2Case, backend: &dyn TrajectoryBackend, repeats: usize) -> Result<Value, PlanError> {
@@ -45,14 +94,15 @@ fn run(case: &E2Case, backend: &dyn TrajectoryBackend, repeats: usize) -> Result
         times.push(solution.stats.elapsed.as_secs_f64() * 1e3);
         last = Some(solution);
     }
-    let solution = last.expect("at least one run");
-    times.sort_by(f64::total_cmp);
-    let clearance = min_clearance(case, &solution, 0.005)?;
+    let solution: Solution = last.expect("at least one run");
+    let cpu_ms_min = times.iter().copied().fold(f64::INFINITY, f64::min);
+    let clearance = min_clearance(case, &solution.traj, 0.005)?;
+    let warm = warm_resolve(case, backend, &solution.traj, repeats)?;
     let (v, a) = solution.traj.max_speed_and_acceleration(64);
     let end = solution.traj.position(solution.traj.t_end());
     Ok(json!({
-        "cpu_ms": times[times.len() / 2],
-        "cpu_ms_min": times[0],
+        "cpu_ms": median(times),
+        "cpu_ms_min": cpu_ms_min,
         "duration_s": solution.traj.duration(),
         "collision_free": clearance >= 0.0,
         "min_clearance_m": clearance,
@@ -64,14 +114,33 @@ fn run(case: &E2Case, backend: &dyn TrajectoryBackend, repeats: usize) -> Result
         "max_acceleration": a,
         "end_to_goal_m": (end - case.goal).norm(),
         "costs": solution.costs,
+        "warm_resolve": warm,
     }))
 }
 
+/// `--repeats N` (or a bare `N`, the older form); 20 without arguments.
+fn parse_repeats() -> Result<usize, String> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let value = match args.as_slice() {
+        [] => return Ok(20),
+        [flag, n] if flag == "--repeats" => n,
+        [n] if !n.starts_with('-') => n,
+        _ => return Err(format!("usage: e2_compare [--repeats N], got {args:?}")),
+    };
+    match value.parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!("--repeats expects an integer >= 1, got {value:?}")),
+    }
+}
+
 fn main() -> Result<(), PlanError> {
-    let repeats = std::env::args()
-        .nth(1)
-        .and_then(|a| a.parse().ok())
-        .unwrap_or(20);
+    let repeats = match parse_repeats() {
+        Ok(n) => n,
+        Err(message) => {
+            eprintln!("{message}");
+            std::process::exit(2);
+        }
+    };
     let backends: [(&str, Box<dyn TrajectoryBackend>); 2] = [
         ("utf-minco", Box::new(UtfMinco::default())),
         ("minco", Box::new(Minco::default())),
@@ -80,6 +149,7 @@ fn main() -> Result<(), PlanError> {
     for case in [e2_static(), e2_dynamic()] {
         let mut per_method = Map::new();
         for (name, backend) in &backends {
+            eprintln!("e2_compare: {} case, {name}, {repeats} repeats", case.name);
             per_method.insert((*name).into(), run(&case, backend.as_ref(), repeats)?);
         }
         out.insert(case.name.into(), Value::Object(per_method));

@@ -273,12 +273,11 @@ mod tests {
         .unwrap();
         let limits = Limits::default();
         let start = State::at_rest(0.0, Vec3::zeros());
-        let init = initial_trajectory(
-            &InitialGuess::Guide(&path),
-            &start,
-            &limits,
-            &PieceParams::default(),
-        );
+        let pieces = PieceParams {
+            target_piece_length_m: 3.0,
+            ..PieceParams::default()
+        };
+        let init = initial_trajectory(&InitialGuess::Guide(&path), &start, &limits, &pieces);
         assert_eq!(init.pieces(), 4);
         let profile = SpeedProfile::new(12.0, 0.0, &limits);
         assert_relative_eq!(init.total_duration, profile.duration());

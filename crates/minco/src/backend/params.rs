@@ -24,15 +24,21 @@ pub struct PieceParams {
 
 impl Default for PieceParams {
     /// Ours (the paper gives no values):
-    /// - `target_piece_length_m = 3`: the E2 path (about 50 m) gets 16–18 pieces, the size of the
-    ///   reference's representative problem (16 pieces);
+    /// - `target_piece_length_m = 7`: the E2 path (about 50 m) gets 7–8 pieces of about 0.7 s at
+    ///   10 m/s. Measured (release, 60 random E2-like scenes of each kind plus the two E2 scenes,
+    ///   `examples/e2_compare.rs` limits): against 3 m (16–18 pieces), 7 m needs about half the
+    ///   evaluations to converge (static 407 vs 936 on average, dynamic 561 vs 993 with the
+    ///   1000-evaluation cap), each evaluation costs about half as much, and the optimizer finds
+    ///   better local minima among moving obstacles (mean `J` 165 vs 216, mean duration 7.5 vs
+    ///   7.8 s; on E2 dynamic 7.7 s to the goal instead of 8.3 s stopping 4 m short). 6 m and 8 m
+    ///   give the same quality; 12 m starts to cut corners between samples;
     /// - `min_pieces = 2`, `max_pieces = 32`: at least one free waypoint; the cost stays within
     ///   the O(n) budget of design.md §6;
     /// - `min_piece_duration_s = 0.02`: keeps MINCO's `T⁵` pivot above 3e-9 and gives a hover
     ///   (start on the goal) a non-degenerate duration when `H_t` pushes every duration down.
     fn default() -> Self {
         Self {
-            target_piece_length_m: 3.0,
+            target_piece_length_m: 7.0,
             min_pieces: 2,
             max_pieces: 32,
             min_piece_duration_s: 0.02,
@@ -94,19 +100,28 @@ pub struct SolverParams {
 }
 
 impl Default for SolverParams {
-    /// - `max_evaluations = 1000`: ours, a hard cap of about 1000 × 15–20 µs ≈ 15–20 ms per solve
-    ///   on this machine (the paper reports ~10 ms per trajectory).
-    /// - `lbfgs`: LBFGS-Lite's defaults (`g_epsilon = 1e-5`, `past = 3`, `delta = 1e-6`, …; see
-    ///   [`LbfgsParams`]) except `memory = 32` (LBFGS-Lite: 8; GCOPTER's own setting: 256).
-    ///   Measured on the E2 scenes with the 1000-evaluation cap (`examples/e2_compare.rs`
-    ///   settings): memory 32 ends about 9 % (static) and 12 % (dynamic) lower in `J` than 8 at
-    ///   the same wall time; 64 and more converge in fewer evaluations but cost more per
-    ///   iteration.
+    /// - `max_evaluations = 1000`: ours, a hard cap (about 5 ms at the E2 problem size on this
+    ///   machine); converged solves stop well before it (E2: 356 dynamic, 722 static; random
+    ///   E2-like scenes: about 400–560 on average).
+    /// - `lbfgs`: LBFGS-Lite's defaults (`g_epsilon = 1e-5`, `past = 3`, …; see [`LbfgsParams`])
+    ///   except:
+    ///   - `memory = 32` (LBFGS-Lite: 8; GCOPTER's own setting: 256). Measured to full convergence
+    ///     on 30 random E2-like scenes of each kind (7 m pieces): the median number of
+    ///     evaluations to come within 1 % of the final `J` is 465 / 872 (static / dynamic) with
+    ///     memory 8, 366 / 580 with 16, 309 / 399 with 32 and 293 / 363 with 64; 32 is within
+    ///     10 % of 64 at half the work per iteration.
+    ///   - `delta = 1e-5` (LBFGS-Lite: 1e-6): on the same 30 + 30 scenes it saves 10–15 % of the
+    ///     evaluations (static 412 vs 465, dynamic 531 vs 628 on average) for mean durations
+    ///     within 0.4 % (7.065 vs 7.047 s, 7.302 vs 7.277 s) and a mean `J` within 0.3 %. Looser
+    ///     tests stop on a plateau (the cost stalls for many iterations while the optimizer
+    ///     slides the trajectory along an obstacle): `1e-4` (or `1e-3` with `past = 10`) ends the
+    ///     dynamic solves about 6.5 % longer in duration, `1e-3` with `past = 3` 21 % longer.
     fn default() -> Self {
         Self {
             max_evaluations: 1000,
             lbfgs: LbfgsParams {
                 memory: 32,
+                delta: 1e-5,
                 ..LbfgsParams::default()
             },
         }
@@ -192,7 +207,7 @@ mod tests {
         let p = PieceParams::default();
         assert_eq!(p.piece_count(0.0), 2);
         assert_eq!(p.piece_count(f64::NAN), 2);
-        assert_eq!(p.piece_count(50.0), 17);
+        assert_eq!(p.piece_count(50.0), 8);
         assert_eq!(p.piece_count(1e9), 32);
     }
 

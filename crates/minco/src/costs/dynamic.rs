@@ -1,10 +1,10 @@
 //! The moving-obstacle penalty `I_o` through the dynamic distance field (paper eqs. design-of-Io
 //! and gradients-of-Io).
 
-use trust_core::{Aabb, Forecast, Vec3};
+use trust_core::{Aabb, Forecast, ObstacleShape, Vec3};
 
 use super::integrate::{Integrand, SampleGrad, SampleState};
-use super::smooth::smoothed_l1;
+use super::smooth::SmoothedL1;
 
 /// The DDF violation `φ_o` of one forecast at `(p, t)` and its partial derivatives
 /// `(φ, ∂φ/∂p, ∂φ/∂t)`.
@@ -31,6 +31,23 @@ pub fn ddf_violation(forecast: &Forecast, p: &Vec3, t: f64, clearance: f64) -> (
     )
 }
 
+/// Cheap exact rejection before [`ddf_violation`]: `true` only if `p` is farther than
+/// `clearance` from the inflated obstacle at `t`, where `φ ≤ 0` (no penalty). Compares squared
+/// distances (no square root, no `hypot`); a cylinder is tested against its bounding
+/// cylinder with flat, unrounded caps, a superset of the points within `clearance`.
+#[inline]
+fn outside_inflated(forecast: &Forecast, p: &Vec3, t: f64, clearance: f64) -> bool {
+    let q = p - forecast.center(t);
+    let r = forecast.radius(t) + clearance;
+    match forecast.shape {
+        ObstacleShape::Sphere => q.norm_squared() >= r * r,
+        ObstacleShape::Cylinder { .. } => {
+            q.x * q.x + q.y * q.y >= r * r
+                || q.z.abs() >= forecast.vertical_half_extent(t) + clearance
+        }
+    }
+}
+
 /// Axis-aligned box that contains every point within `margin` of the inflated obstacle at any
 /// time of `[t_a, t_b]` (broad phase). Never fails; non-finite input gives a non-finite box that
 /// intersects nothing.
@@ -47,7 +64,7 @@ pub fn swept_box(forecast: &Forecast, t_a: f64, t_b: f64, margin: f64) -> Aabb {
 }
 
 /// `I_o` for moving obstacles: `L_o = Σ_O f_max(φ_o)` (paper eq. design-of-Io) with
-/// [`ddf_violation`] and [`smoothed_l1`].
+/// [`ddf_violation`] and [`super::smoothed_l1`].
 ///
 /// Broad phase: per trajectory and then per piece, only forecasts whose [`swept_box`] over the
 /// time window (inflated by the clearance) meets the box of the samples are evaluated; the
@@ -56,7 +73,7 @@ pub fn swept_box(forecast: &Forecast, t_a: f64, t_b: f64, margin: f64) -> Aabb {
 pub struct DynamicObstacleTerm<'a> {
     forecasts: &'a [Forecast],
     clearance: f64,
-    smoothing: f64,
+    smoothing: SmoothedL1,
     near_trajectory: Vec<usize>,
     near_piece: Vec<usize>,
 }
@@ -67,7 +84,7 @@ impl<'a> DynamicObstacleTerm<'a> {
         Self {
             forecasts,
             clearance,
-            smoothing,
+            smoothing: SmoothedL1::new(smoothing),
             near_trajectory: Vec::with_capacity(forecasts.len()),
             near_piece: Vec::with_capacity(forecasts.len()),
         }
@@ -80,6 +97,7 @@ impl<'a> DynamicObstacleTerm<'a> {
 
     /// `L_o` at one node without broad phase: adds `weight · ∂L_o` into `grad` and returns the
     /// unweighted `L_o` over the forecasts listed in `indices`.
+    #[inline]
     fn accumulate(
         &self,
         indices: impl Iterator<Item = usize>,
@@ -89,11 +107,15 @@ impl<'a> DynamicObstacleTerm<'a> {
     ) -> f64 {
         let mut total = 0.0;
         for o in indices {
-            let (phi, phi_p, phi_t) = ddf_violation(&self.forecasts[o], &s.p, s.t, self.clearance);
+            let forecast = &self.forecasts[o];
+            if outside_inflated(forecast, &s.p, s.t, self.clearance) {
+                continue;
+            }
+            let (phi, phi_p, phi_t) = ddf_violation(forecast, &s.p, s.t, self.clearance);
             if phi <= 0.0 {
                 continue;
             }
-            let (value, slope) = smoothed_l1(phi, self.smoothing);
+            let (value, slope) = self.smoothing.eval(phi);
             total += value;
             let k = weight * slope;
             grad.p += phi_p * k;
@@ -130,6 +152,7 @@ impl<'a> DynamicObstacleTerm<'a> {
     }
 
     /// `L_o` at one node over the current piece's candidates, gradient scaled by `weight`.
+    #[inline]
     pub(crate) fn sample_weighted(
         &self,
         s: &SampleState,
@@ -155,6 +178,7 @@ impl Integrand for DynamicObstacleTerm<'_> {
         self.begin_piece_impl(t_begin, t_end, samples_box)
     }
 
+    #[inline]
     fn sample(&mut self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
         self.sample_weighted(s, grad, 1.0)
     }
@@ -219,6 +243,19 @@ mod tests {
             }
             let fd = (ddf_violation(&f, &p, t + h, c).0 - ddf_violation(&f, &p, t - h, c).0) / (2.0 * h);
             prop_assert!((fd - gt).abs() < 1e-4 * (1.0 + fd.abs()), "t: {fd} vs {gt}");
+        }
+
+        /// The cheap rejection never skips a sample with a positive violation.
+        #[test]
+        fn rejection_is_exact(
+            px in -2.0..4.0f64, py in -1.0..5.0f64, pz in 0.0..6.0f64,
+            t in 0.0..3.0f64, clearance in 0.0..0.5f64, cylinder in any::<bool>(),
+        ) {
+            let f = forecast(cylinder);
+            let p = Vec3::new(px, py, pz);
+            if outside_inflated(&f, &p, t, clearance) {
+                prop_assert!(ddf_violation(&f, &p, t, clearance).0 <= 0.0);
+            }
         }
 
         #[test]

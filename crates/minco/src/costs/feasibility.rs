@@ -3,7 +3,7 @@
 use trust_core::{Limits, Vec3};
 
 use super::integrate::{Integrand, SampleGrad, SampleState};
-use super::smooth::smoothed_l1;
+use super::smooth::SmoothedL1;
 
 /// `φ = ‖x‖²/x_max² − 1` and `∂φ/∂x = 2x/x_max²` (paper eq. design-of-Id, for `x` = velocity or
 /// acceleration).
@@ -18,16 +18,32 @@ pub fn norm_violation(x: &Vec3, x_max: f64) -> (f64, Vec3) {
 /// and `2jᵀa/a_max²` follow from `∂L/∂v · a` and `∂L/∂a · j` in the integrator).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FeasibilityTerm {
-    /// Speed and acceleration limits.
-    pub limits: Limits,
-    /// Smoothing `μ`.
-    pub smoothing: f64,
+    limits: Limits,
+    smoothing: SmoothedL1,
+    /// `1/v_max²` and `1/a_max²`, precomputed (no division per sample).
+    inv_v2: f64,
+    inv_a2: f64,
 }
 
 impl FeasibilityTerm {
     /// The penalty for `limits` with smoothing `μ`.
     pub fn new(limits: Limits, smoothing: f64) -> Self {
-        Self { limits, smoothing }
+        Self {
+            limits,
+            smoothing: SmoothedL1::new(smoothing),
+            inv_v2: 1.0 / (limits.v_max * limits.v_max),
+            inv_a2: 1.0 / (limits.a_max * limits.a_max),
+        }
+    }
+
+    /// Speed and acceleration limits.
+    pub fn limits(&self) -> &Limits {
+        &self.limits
+    }
+
+    /// Smoothing `μ`.
+    pub fn smoothing(&self) -> f64 {
+        self.smoothing.mu()
     }
 
     /// Unweighted `(f_max(φ_v), f_max(φ_a))` at one node; adds `weight · ∂L_d` into `grad`.
@@ -38,17 +54,17 @@ impl FeasibilityTerm {
         grad: &mut SampleGrad,
         weight: f64,
     ) -> (f64, f64) {
-        let (phi_v, dv) = norm_violation(&s.v, self.limits.v_max);
-        let (phi_a, da) = norm_violation(&s.a, self.limits.a_max);
+        let phi_v = s.v.norm_squared() * self.inv_v2 - 1.0;
+        let phi_a = s.a.norm_squared() * self.inv_a2 - 1.0;
         let mut out = (0.0, 0.0);
         if phi_v > 0.0 {
-            let (value, slope) = smoothed_l1(phi_v, self.smoothing);
-            grad.v += dv * (weight * slope);
+            let (value, slope) = self.smoothing.eval(phi_v);
+            grad.v += s.v * (2.0 * self.inv_v2 * weight * slope);
             out.0 = value;
         }
         if phi_a > 0.0 {
-            let (value, slope) = smoothed_l1(phi_a, self.smoothing);
-            grad.a += da * (weight * slope);
+            let (value, slope) = self.smoothing.eval(phi_a);
+            grad.a += s.a * (2.0 * self.inv_a2 * weight * slope);
             out.1 = value;
         }
         out
@@ -56,6 +72,7 @@ impl FeasibilityTerm {
 }
 
 impl Integrand for FeasibilityTerm {
+    #[inline]
     fn sample(&mut self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
         let (v, a) = self.sample_parts(s, grad, 1.0);
         v + a

@@ -120,9 +120,20 @@ pub trait Integrand {
 ///
 /// Holds its scratch buffers; [`TrapezoidIntegrator::integrate`] allocates only when a trajectory
 /// has more pieces than any before.
+///
+/// # Implementation
+///
+/// The nodes sit at the same fractions `u_k = k/κ` of every piece, so the integrator keeps the
+/// powers `u_k^e` in a table and works with each piece's coefficients scaled to `u`: node values
+/// are sums of independent products (no Horner chain, no powers computed per node), and
+/// `∂I/∂c` is gathered per piece as the moments `Σ_k ω_k h ∂L/∂(d-th derivative) u_k^e`, which
+/// are turned into coefficient gradients once per piece (`β_d` of `s = uT` factorizes into
+/// `u^e T^e`).
 #[derive(Debug, Clone)]
 pub struct TrapezoidIntegrator {
     kappa: usize,
+    /// `[1, u, u², u³, u⁴, u⁵]` at every node fraction `u_k = k/κ`.
+    u_powers: Vec<[f64; 6]>,
     /// `[p, v, a, j]` at every node, piece by piece.
     nodes: Vec<[Vec3; 4]>,
     /// Box of each piece's node positions.
@@ -134,8 +145,20 @@ pub struct TrapezoidIntegrator {
 impl TrapezoidIntegrator {
     /// An integrator with `kappa` intervals per piece (`κ + 1` nodes); `kappa = 0` is raised to 1.
     pub fn new(kappa: usize) -> Self {
+        let kappa = kappa.max(1);
+        let u_powers = (0..=kappa)
+            .map(|k| {
+                let u = k as f64 / kappa as f64;
+                let mut pw = [1.0; 6];
+                for e in 1..6 {
+                    pw[e] = pw[e - 1] * u;
+                }
+                pw
+            })
+            .collect();
         Self {
-            kappa: kappa.max(1),
+            kappa,
+            u_powers,
             nodes: Vec::new(),
             boxes: Vec::new(),
             coupling: Vec::new(),
@@ -169,26 +192,30 @@ impl TrapezoidIntegrator {
             return Ok(0.0);
         }
         let kappa = self.kappa;
-        let kf = kappa as f64;
+        let nodes_per_piece = kappa + 1;
 
         // Pass 1: node derivatives and per-piece boxes.
-        self.nodes.clear();
+        self.nodes.resize(n * nodes_per_piece, [Vec3::zeros(); 4]);
         self.boxes.clear();
         let mut all = Aabb {
             min: Vec3::repeat(f64::INFINITY),
             max: Vec3::repeat(f64::NEG_INFINITY),
         };
-        for (c, &duration) in traj.coeffs.chunks_exact(6).zip(traj.durations) {
-            let h = duration / kf;
+        for ((c, &duration), nodes) in traj
+            .coeffs
+            .chunks_exact(6)
+            .zip(traj.durations)
+            .zip(self.nodes.chunks_exact_mut(nodes_per_piece))
+        {
+            let scaled = ScaledPiece::new(c, duration);
             let mut b = Aabb {
                 min: Vec3::repeat(f64::INFINITY),
                 max: Vec3::repeat(f64::NEG_INFINITY),
             };
-            for k in 0..=kappa {
-                let node = node_derivatives(c, k as f64 * h);
+            for (node, u) in nodes.iter_mut().zip(&self.u_powers) {
+                *node = scaled.at(u);
                 b.min = b.min.inf(&node[0]);
                 b.max = b.max.sup(&node[0]);
-                self.nodes.push(node);
             }
             all = all.union(&b);
             self.boxes.push(b);
@@ -204,40 +231,26 @@ impl TrapezoidIntegrator {
         for i in 0..n {
             let duration = traj.durations[i];
             let piece_end = piece_start + duration;
-            let h = duration / kf;
             if integrand.begin_piece(i, piece_start, piece_end, &self.boxes[i]) {
+                let nodes = &self.nodes[i * nodes_per_piece..(i + 1) * nodes_per_piece];
                 let c = &traj.coeffs[6 * i..6 * i + 6];
-                let (gc, gt) = (&mut grad_c[6 * i..6 * i + 6], &mut grad_t[i]);
-                for k in 0..=kappa {
-                    let [p, v, a, j] = self.nodes[i * (kappa + 1) + k];
-                    let omega = if k == 0 || k == kappa { 0.5 } else { 1.0 };
-                    let s = k as f64 * h;
-                    let state = SampleState {
-                        piece: i,
-                        index: k,
-                        t: piece_start + s,
-                        weight: omega * h,
-                        p,
-                        v,
-                        a,
-                        j,
-                    };
-                    let mut g = SampleGrad::ZERO;
-                    let value = integrand.sample(&state, &mut g);
-                    if value == 0.0 && g.is_zero() {
-                        continue;
-                    }
-                    let w = state.weight;
-                    total += w * value;
-                    add_coefficient_grad(gc, s, &g, w);
-                    let snap = if g.j == Vec3::zeros() {
-                        Vec3::zeros()
-                    } else {
-                        c[4] * 24.0 + c[5] * (120.0 * s)
-                    };
-                    let along = g.p.dot(&v) + g.v.dot(&a) + g.a.dot(&j) + g.j.dot(&snap) + g.t;
-                    *gt += omega / kf * value + w * (k as f64 / kf) * along;
-                    self.coupling[i] += w * g.t;
+                let piece = integrate_piece(
+                    integrand,
+                    i,
+                    piece_start,
+                    duration,
+                    kappa,
+                    nodes,
+                    &self.u_powers,
+                    c,
+                );
+                if piece.active {
+                    total += piece.value;
+                    piece
+                        .moments
+                        .add_to(&mut grad_c[6 * i..6 * i + 6], duration);
+                    grad_t[i] += piece.grad_t;
+                    self.coupling[i] += piece.coupling;
                 }
             }
             piece_start = piece_end;
@@ -252,34 +265,182 @@ impl TrapezoidIntegrator {
     }
 }
 
-/// `[p, v, a, j]` of a piece at local time `s` (Horner form).
-#[inline(always)]
-fn node_derivatives(c: &[Vec3], s: f64) -> [Vec3; 4] {
-    let p = ((((c[5] * s + c[4]) * s + c[3]) * s + c[2]) * s + c[1]) * s + c[0];
-    let v = (((c[5] * (5.0 * s) + c[4] * 4.0) * s + c[3] * 3.0) * s + c[2] * 2.0) * s + c[1];
-    let a = ((c[5] * (20.0 * s) + c[4] * 12.0) * s + c[3] * 6.0) * s + c[2] * 2.0;
-    let j = (c[5] * (60.0 * s) + c[4] * 24.0) * s + c[3] * 6.0;
-    [p, v, a, j]
+/// What one piece contributes: `I_i`, the moments for `∂I/∂c_i`, the explicit `∂I_i/∂T_i` and the
+/// dI-c coupling.
+struct PieceIntegral {
+    active: bool,
+    value: f64,
+    moments: Moments,
+    grad_t: f64,
+    coupling: f64,
 }
 
-/// `grad_c[m] += w Σ_d β_d[m](s) ∂L/∂(d-th derivative)` for the six coefficients of one piece,
-/// with `β_d[m] = m!/(m−d)! s^{m−d}` written out (the zero entries of the basis skipped).
+/// Integrates one piece (pass 2 of [`TrapezoidIntegrator::integrate`]).
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn add_coefficient_grad(grad_c: &mut [Vec3], s: f64, g: &SampleGrad, w: f64) {
-    let (p, v, a) = (g.p * w, g.v * w, g.a * w);
-    let (s2, s3) = (s * s, s * s * s);
-    let s4 = s2 * s2;
-    grad_c[0] += p;
-    grad_c[1] += p * s + v;
-    grad_c[2] += p * s2 + v * (2.0 * s) + a * 2.0;
-    grad_c[3] += p * s3 + v * (3.0 * s2) + a * (6.0 * s);
-    grad_c[4] += p * s4 + v * (4.0 * s3) + a * (12.0 * s2);
-    grad_c[5] += p * (s4 * s) + v * (5.0 * s4) + a * (20.0 * s3);
-    if g.j != Vec3::zeros() {
-        let j = g.j * w;
-        grad_c[3] += j * 6.0;
-        grad_c[4] += j * (24.0 * s);
-        grad_c[5] += j * (60.0 * s2);
+fn integrate_piece<I: Integrand + ?Sized>(
+    integrand: &mut I,
+    piece: usize,
+    piece_start: f64,
+    duration: f64,
+    kappa: usize,
+    nodes: &[[Vec3; 4]],
+    u_powers: &[[f64; 6]],
+    c: &[Vec3],
+) -> PieceIntegral {
+    let inv_kappa = 1.0 / kappa as f64;
+    let h = duration * inv_kappa;
+    let mut out = PieceIntegral {
+        active: false,
+        value: 0.0,
+        moments: Moments::ZERO,
+        grad_t: 0.0,
+        coupling: 0.0,
+    };
+    for (k, (node, u)) in nodes.iter().zip(u_powers).enumerate() {
+        let [p, v, a, j] = *node;
+        let omega = if k == 0 || k == kappa { 0.5 } else { 1.0 };
+        let weight = omega * h;
+        let s = u[1] * duration;
+        let state = SampleState {
+            piece,
+            index: k,
+            t: piece_start + s,
+            weight,
+            p,
+            v,
+            a,
+            j,
+        };
+        let mut g = SampleGrad::ZERO;
+        let value = integrand.sample(&state, &mut g);
+        if value == 0.0 && g.is_zero() {
+            continue;
+        }
+        out.active = true;
+        out.value += weight * value;
+        let has_jerk = g.j != Vec3::zeros();
+        out.moments.add(&g, weight, u, has_jerk);
+        let mut along = g.p.dot(&v) + g.v.dot(&a) + g.a.dot(&j) + g.t;
+        if has_jerk {
+            let snap = c[4] * 24.0 + c[5] * (120.0 * s);
+            along += g.j.dot(&snap);
+        }
+        out.grad_t += omega * inv_kappa * value + weight * u[1] * along;
+        out.coupling += weight * g.t;
+    }
+    out
+}
+
+/// A piece's coefficients rescaled to the node fraction `u = s/T`: position, velocity,
+/// acceleration and jerk are `Σ_e X_e u^e` with the `X` below.
+struct ScaledPiece {
+    p: [Vec3; 6],
+    v: [Vec3; 5],
+    a: [Vec3; 4],
+    j: [Vec3; 3],
+}
+
+impl ScaledPiece {
+    #[inline(always)]
+    fn new(c: &[Vec3], duration: f64) -> Self {
+        let t = duration;
+        let tp = [1.0, t, t * t, t * t * t, t * t * t * t, t * t * t * t * t];
+        let p = [
+            c[0],
+            c[1] * tp[1],
+            c[2] * tp[2],
+            c[3] * tp[3],
+            c[4] * tp[4],
+            c[5] * tp[5],
+        ];
+        // d/ds of Σ c_m s^m = Σ m c_m s^{m−1}; with s = uT, s^{m−1} = u^{m−1} T^{m−1}.
+        let v = [
+            c[1],
+            c[2] * (2.0 * tp[1]),
+            c[3] * (3.0 * tp[2]),
+            c[4] * (4.0 * tp[3]),
+            c[5] * (5.0 * tp[4]),
+        ];
+        let a = [
+            c[2] * 2.0,
+            c[3] * (6.0 * tp[1]),
+            c[4] * (12.0 * tp[2]),
+            c[5] * (20.0 * tp[3]),
+        ];
+        let j = [c[3] * 6.0, c[4] * (24.0 * tp[1]), c[5] * (60.0 * tp[2])];
+        Self { p, v, a, j }
+    }
+
+    /// `[p, v, a, j]` at the node with powers `u = [1, u, …, u⁵]`.
+    #[inline(always)]
+    fn at(&self, u: &[f64; 6]) -> [Vec3; 4] {
+        let p = self.p[0]
+            + self.p[1] * u[1]
+            + self.p[2] * u[2]
+            + self.p[3] * u[3]
+            + self.p[4] * u[4]
+            + self.p[5] * u[5];
+        let v =
+            self.v[0] + self.v[1] * u[1] + self.v[2] * u[2] + self.v[3] * u[3] + self.v[4] * u[4];
+        let a = self.a[0] + self.a[1] * u[1] + self.a[2] * u[2] + self.a[3] * u[3];
+        let j = self.j[0] + self.j[1] * u[1] + self.j[2] * u[2];
+        [p, v, a, j]
+    }
+}
+
+/// Per-piece moments `M_{d,e} = Σ_k w_k ∂L/∂(d-th derivative)_k u_k^e` (`d = 0..3`,
+/// `e ≤ 5 − d`), from which `∂I/∂c_m = Σ_d m!/(m−d)! T^{m−d} M_{d,m−d}` (eq. dI-a with
+/// `β_d,m(s) = m!/(m−d)! s^{m−d}` and `s = uT`).
+struct Moments {
+    p: [Vec3; 6],
+    v: [Vec3; 5],
+    a: [Vec3; 4],
+    j: [Vec3; 3],
+}
+
+impl Moments {
+    const ZERO: Moments = Moments {
+        p: [Vec3::new(0.0, 0.0, 0.0); 6],
+        v: [Vec3::new(0.0, 0.0, 0.0); 5],
+        a: [Vec3::new(0.0, 0.0, 0.0); 4],
+        j: [Vec3::new(0.0, 0.0, 0.0); 3],
+    };
+
+    #[inline(always)]
+    fn add(&mut self, g: &SampleGrad, w: f64, u: &[f64; 6], has_jerk: bool) {
+        let (gp, gv, ga) = (g.p * w, g.v * w, g.a * w);
+        for (m, ue) in self.p.iter_mut().zip(u) {
+            *m += gp * *ue;
+        }
+        for (m, ue) in self.v.iter_mut().zip(u) {
+            *m += gv * *ue;
+        }
+        for (m, ue) in self.a.iter_mut().zip(u) {
+            *m += ga * *ue;
+        }
+        if has_jerk {
+            let gj = g.j * w;
+            for (m, ue) in self.j.iter_mut().zip(u) {
+                *m += gj * *ue;
+            }
+        }
+    }
+
+    /// `grad_c[m] += Σ_d m!/(m−d)! T^{m−d} M_{d,m−d}` for the six coefficients of the piece.
+    #[inline(always)]
+    fn add_to(&self, grad_c: &mut [Vec3], duration: f64) {
+        let t = duration;
+        let tp = [1.0, t, t * t, t * t * t, t * t * t * t, t * t * t * t * t];
+        let (p, v, a, j) = (&self.p, &self.v, &self.a, &self.j);
+        grad_c[0] += p[0];
+        grad_c[1] += p[1] * tp[1] + v[0];
+        grad_c[2] += p[2] * tp[2] + v[1] * (2.0 * tp[1]) + a[0] * 2.0;
+        grad_c[3] += p[3] * tp[3] + v[2] * (3.0 * tp[2]) + a[1] * (6.0 * tp[1]) + j[0] * 6.0;
+        grad_c[4] +=
+            p[4] * tp[4] + v[3] * (4.0 * tp[3]) + a[2] * (12.0 * tp[2]) + j[1] * (24.0 * tp[1]);
+        grad_c[5] +=
+            p[5] * tp[5] + v[4] * (5.0 * tp[4]) + a[3] * (20.0 * tp[3]) + j[2] * (60.0 * tp[2]);
     }
 }
 
@@ -299,6 +460,73 @@ fn check_len(field: &'static str, expected: usize, got: usize) -> Result<(), Min
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+    use proptest::prelude::*;
+
+    /// A smooth integrand that uses every input, including jerk and absolute time:
+    /// `L = ½‖p − a₀‖² + v·a + ‖j‖² sin(t) + 0.3 t p_x`.
+    struct Everything;
+    impl Integrand for Everything {
+        fn sample(&mut self, s: &SampleState, g: &mut SampleGrad) -> f64 {
+            let a0 = Vec3::new(0.5, -0.2, 0.1);
+            g.p += s.p - a0 + Vec3::x() * (0.3 * s.t);
+            g.v += s.a;
+            g.a += s.v;
+            g.j += s.j * (2.0 * s.t.sin());
+            g.t += s.j.norm_squared() * s.t.cos() + 0.3 * s.p.x;
+            0.5 * (s.p - a0).norm_squared()
+                + s.v.dot(&s.a)
+                + s.j.norm_squared() * s.t.sin()
+                + 0.3 * s.t * s.p.x
+        }
+    }
+
+    fn integral(coeffs: &[Vec3], durations: &[f64], t_start: f64) -> (f64, Vec<Vec3>, Vec<f64>) {
+        let view = PiecewiseView {
+            t_start,
+            coeffs,
+            durations,
+        };
+        let mut gc = vec![Vec3::zeros(); coeffs.len()];
+        let mut gt = vec![0.0; durations.len()];
+        let v = TrapezoidIntegrator::new(5)
+            .integrate(&view, &mut Everything, &mut gc, &mut gt)
+            .unwrap();
+        (v, gc, gt)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+
+        /// eqs. dI-a/b/c against central differences, with every derivative order and the
+        /// explicit time dependence in play (the moments and the snap term of `∂I/∂T`).
+        #[test]
+        fn coefficient_and_duration_gradients_match_finite_differences(
+            raw in proptest::collection::vec(-1.0..1.0f64, 36),
+            d0 in 0.3..1.2f64, d1 in 0.3..1.2f64,
+        ) {
+            let coeffs: Vec<Vec3> = raw.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
+            let durations = [d0, d1];
+            let (_, gc, gt) = integral(&coeffs, &durations, 0.4);
+            let h = 1e-6;
+            for row in 0..coeffs.len() {
+                for axis in 0..3 {
+                    let (mut hi, mut lo) = (coeffs.clone(), coeffs.clone());
+                    hi[row][axis] += h;
+                    lo[row][axis] -= h;
+                    let fd = (integral(&hi, &durations, 0.4).0 - integral(&lo, &durations, 0.4).0) / (2.0 * h);
+                    prop_assert!((fd - gc[row][axis]).abs() <= 1e-6 * (1.0 + fd.abs()),
+                        "c[{row}][{axis}]: fd {fd} vs {}", gc[row][axis]);
+                }
+            }
+            for i in 0..2 {
+                let (mut hi, mut lo) = (durations, durations);
+                hi[i] += h;
+                lo[i] -= h;
+                let fd = (integral(&coeffs, &hi, 0.4).0 - integral(&coeffs, &lo, 0.4).0) / (2.0 * h);
+                prop_assert!((fd - gt[i]).abs() <= 1e-5 * (1.0 + fd.abs()), "T[{i}]: fd {fd} vs {}", gt[i]);
+            }
+        }
+    }
 
     /// `L = ‖p‖²` (no time dependence).
     struct SquaredNorm;

@@ -19,14 +19,52 @@
 /// ```
 #[inline]
 pub fn smoothed_l1(x: f64, mu: f64) -> (f64, f64) {
-    if x <= 0.0 {
-        (0.0, 0.0)
-    } else if x < mu {
-        let r = x / mu;
-        let r2 = r * r;
-        (mu * r2 * (r - 0.5 * r2), r2 * (3.0 - 2.0 * r))
-    } else {
-        (x - 0.5 * mu, 1.0)
+    SmoothedL1::new(mu).eval(x)
+}
+
+/// [`smoothed_l1`] with its width fixed and `1/μ` precomputed, for inner loops (a division costs
+/// as much as the rest of the function).
+///
+/// ```
+/// use trust_minco::costs::{SmoothedL1, smoothed_l1};
+/// let f = SmoothedL1::new(0.01);
+/// assert_eq!(f.eval(0.004), smoothed_l1(0.004, 0.01));
+/// assert_eq!(f.mu(), 0.01);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SmoothedL1 {
+    mu: f64,
+    inv_mu: f64,
+}
+
+impl SmoothedL1 {
+    /// The smoothed max of width `mu` (> 0 for a smooth function; the caller validates).
+    #[inline]
+    pub fn new(mu: f64) -> Self {
+        Self {
+            mu,
+            inv_mu: 1.0 / mu,
+        }
+    }
+
+    /// The width `μ`.
+    #[inline]
+    pub fn mu(&self) -> f64 {
+        self.mu
+    }
+
+    /// `(f_max(x), f_max'(x))`, see [`smoothed_l1`].
+    #[inline]
+    pub fn eval(&self, x: f64) -> (f64, f64) {
+        if x <= 0.0 {
+            (0.0, 0.0)
+        } else if x < self.mu {
+            let r = x * self.inv_mu;
+            let r2 = r * r;
+            (self.mu * r2 * (r - 0.5 * r2), r2 * (3.0 - 2.0 * r))
+        } else {
+            (x - 0.5 * self.mu, 1.0)
+        }
     }
 }
 

@@ -1,9 +1,10 @@
 //! The static-map obstacle penalty (part of `I_o`).
 
 use trust_core::{Aabb, StaticMap, Vec3};
+use trust_geometry::Shape;
 
 use super::integrate::{Integrand, SampleGrad, SampleState};
-use super::smooth::smoothed_l1;
+use super::smooth::SmoothedL1;
 
 /// Static-map penalty `L_s = Σ_shapes f_max(c − d_shape(p)) + f_max(c − d_esdf(p))`: the smoothed
 /// violation of the clearance `c` by each analytic shape of the [`StaticMap`] and by its voxel
@@ -18,7 +19,7 @@ use super::smooth::smoothed_l1;
 pub struct StaticObstacleTerm<'a> {
     map: &'a StaticMap,
     clearance: f64,
-    smoothing: f64,
+    smoothing: SmoothedL1,
     near: Vec<usize>,
     use_esdf: bool,
 }
@@ -29,7 +30,7 @@ impl<'a> StaticObstacleTerm<'a> {
         Self {
             map,
             clearance,
-            smoothing,
+            smoothing: SmoothedL1::new(smoothing),
             near: Vec::new(),
             use_esdf: false,
         }
@@ -55,6 +56,7 @@ impl<'a> StaticObstacleTerm<'a> {
     }
 
     /// Unweighted `L_s` at one node; adds `weight · ∂L_s/∂p` into `grad`.
+    #[inline]
     pub(crate) fn sample_weighted(
         &self,
         s: &SampleState,
@@ -64,14 +66,16 @@ impl<'a> StaticObstacleTerm<'a> {
         let shapes = self.map.shapes();
         let mut total = 0.0;
         let mut add = |(d, g): (f64, Vec3)| {
-            let (value, slope) = smoothed_l1(self.clearance - d, self.smoothing);
+            let (value, slope) = self.smoothing.eval(self.clearance - d);
             if slope != 0.0 || value != 0.0 {
                 total += value;
                 grad.p -= g * (weight * slope);
             }
         };
         for &i in &self.near {
-            add(shapes[i].distance_and_gradient(&s.p));
+            if !beyond_clearance(&shapes[i], &s.p, self.clearance) {
+                add(shapes[i].distance_and_gradient(&s.p));
+            }
         }
         if self.use_esdf
             && let Some(esdf) = self.map.esdf()
@@ -79,6 +83,27 @@ impl<'a> StaticObstacleTerm<'a> {
             add(esdf.distance_and_gradient(&s.p));
         }
         total
+    }
+}
+
+/// Cheap exact rejection before the signed distance: `true` only if `p` is at least `clearance`
+/// away from `shape` (no penalty there). Squared distances for spheres and cylinder walls, the
+/// inflated box for boxes and cylinder caps (a superset of the points within `clearance`).
+#[inline]
+fn beyond_clearance(shape: &Shape, p: &Vec3, clearance: f64) -> bool {
+    match shape {
+        Shape::Sphere(s) => {
+            let r = s.radius + clearance;
+            (p - s.center).norm_squared() >= r * r
+        }
+        Shape::Cylinder(c) => {
+            let q = p - c.center;
+            let r = c.radius + clearance;
+            q.x * q.x + q.y * q.y >= r * r || q.z.abs() >= c.half_height + clearance
+        }
+        Shape::AaBox(b) => {
+            (0..3).any(|k| p[k] <= b.min[k] - clearance || p[k] >= b.max[k] + clearance)
+        }
     }
 }
 
@@ -93,6 +118,7 @@ impl Integrand for StaticObstacleTerm<'_> {
         self.begin_piece_impl(samples_box)
     }
 
+    #[inline]
     fn sample(&mut self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
         self.sample_weighted(s, grad, 1.0)
     }
@@ -149,6 +175,42 @@ mod tests {
                 - term.sample(&state(lo), &mut SampleGrad::default()))
                 / (2.0 * h);
             assert_relative_eq!(g.p[d], fd, epsilon = 1e-6, max_relative = 1e-6);
+        }
+    }
+
+    /// The cheap rejection never skips a point closer than the clearance.
+    #[test]
+    fn rejection_is_exact() {
+        use trust_geometry::{AaBox, Cylinder, Sphere};
+        let shapes = [
+            Shape::Sphere(Sphere {
+                center: Vec3::new(1.0, 1.0, 1.0),
+                radius: 0.7,
+            }),
+            Shape::Cylinder(Cylinder {
+                center: Vec3::new(1.0, 1.0, 1.0),
+                radius: 0.6,
+                half_height: 0.9,
+            }),
+            Shape::AaBox(AaBox {
+                min: Vec3::new(0.5, 0.4, 0.3),
+                max: Vec3::new(1.5, 1.2, 1.9),
+            }),
+        ];
+        for shape in &shapes {
+            for i in 0..=40 {
+                for j in 0..=40 {
+                    let p = Vec3::new(0.05 * i as f64, 1.0 + 0.013 * j as f64, 0.05 * j as f64);
+                    for clearance in [0.0, 0.1, 0.3] {
+                        if beyond_clearance(shape, &p, clearance) {
+                            assert!(
+                                shape.distance_and_gradient(&p).0 >= clearance - 1e-12,
+                                "{shape:?} {p:?} {clearance}"
+                            );
+                        }
+                    }
+                }
+            }
         }
     }
 
