@@ -1,6 +1,7 @@
-//! Criterion benches: one DEV-PRM search and one V-PRM search on an E1 scene (K = 10), one TVD check
-//! between two trajectories among the same obstacles, and the roadmap's cone segment test against
-//! `trust_predict::Pdc`'s.
+//! Criterion benches: one DEV-PRM search and one V-PRM search on an E1 scene (K = 10), the UVD test
+//! the roadmap runs for every connector candidate (two connectors of the same guards, on the same and
+//! on opposite sides of a moving obstacle's PDC), one TVD check between two trajectories among the E1
+//! obstacles, and the roadmap's cone segment test against `trust_predict::Pdc`'s.
 //!
 //! `cargo bench -p trust-topo-prm` for medians; `cargo bench -p trust-topo-prm -- --test` runs each
 //! once (CI smoke mode).
@@ -10,8 +11,9 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use rand::SeedableRng;
 
-use trust_core::{PathFrontend, PolyTraj, Rng, Scene, Vec3};
-use trust_topo_prm::{DevPrm, DevPrmParams, Vprm, VprmParams, scenes, tvd};
+use trust_core::{PathFrontend, PolyTraj, Rng, Scene, StaticMap, Vec3};
+use trust_topo_prm::visibility::Obstacles;
+use trust_topo_prm::{DevPrm, DevPrmParams, Vprm, VprmParams, scenes, tvd, uvd};
 
 fn world() -> scenes::RandomScene {
     scenes::random_dynamic_scene(
@@ -52,6 +54,54 @@ fn bench_frontends(c: &mut Criterion) {
                 vprm.search(&w.query, &scene, &mut rng)
                     .expect("valid query"),
             )
+        });
+    });
+}
+
+/// The connector-redundancy test of the roadmap: `[start, via, goal]` against `[start, via', goal]`
+/// around the PDC of a ball crossing the straight line (UVD at 0.1 m, threshold 0).
+fn bench_uvd_connectors(c: &mut Criterion) {
+    let map = StaticMap::new(
+        trust_core::Aabb::new(Vec3::zeros(), Vec3::new(20.0, 20.0, 10.0)).expect("valid box"),
+    )
+    .expect("valid map");
+    let f = trust_core::Forecast::sphere(
+        Vec3::new(10.0, 9.0, 5.0),
+        Vec3::new(0.0, 1.0, 0.0),
+        0.0,
+        1.0,
+        0.0,
+        0.2,
+    )
+    .expect("valid forecast");
+    let obstacles = Obstacles::with_forecast_cones(&map, &[f], 0.0, 2.0);
+    let (s, g) = (Vec3::new(1.0, 10.0, 5.0), Vec3::new(19.0, 10.0, 5.0));
+    let above = [s, Vec3::new(9.0, 13.5, 5.0), g];
+    let above2 = [s, Vec3::new(11.0, 14.5, 5.3), g];
+    let below = [s, Vec3::new(10.0, 6.5, 5.0), g];
+    let mut scratch = uvd::UvdScratch::default();
+    c.bench_function("uvd_connectors_same_side", |b| {
+        b.iter(|| {
+            black_box(uvd::polylines_equivalent_among(
+                &obstacles,
+                &above,
+                &above2,
+                0.1,
+                0.0,
+                &mut scratch,
+            ))
+        });
+    });
+    c.bench_function("uvd_connectors_opposite_sides", |b| {
+        b.iter(|| {
+            black_box(uvd::polylines_equivalent_among(
+                &obstacles,
+                &above,
+                &below,
+                0.1,
+                0.0,
+                &mut scratch,
+            ))
         });
     });
 }
@@ -118,5 +168,11 @@ fn bench_cone_tests(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, bench_frontends, bench_tvd, bench_cone_tests);
+criterion_group!(
+    benches,
+    bench_frontends,
+    bench_uvd_connectors,
+    bench_tvd,
+    bench_cone_tests
+);
 criterion_main!(benches);

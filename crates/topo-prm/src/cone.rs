@@ -153,7 +153,7 @@ impl Cone {
                 let gxy = Vec3::new(gxy.x, gxy.y, 0.0);
                 if dxy > 0.0 || dz > 0.0 {
                     let (ex, ez) = (dxy.max(0.0), dz.max(0.0));
-                    let d = ex.hypot(ez);
+                    let d = (ex * ex + ez * ez).sqrt();
                     (d, (gxy * ex + gz * ez) / d)
                 } else if dxy >= dz {
                     (dxy, gxy)
@@ -166,7 +166,12 @@ impl Cone {
 
     /// True if `p` is closer than `clearance` to the cone (or inside it).
     pub fn contains(&self, p: &Vec3, clearance: f64) -> bool {
-        self.signed_distance(p) < clearance
+        // Outside the box grown by the clearance: farther than that from the cone.
+        let far = clearance >= 0.0
+            && (0..3).any(|i| {
+                p[i] < self.aabb.min[i] - clearance || p[i] > self.aabb.max[i] + clearance
+            });
+        !far && self.signed_distance(p) < clearance
     }
 
     /// True if every point of the segment `[p, q]` keeps at least `clearance` from the cone. Cheap
@@ -221,9 +226,11 @@ impl Cone {
     ///   of the slab inside `region`, and above and below the cylinder.
     /// * A cone that does not move has one slice: a horizontal ring (at the region's mid-height for a
     ///   cylinder).
+    /// * A moving cone also gets one point beyond each cap, on the axis of the sweep (at the region's
+    ///   mid-height for a cylinder): the ways around its front and back.
     ///
     /// Candidates are spread evenly over each slice's boundary and those outside `region` are dropped,
-    /// so that the samples land where the planner samples.
+    /// so that the samples land where the planner samples. At most `slices · per_slice + 2` points.
     pub fn surface_samples(
         &self,
         slices: usize,
@@ -244,7 +251,20 @@ impl Cone {
         // distance of its guess (the hull's cross-section radius exceeds the slice radius by at most
         // the radius change over the sweep, scaled by the cone's slope).
         let slack = 2.0 * (self.ra - self.rb).abs() + offset.abs() + 0.5;
-        let mut candidates: Vec<(Vec3, Vec3)> = Vec::new();
+        // Cosine of the lateral surface's slope: a ray perpendicular to the axis from the slice
+        // centre (radius r) meets the offset surface at (r + offset) / cos α when it leaves through
+        // the lateral surface — the Newton start, exact in that case.
+        let axis_len = match self.kind {
+            ConeKind::Sphere => sweep.norm(),
+            ConeKind::Cylinder => sweep.x.hypot(sweep.y),
+        };
+        let sin_a = if axis_len > (self.ra - self.rb).abs() {
+            (self.ra - self.rb) / axis_len
+        } else {
+            0.0
+        };
+        let cos_a = (1.0 - sin_a * sin_a).sqrt().max(0.05);
+        let mut candidates: Vec<(Vec3, Vec3, f64)> = Vec::new();
         let mut kept = Vec::new();
         for k in 0..slice_count {
             let s = if slice_count == 1 {
@@ -255,12 +275,13 @@ impl Cone {
             let center = self.a + sweep * s;
             let r_k = self.ra + (self.rb - self.ra) * s;
             let stagger = 0.5 * (k % 2) as f64;
+            let lateral = (r_k + offset) / cos_a;
             candidates.clear();
-            let ring = |axis: &Vec3, origin: Vec3, n: usize, out: &mut Vec<(Vec3, Vec3)>| {
+            let ring = |axis: &Vec3, origin: Vec3, n: usize, out: &mut Vec<(Vec3, Vec3, f64)>| {
                 let [_, w1, w2] = crate::sampling::frame(&Vec3::zeros(), axis);
                 for j in 0..n {
                     let theta = std::f64::consts::TAU * (j as f64 + stagger) / n as f64;
-                    out.push((origin, w1 * theta.cos() + w2 * theta.sin()));
+                    out.push((origin, w1 * theta.cos() + w2 * theta.sin(), lateral));
                 }
             };
             match (self.kind, moving) {
@@ -283,8 +304,8 @@ impl Cone {
                             for j in 0..heights {
                                 let z = z_lo + (j as f64 + 0.5) / heights as f64 * (z_hi - z_lo);
                                 let origin = Vec3::new(center.x, center.y, z);
-                                candidates.push((origin, side));
-                                candidates.push((origin, -side));
+                                candidates.push((origin, side, lateral));
+                                candidates.push((origin, -side, lateral));
                             }
                         }
                     } else {
@@ -296,17 +317,17 @@ impl Cone {
                         );
                     }
                     let top = Vec3::new(center.x, center.y, z_mid);
-                    candidates.push((top, Vec3::z()));
-                    candidates.push((top, -Vec3::z()));
+                    candidates.push((top, Vec3::z(), self.slab.1 - z_mid + offset));
+                    candidates.push((top, -Vec3::z(), z_mid - self.slab.0 + offset));
                 }
             }
             kept.clear();
-            for (origin, dir) in &candidates {
+            for (origin, dir, y0) in &candidates {
                 let guess = origin + dir * (r_k + offset);
                 if region.distance_to_point(&guess) > slack {
                     continue;
                 }
-                let p = self.point_at_distance(origin, dir, offset, reach);
+                let p = self.point_at_distance(origin, dir, offset, *y0, reach);
                 if region.contains(&p) {
                     kept.push(p);
                 }
@@ -316,14 +337,50 @@ impl Cone {
             } else {
                 out.extend((0..per_slice).map(|i| kept[i * kept.len() / per_slice]));
             }
+            // The end slices also get the point on the axis beyond the cap: the way around the front
+            // or the back of the swept volume.
+            if moving && (k == 0 || k + 1 == slice_count) {
+                let axial = match self.kind {
+                    ConeKind::Sphere => Some(sweep / sweep.norm()),
+                    ConeKind::Cylinder => {
+                        let flat = Vec3::new(sweep.x, sweep.y, 0.0);
+                        let n = flat.norm();
+                        (n > 1e-9).then(|| flat / n)
+                    }
+                };
+                if let Some(axial) = axial {
+                    let dir = if k == 0 { -axial } else { axial };
+                    let origin = match self.kind {
+                        ConeKind::Sphere => center,
+                        ConeKind::Cylinder => Vec3::new(
+                            center.x,
+                            center.y,
+                            (0.5 * (region.min.z + region.max.z)).clamp(self.slab.0, self.slab.1),
+                        ),
+                    };
+                    let r_end = if k == 0 { self.ra } else { self.rb };
+                    let p = self.point_at_distance(&origin, &dir, offset, r_end + offset, reach);
+                    if region.contains(&p) {
+                        out.push(p);
+                    }
+                }
+            }
         }
     }
 
     /// The point on the ray `origin + y·dir` (from a point inside the cone) whose signed distance is
-    /// `offset`: Newton steps on `d(y) − offset` with the analytic gradient, falling back to bisection
-    /// on `y ∈ [0, reach]` (the distance grows along the ray) if they do not converge.
-    fn point_at_distance(&self, origin: &Vec3, dir: &Vec3, offset: f64, reach: f64) -> Vec3 {
-        let mut y = (self.ra.min(self.rb) + offset).clamp(0.0, reach);
+    /// `offset`: Newton steps on `d(y) − offset` with the analytic gradient from `y = y0`, falling
+    /// back to bisection on `y ∈ [0, reach]` (the distance grows along the ray) if they do not
+    /// converge.
+    fn point_at_distance(
+        &self,
+        origin: &Vec3,
+        dir: &Vec3,
+        offset: f64,
+        y0: f64,
+        reach: f64,
+    ) -> Vec3 {
+        let mut y = if y0.is_finite() { y0 } else { offset }.clamp(0.0, reach);
         for _ in 0..8 {
             let (d, g) = self.distance_and_gradient(&(origin + dir * y));
             let err = offset - d;
@@ -346,6 +403,39 @@ impl Cone {
             }
         }
         origin + dir * hi
+    }
+}
+
+impl crate::gjk::SupportMap for Cone {
+    fn support(&self, d: &Vec3) -> Vec3 {
+        match self.kind {
+            ConeKind::Sphere => {
+                let n = d.norm();
+                if n.is_nan() || n <= 0.0 {
+                    return self.a;
+                }
+                let u = d / n;
+                let (pa, pb) = (self.a + u * self.ra, self.b + u * self.rb);
+                if pa.dot(d) >= pb.dot(d) { pa } else { pb }
+            }
+            ConeKind::Cylinder => {
+                let n = (d.x * d.x + d.y * d.y).sqrt();
+                let (x, y) = if n > 0.0 {
+                    let (ux, uy) = (d.x / n, d.y / n);
+                    let (ax, ay) = (self.a.x + ux * self.ra, self.a.y + uy * self.ra);
+                    let (bx, by) = (self.b.x + ux * self.rb, self.b.y + uy * self.rb);
+                    if ax * d.x + ay * d.y >= bx * d.x + by * d.y {
+                        (ax, ay)
+                    } else {
+                        (bx, by)
+                    }
+                } else {
+                    (self.a.x, self.a.y)
+                };
+                let z = if d.z >= 0.0 { self.slab.1 } else { self.slab.0 };
+                Vec3::new(x, y, z)
+            }
+        }
     }
 }
 
@@ -403,9 +493,9 @@ fn any_perpendicular(u: &Vec3) -> Vec3 {
     (pick - u * u.dot(&pick)).normalize()
 }
 
-/// Distance between the segments `[p0, p1]` and `[q0, q1]` (closest points by clamped projection;
-/// degenerate segments allowed).
-pub fn segment_segment_distance(p0: &Vec3, p1: &Vec3, q0: &Vec3, q1: &Vec3) -> f64 {
+/// Parameters `(s, t) ∈ [0, 1]²` of the closest points `p0 + s·(p1 − p0)` and `q0 + t·(q1 − q0)` of
+/// the segments `[p0, p1]` and `[q0, q1]` (clamped projection; degenerate segments allowed).
+pub fn segment_segment_params(p0: &Vec3, p1: &Vec3, q0: &Vec3, q1: &Vec3) -> (f64, f64) {
     let d1 = p1 - p0;
     let d2 = q1 - q0;
     let r = p0 - q0;
@@ -413,7 +503,7 @@ pub fn segment_segment_distance(p0: &Vec3, p1: &Vec3, q0: &Vec3, q1: &Vec3) -> f
     let e = d2.dot(&d2);
     let f = d2.dot(&r);
     let tiny = 1e-18;
-    let (s, t) = if a <= tiny && e <= tiny {
+    if a <= tiny && e <= tiny {
         (0.0, 0.0)
     } else if a <= tiny {
         (0.0, (f / e).clamp(0.0, 1.0))
@@ -439,8 +529,14 @@ pub fn segment_segment_distance(p0: &Vec3, p1: &Vec3, q0: &Vec3, q1: &Vec3) -> f
             }
             (s, t)
         }
-    };
-    ((p0 + d1 * s) - (q0 + d2 * t)).norm()
+    }
+}
+
+/// Distance between the segments `[p0, p1]` and `[q0, q1]` (closest points by clamped projection;
+/// degenerate segments allowed).
+pub fn segment_segment_distance(p0: &Vec3, p1: &Vec3, q0: &Vec3, q1: &Vec3) -> f64 {
+    let (s, t) = segment_segment_params(p0, p1, q0, q1);
+    ((p0 + (p1 - p0) * s) - (q0 + (q1 - q0) * t)).norm()
 }
 
 /// Whether a convex function `f` (value and gradient) stays at or above `c` along the segment
@@ -567,6 +663,29 @@ mod tests {
         }
 
         #[test]
+        fn support_points_are_extreme_points_of_the_cone(
+            a in v3(), b in v3(), ra in 0.1..1.5f64, rb in 0.1..1.5f64, d in v3(), cyl in any::<bool>(),
+            probes in prop::collection::vec(v3(), 20)
+        ) {
+            use crate::gjk::SupportMap;
+            let cone = if cyl {
+                Cone::cylinder(a, b, ra, rb, 1.0, 1.3)
+            } else {
+                Cone::sphere(a, b, ra, rb)
+            };
+            let s = cone.support(&d);
+            // On the surface (the cylinder's support is a rim point: distance 0 up to rounding).
+            prop_assert!(cone.signed_distance(&s).abs() < 1e-6, "{}", cone.signed_distance(&s));
+            // No point of the cone goes farther along d: project probes onto the cone's closed set
+            // by moving them inward along the gradient until inside.
+            for p in &probes {
+                let (dist, g) = cone.distance_and_gradient(p);
+                let q = if dist > 0.0 { p - g * dist } else { *p };
+                prop_assert!(q.dot(&d) <= s.dot(&d) + 1e-6 * (1.0 + d.norm()));
+            }
+        }
+
+        #[test]
         fn segment_distance_matches_sampling(p0 in v3(), p1 in v3(), q0 in v3(), q1 in v3()) {
             let d = segment_segment_distance(&p0, &p1, &q0, &q1);
             let mut brute = f64::INFINITY;
@@ -614,7 +733,7 @@ mod tests {
                 let mut out = Vec::new();
                 cone.surface_samples(3, 8, 0.4, &region, &mut out);
                 assert!(!out.is_empty());
-                assert!(out.len() <= 24);
+                assert!(out.len() <= 26);
                 assert!(out.iter().all(|p| region.contains(p)));
                 for p in &out {
                     assert!(

@@ -19,6 +19,14 @@
 //! * the time budget `t_max` covers the roadmap construction (obstacle-aware and random samples);
 //!   the search and selection that follow are bounded by counts (`max_expansions`,
 //!   `keep_raw_paths`), as in Fast-Planner;
+//! * besides `t_max` and `N_max`, random sampling stops when the roadmap stalls
+//!   ([`DevPrmParams::stall_samples`]): the coverage rule of the original visibility PRM (Siméon et
+//!   al. 2000), which Fast-Planner replaced by a fixed budget;
+//! * obstacle-aware samples lie on slices of each PDC and, for a moving obstacle, on its axis beyond
+//!   the first and last slice ([`crate::cone::Cone::surface_samples`]); they are inserted first, when
+//!   only the start and the terminal are guards, so one that sees a single guard is kept and retried
+//!   against the guards added later ([`crate::roadmap::RoadmapBuilder::add_persistent_sample`])
+//!   instead of being discarded;
 //! * the sampling box spans the start and the point of the GGS nearest to it, and samples inside the
 //!   GGS ball are rejected.
 
@@ -44,6 +52,14 @@ pub struct DevPrmParams {
     pub budget_ms: f64,
     /// Random-sample budget `N_max`. Fast-Planner's 2000.
     pub max_samples: usize,
+    /// Random sampling stops early after this many consecutive samples in free space that added
+    /// neither a guard nor a connector; `0` switches the stop off (only `budget_ms` and `max_samples`
+    /// bind, as in Fast-Planner). This is the termination rule of the original visibility PRM
+    /// (Siméon, Laumond & Nissoux 2000: stop after `M` consecutive failures to add a guard, `1/M`
+    /// estimating the part of the free space no guard sees), extended to connectors because the
+    /// homotopy classes live in them. Ours: 200 (the guards see an estimated 99.5 % of the sampling
+    /// region, and the last 200 samples brought no new connector, i.e. no candidate class).
+    pub stall_samples: usize,
     /// Width of the beam search (partial paths kept per level). Ours: 16.
     pub beam_width: usize,
     /// The search stops after this many raw paths. Fast-Planner: 300.
@@ -80,6 +96,7 @@ impl Default for DevPrmParams {
             resolution: 0.1,
             budget_ms: 5.0,
             max_samples: 2000,
+            stall_samples: 200,
             beam_width: 16,
             max_raw_paths: 300,
             keep_raw_paths: 25,
@@ -139,6 +156,7 @@ impl DevPrmParams {
             resolution: self.resolution,
             budget,
             max_samples: self.max_samples,
+            stall_samples: self.stall_samples,
             search: GraphSearch::Beam {
                 width: self.beam_width,
             },

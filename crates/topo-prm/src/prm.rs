@@ -1,6 +1,6 @@
 //! The pipeline V-PRM and DEV-PRM share: validate → region and obstacles → roadmap (obstacle-aware
-//! samples, then random samples under a time and sample budget) → graph search → shortcut →
-//! `TopoPathSelect`.
+//! samples, then random samples under a time and sample budget, optionally until the roadmap stalls)
+//! → graph search → shortcut → `TopoPathSelect`.
 
 use std::time::{Duration, Instant};
 
@@ -11,7 +11,7 @@ use trust_core::{
 
 use crate::cone::Cone;
 use crate::ggs::Terminal;
-use crate::roadmap::{RoadmapBuilder, RoadmapParams};
+use crate::roadmap::{RoadmapBuilder, RoadmapParams, SampleOutcome};
 use crate::sampling::SamplingBox;
 use crate::search::{
     SearchLimits, beam_paths, depth_first_paths, keep_fewest_nodes, keep_shortest,
@@ -105,6 +105,7 @@ pub(crate) struct PrmSetup {
     pub resolution: f64,
     pub budget: Duration,
     pub max_samples: usize,
+    pub stall_samples: usize,
     pub search: GraphSearch,
     pub max_raw_paths: usize,
     pub keep_raw_paths: usize,
@@ -140,6 +141,35 @@ fn box_aabb(b: &SamplingBox, extra: &[Vec3]) -> Aabb {
         min: b.center,
         max: b.center,
     })
+}
+
+/// The coverage-based stop of the random sampling phase: consecutive free samples that added neither
+/// a guard nor a connector (rejected samples neither count nor reset it).
+#[derive(Debug, Clone, Copy)]
+struct StallCounter {
+    limit: usize,
+    run: usize,
+}
+
+impl StallCounter {
+    /// A counter that stalls after `limit` useless samples in a row (`0`: never).
+    fn new(limit: usize) -> Self {
+        StallCounter { limit, run: 0 }
+    }
+
+    fn record(&mut self, outcome: SampleOutcome) {
+        match outcome {
+            SampleOutcome::Guard | SampleOutcome::Connector => self.run = 0,
+            SampleOutcome::Rejected => {}
+            SampleOutcome::Redundant | SampleOutcome::Discarded | SampleOutcome::Pending => {
+                self.run += 1;
+            }
+        }
+    }
+
+    fn stalled(&self) -> bool {
+        self.limit > 0 && self.run >= self.limit
+    }
 }
 
 /// Runs the pipeline.
@@ -207,7 +237,8 @@ pub(crate) fn run(
     let mut builder = RoadmapBuilder::new(start, terminal, &obstacles, params, region);
     let mut stats = SearchStats::default();
 
-    // Obstacle-aware samples first (Algorithm 2, ConstructRoadMap(G, P_PDC)).
+    // Obstacle-aware samples first (Algorithm 2, ConstructRoadMap(G, P_PDC)). They are persistent:
+    // one that sees a single guard now is retried against the guards random sampling adds.
     if let Some(s) = setup.surface_sampling {
         let mut samples = Vec::new();
         for cone in obstacles.cones() {
@@ -218,18 +249,19 @@ pub(crate) fn run(
                 stats.budget_exhausted = true;
                 break;
             }
-            builder.add_sample(p);
+            builder.add_persistent_sample(p);
             stats.sample_count += 1;
         }
     }
-    // Random samples until the time or sample budget runs out.
+    // Random samples until the time or sample budget runs out, or until the roadmap stalls.
     let mut random = 0;
-    while random < setup.max_samples {
+    let mut stall = StallCounter::new(setup.stall_samples);
+    while random < setup.max_samples && !stall.stalled() {
         if Instant::now() >= deadline {
             stats.budget_exhausted = true;
             break;
         }
-        builder.add_sample(sampling.sample(rng));
+        stall.record(builder.add_sample(sampling.sample(rng)));
         random += 1;
         stats.sample_count += 1;
     }
@@ -280,4 +312,34 @@ pub(crate) fn run(
         .collect::<Result<Vec<_>, _>>()?;
     stats.elapsed = since.elapsed();
     Ok(SearchResult { paths, stats })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stall_counter_counts_useless_free_samples_in_a_row() {
+        let mut c = StallCounter::new(3);
+        for o in [
+            SampleOutcome::Redundant,
+            SampleOutcome::Rejected,
+            SampleOutcome::Discarded,
+        ] {
+            c.record(o);
+        }
+        assert!(!c.stalled());
+        c.record(SampleOutcome::Connector);
+        for _ in 0..2 {
+            c.record(SampleOutcome::Discarded);
+        }
+        assert!(!c.stalled());
+        c.record(SampleOutcome::Pending);
+        assert!(c.stalled());
+        let mut off = StallCounter::new(0);
+        for _ in 0..10_000 {
+            off.record(SampleOutcome::Redundant);
+        }
+        assert!(!off.stalled());
+    }
 }

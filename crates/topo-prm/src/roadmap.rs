@@ -6,7 +6,10 @@
 //! * exactly two → a candidate connector between them. If an existing connector of the same two
 //!   guards gives a UVD-equivalent path, the sample is redundant (and that connector moves to the
 //!   sample when the path through the sample is shorter); otherwise it becomes a connector;
-//! * one or three → discarded.
+//! * one or three → discarded; except that a sample added with
+//!   [`RoadmapBuilder::add_persistent_sample`] that sees exactly one guard waits for a second one:
+//!   it is tested against every guard added later, and the first it sees makes it a connector
+//!   candidate, as if it had been sampled at that moment.
 //!
 //! The start and the terminal (goal point or goal guidance surface) are guards. [`RoadmapBuilder::finish`]
 //! then removes dead ends (non-terminal nodes with at most one neighbour) until none is left.
@@ -53,6 +56,9 @@ pub enum SampleOutcome {
     Redundant,
     /// Saw one or at least three guards.
     Discarded,
+    /// Saw exactly one guard and was kept to be retried against later guards
+    /// ([`RoadmapBuilder::add_persistent_sample`]).
+    Pending,
 }
 
 /// Thresholds of the roadmap.
@@ -183,6 +189,8 @@ pub struct RoadmapBuilder<'o, 'm> {
     uvd: UvdScratch,
     candidates: Vec<Vec3>,
     visible: Vec<(usize, Option<Vec3>)>,
+    /// Persistent samples that saw exactly one guard: the point and that guard (with its attach point).
+    pending: Vec<(Vec3, (usize, Option<Vec3>))>,
 }
 
 impl<'o, 'm> RoadmapBuilder<'o, 'm> {
@@ -237,6 +245,7 @@ impl<'o, 'm> RoadmapBuilder<'o, 'm> {
             uvd: UvdScratch::default(),
             candidates: Vec::new(),
             visible: Vec::new(),
+            pending: Vec::new(),
         }
     }
 
@@ -285,6 +294,24 @@ impl<'o, 'm> RoadmapBuilder<'o, 'm> {
 
     /// Adds one sample.
     pub fn add_sample(&mut self, p: Vec3) -> SampleOutcome {
+        self.insert(p, false)
+    }
+
+    /// Adds one sample that is not discarded when it sees exactly one guard: it is kept and tested
+    /// against every later guard, and the first later guard it sees makes it a connector candidate of
+    /// the two (exactly as if it had been sampled then). DEV-PRM inserts its obstacle-aware samples
+    /// this way, because they come first, when only the start and the terminal are guards and the
+    /// obstacle they hug hides one of them.
+    pub fn add_persistent_sample(&mut self, p: Vec3) -> SampleOutcome {
+        self.insert(p, true)
+    }
+
+    /// Samples waiting for a second guard ([`RoadmapBuilder::add_persistent_sample`]).
+    pub fn pending_count(&self) -> usize {
+        self.pending.len()
+    }
+
+    fn insert(&mut self, p: Vec3, persistent: bool) -> SampleOutcome {
         if !self.region.contains(&p)
             || self.graph.terminal.is_beyond(&p)
             || !self.obstacles.is_free(&p, self.params.sample_clearance)
@@ -305,11 +332,39 @@ impl<'o, 'm> RoadmapBuilder<'o, 'm> {
             0 => {
                 let n = self.graph.add_node(p, NodeKind::Guard);
                 self.guards.push(n);
+                self.retry_pending(n);
                 SampleOutcome::Guard
+            }
+            1 if persistent => {
+                self.pending.push((p, self.visible[0]));
+                SampleOutcome::Pending
             }
             2 => self.try_connect(p),
             _ => SampleOutcome::Discarded,
         }
+    }
+
+    /// Tests the pending samples against the new guard `g`; those that see it become connector
+    /// candidates of their first guard and `g`.
+    fn retry_pending(&mut self, g: usize) {
+        if self.pending.is_empty() {
+            return;
+        }
+        let pending = std::mem::take(&mut self.pending);
+        let mut still = Vec::with_capacity(pending.len());
+        for (p, first) in pending {
+            match self.sees(&p, g) {
+                Some(attach) => {
+                    self.visible.clear();
+                    self.visible.push(first);
+                    self.visible.push((g, attach));
+                    self.try_connect(p);
+                }
+                None => still.push((p, first)),
+            }
+        }
+        // Connections made above add no guards, so nothing was queued meanwhile.
+        self.pending = still;
     }
 
     fn try_connect(&mut self, p: Vec3) -> SampleOutcome {
@@ -445,6 +500,47 @@ mod tests {
         let g = b.finish();
         assert_eq!(g.alive_count(), 2);
         assert!(g.neighbors(START).is_empty());
+    }
+
+    #[test]
+    fn persistent_samples_wait_for_a_second_guard() {
+        // Left wall with a gap at y ∈ [3, 5], right wall without: the goal is hidden from the left.
+        let slab = |x: f64, y0: f64, y1: f64| {
+            Shape::from(
+                trust_geometry::AaBox::new(
+                    Vec3::new(x - 0.2, y0, -5.0),
+                    Vec3::new(x + 0.2, y1, 5.0),
+                )
+                .unwrap(),
+            )
+        };
+        let map = world(vec![
+            slab(-2.0, -10.0, 3.0),
+            slab(-2.0, 5.0, 10.0),
+            slab(2.0, -10.0, 10.0),
+        ]);
+        let obs = Obstacles::new(&map);
+        let mut b = RoadmapBuilder::new(
+            Vec3::new(-5.0, 0.0, 0.0),
+            Terminal::Point(Vec3::new(5.0, 0.0, 0.0)),
+            &obs,
+            params(),
+            *map.bounds(),
+        );
+        // Sees only the start: an ordinary sample is discarded, a persistent one waits.
+        let p = Vec3::new(-4.0, 4.0, 0.0);
+        assert_eq!(b.add_sample(p), SampleOutcome::Discarded);
+        assert_eq!(b.add_persistent_sample(p), SampleOutcome::Pending);
+        assert_eq!(b.pending_count(), 1);
+        // A guard between the walls that `p` sees through the gap: `p` becomes its connector with
+        // the start.
+        assert_eq!(b.add_sample(Vec3::new(0.0, 4.0, 0.0)), SampleOutcome::Guard);
+        assert_eq!(b.pending_count(), 0);
+        let g = b.graph();
+        assert_eq!(g.node_count(), 4);
+        assert_eq!(g.kind(3), NodeKind::Connector);
+        assert_eq!(g.position(3), p);
+        assert_eq!(g.neighbors(3), &[START, 2]);
     }
 
     #[test]

@@ -8,6 +8,8 @@
 //! length) are compared with two points (their ends).
 //!
 //! * [`equivalent`] — the free function over any [`Curve`] with a visibility closure.
+//! * [`polylines_equivalent_among`] — the roadmap's test for polylines against an obstacle set,
+//!   accelerated by GJK separation of whole chord ranges (same answer as testing every chord).
 //! * [`Uvd`] — the [`HomotopyChecker`], against the static map and, with
 //!   [`UvdParams::pdc_horizon_s`], the predictive directional cones of all forecasts, so that it also
 //!   separates paths around moving obstacles.
@@ -19,6 +21,7 @@ use trust_core::{
 };
 
 use crate::cone::Cone;
+use crate::gjk::{Hull, separated_along};
 use crate::visibility::Obstacles;
 
 /// Upper bound on the resampled point count (guards against a tiny resolution on a huge curve).
@@ -150,6 +153,8 @@ pub struct UvdScratch {
     cum_a: Vec<f64>,
     cum_b: Vec<f64>,
     shapes: Vec<usize>,
+    hull: Vec<Vec3>,
+    splits: Vec<usize>,
     map_relevant: bool,
 }
 
@@ -211,11 +216,15 @@ pub fn equivalent_among(
     matched_chords_clear(obstacles, threshold, scratch)
 }
 
-/// [`equivalent_among`] for polylines given by their vertices, by recursive subdivision of the matched
-/// index range: the chords of a range lie in the box of the two sub-polylines it covers, so a range
-/// whose box meets no obstacle is accepted without generating its points, and only ranges of at most
-/// 16 chords near an obstacle are tested chord by chord. Curves with nothing near them
-/// cost one box test.
+/// [`equivalent_among`] for polylines given by their vertices (same answer), by subdivision of the
+/// matched index range. The chords of a range lie in the convex hull of the two sub-polylines it
+/// covers, so a cone whose box misses that hull's box, or which [`crate::gjk::separated`] proves to be
+/// at least `threshold` away from the hull, blocks none of them and is dropped for the whole range.
+/// The range is first cut at the vertices of both polylines, so that each piece's hull is the
+/// tetrahedron of its four end points (a triangle where the polylines share an end): for two paths of
+/// the same class that hull is usually clear, and the test costs a few GJK steps instead of a
+/// hundred chords. Ranges with cones left are split in halves (middle chord first), down to blocks
+/// of at most 16 chords tested one by one. Curves with nothing near them cost one box test.
 pub fn polylines_equivalent_among(
     obstacles: &Obstacles<'_>,
     a: &[Vec3],
@@ -250,22 +259,54 @@ pub fn polylines_equivalent_among(
         step_b: mb.total / (n - 1) as f64,
         last: n - 1,
     };
-    let mut near = std::mem::take(&mut scratch.near);
-    let clear = range_clear(
-        obstacles,
-        threshold.max(0.0),
-        &walk,
-        0,
-        n - 1,
-        &near,
-        scratch,
-        0,
-    );
+    // Split the matched range at the vertices of both polylines, so that on every piece both sides
+    // are straight and the chords lie in the tetrahedron of the piece's four end points.
+    let mut splits = std::mem::take(&mut scratch.splits);
+    splits.clear();
+    knee_splits(&cum_a, walk.step_a, walk.last, &mut splits);
+    knee_splits(&cum_b, walk.step_b, walk.last, &mut splits);
+    splits.sort_unstable();
+    splits.dedup();
+    let near = std::mem::take(&mut scratch.near);
+    let c = threshold.max(0.0);
+    // The middle chord of the whole range first: paths of different classes usually part there.
+    let (p, q) = walk.pair(walk.last / 2);
+    let mut clear = pair_clear(obstacles, &near, scratch.map_relevant, c, &p, &q);
+    let mut from = 0;
+    for &to in splits.iter().chain(std::iter::once(&walk.last)) {
+        if !clear {
+            break;
+        }
+        if to < from {
+            continue;
+        }
+        if !range_clear(obstacles, c, &walk, from, to, &near, scratch, 0) {
+            clear = false;
+            break;
+        }
+        from = to + 1;
+    }
+    scratch.splits = splits;
+    let mut near = near;
     near.clear();
     scratch.near = near;
     scratch.cum_a = cum_a;
     scratch.cum_b = cum_b;
     clear
+}
+
+/// Appends the matched indices `k` after which an interior vertex of a polyline lies (its arc length
+/// is in `[k·step, (k+1)·step)`), for a polyline with cumulative vertex distances `cum`.
+fn knee_splits(cum: &[f64], step: f64, last: usize, out: &mut Vec<usize>) {
+    if !(step.is_finite() && step > 0.0) || cum.len() < 3 {
+        return;
+    }
+    for &c in &cum[1..cum.len() - 1] {
+        let k = (c / step).floor();
+        if k.is_finite() && k >= 0.0 {
+            out.push((k as usize).min(last.saturating_sub(1)));
+        }
+    }
 }
 
 /// Length of a polyline with its cumulative vertex distances written to a buffer.
@@ -339,30 +380,32 @@ impl MatchedWalk<'_> {
         )
     }
 
-    /// Box of the sub-polyline of `points` between matched indices `k0 <= k1`.
-    fn sub_box(points: &[Vec3], cum: &[f64], step: f64, k0: usize, k1: usize, last: usize) -> Aabb {
-        let p0 = Self::point(points, cum, step, k0, last);
-        let p1 = Self::point(points, cum, step, k1, last);
-        let mut bx = Aabb::from_segment(&p0, &p1);
+    /// Appends to `out` the points of the sub-polyline of `points` between matched indices
+    /// `k0 <= k1`: both ends and the vertices in between.
+    fn sub_points(
+        points: &[Vec3],
+        cum: &[f64],
+        step: f64,
+        (k0, k1): (usize, usize),
+        last: usize,
+        out: &mut Vec<Vec3>,
+    ) {
+        out.push(Self::point(points, cum, step, k0, last));
         let (t0, t1) = (k0 as f64 * step, k1 as f64 * step);
         for (p, &c) in points.iter().zip(cum) {
             if c > t0 && c < t1 {
-                bx.min = bx.min.inf(p);
-                bx.max = bx.max.sup(p);
+                out.push(*p);
             }
         }
-        bx
+        out.push(Self::point(points, cum, step, k1, last));
     }
 
-    fn range_box(&self, k0: usize, k1: usize) -> Aabb {
-        Self::sub_box(self.a, self.cum_a, self.step_a, k0, k1, self.last).union(&Self::sub_box(
-            self.b,
-            self.cum_b,
-            self.step_b,
-            k0,
-            k1,
-            self.last,
-        ))
+    /// The points whose convex hull contains every chord `k0..=k1` (written to `out`, cleared
+    /// first): the two sub-polylines.
+    fn range_points(&self, k0: usize, k1: usize, out: &mut Vec<Vec3>) {
+        out.clear();
+        Self::sub_points(self.a, self.cum_a, self.step_a, (k0, k1), self.last, out);
+        Self::sub_points(self.b, self.cum_b, self.step_b, (k0, k1), self.last, out);
     }
 }
 
@@ -406,8 +449,33 @@ impl<'a> SegmentCursor<'a> {
     }
 }
 
+/// Whether chord `[p, q]` keeps `c` from the cones `cones[i]`, `i ∈ which`, and (if `map_relevant`)
+/// from the static map.
+fn pair_clear(
+    obstacles: &Obstacles<'_>,
+    which: &[usize],
+    map_relevant: bool,
+    c: f64,
+    p: &Vec3,
+    q: &Vec3,
+) -> bool {
+    if p == q {
+        return true;
+    }
+    let cones = obstacles.cones();
+    let seg_box = Aabb::from_segment(p, q);
+    which
+        .iter()
+        .all(|&i| cones[i].segment_clear_in_box(p, q, c, &seg_box))
+        && (!map_relevant || obstacles.map().segment_clear(p, q, c))
+}
+
 /// Whether the matched chords `k0..=k1` are clear of the cones in `parent` (indices into
 /// `obstacles.cones()`) and of the static map.
+///
+/// The middle chord is tested first (paths in different classes are usually separated mid-way, so a
+/// blocked chord is found before anything else is done); then the cones that cannot block any chord
+/// of the range are dropped, and what is left is decided chord by chord (short ranges) or by halves.
 #[allow(clippy::too_many_arguments)]
 fn range_clear(
     obstacles: &Obstacles<'_>,
@@ -419,10 +487,23 @@ fn range_clear(
     scratch: &mut UvdScratch,
     depth: usize,
 ) -> bool {
-    let tight = walk.range_box(k0, k1);
+    let mid = k0 + (k1 - k0) / 2;
+    if k1 - k0 >= CHORD_BLOCK {
+        let (p, q) = walk.pair(mid);
+        if !pair_clear(obstacles, parent, scratch.map_relevant, c, &p, &q) {
+            return false;
+        }
+    }
+    let mut hull = std::mem::take(&mut scratch.hull);
+    walk.range_points(k0, k1, &mut hull);
+    let tight = Aabb::from_points(&hull).unwrap_or(Aabb {
+        min: Vec3::zeros(),
+        max: Vec3::zeros(),
+    });
     let bx = tight.inflated(c);
     // Every chord of the range lies in the ball around the box centre through its corners: a cone at
-    // least `c` outside that ball cannot block any of them.
+    // least `c` outside that ball cannot block any of them. Cones that pass that cheap test are
+    // tested against the convex hull of the two sub-polylines, which contains every chord.
     let center = tight.center();
     let ball = 0.5 * tight.extent().norm();
     let cones = obstacles.cones();
@@ -433,8 +514,16 @@ fn range_clear(
         .unwrap_or_default();
     local.clear();
     local.extend(parent.iter().copied().filter(|&i| {
-        cones[i].aabb().intersects(&bx) && cones[i].signed_distance(&center) < ball + c
+        cones[i].aabb().intersects(&bx)
+            && cones[i].signed_distance(&center) < ball + c
+            && !separated_along(
+                &Hull(&hull),
+                &cones[i],
+                c,
+                &(center - cones[i].aabb().center()),
+            )
     }));
+    scratch.hull = hull;
     let map = obstacles.map();
     let map_relevant = scratch.map_relevant && {
         map.esdf().is_some_and(|e| e.occupied_count() > 0) || {
@@ -442,30 +531,14 @@ fn range_clear(
             !scratch.shapes.is_empty()
         }
     };
-    let pair_clear = |p: &Vec3, q: &Vec3| {
-        if p == q {
-            return true;
-        }
-        let seg_box = Aabb::from_segment(p, q);
-        local
-            .iter()
-            .all(|&i| cones[i].segment_clear_in_box(p, q, c, &seg_box))
-            && (!map_relevant || map.segment_clear(p, q, c))
-    };
-    let chord_clear = |k: usize| {
-        let (p, q) = walk.pair(k);
-        pair_clear(&p, &q)
-    };
     let clear = if local.is_empty() && !map_relevant {
         true
     } else if k1 - k0 < CHORD_BLOCK {
-        walk.all_pairs(k0, k1, pair_clear)
+        walk.all_pairs(k0, k1, |p, q| {
+            pair_clear(obstacles, &local, map_relevant, c, p, q)
+        })
     } else {
-        // The middle chord first: paths in different classes are usually separated mid-way, so a
-        // blocked chord is found before the left half is swept.
-        let mid = k0 + (k1 - k0) / 2;
-        chord_clear(mid)
-            && range_clear(obstacles, c, walk, k0, mid, &local, scratch, depth + 1)
+        range_clear(obstacles, c, walk, k0, mid, &local, scratch, depth + 1)
             && range_clear(obstacles, c, walk, mid + 1, k1, &local, scratch, depth + 1)
     };
     if scratch.levels.len() <= depth {
@@ -793,6 +866,57 @@ mod tests {
             .is_err()
         );
         assert!(Uvd::with_pdc(f64::NAN).is_err());
+    }
+
+    fn v3(lo: f64, hi: f64) -> impl proptest::strategy::Strategy<Value = Vec3> {
+        use proptest::prelude::*;
+        prop::array::uniform3(lo..hi).prop_map(|a| Vec3::new(a[0], a[1], a[2]))
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig {
+            cases: 128,
+            ..proptest::prelude::ProptestConfig::default()
+        })]
+
+        /// The accelerated test (pieces between vertices, hull-versus-cone separation, recursive
+        /// ranges) gives exactly the answer of the definition: every matched chord tested.
+        #[test]
+        fn accelerated_uvd_agrees_with_testing_every_chord(
+            mid_a in proptest::collection::vec(v3(-4.0, 4.0), 1..4),
+            mid_b in proptest::collection::vec(v3(-4.0, 4.0), 1..4),
+            cones in proptest::collection::vec(
+                (v3(-3.0, 3.0), v3(-1.5, 1.5), 0.2..1.2f64, 0.0..0.6f64, proptest::bool::ANY),
+                1..4,
+            ),
+            threshold in proptest::sample::select(vec![0.0, 0.1]),
+        ) {
+            let map = pillar_map();
+            let map = StaticMap::new(*map.bounds()).unwrap();
+            let (start, goal) = (Vec3::new(-6.0, 0.0, 0.0), Vec3::new(6.0, 0.0, 0.0));
+            let a: Vec<Vec3> = std::iter::once(start).chain(mid_a).chain([goal]).collect();
+            let b: Vec<Vec3> = std::iter::once(start).chain(mid_b).chain([goal]).collect();
+            let cones: Vec<Cone> = cones
+                .into_iter()
+                .map(|(c, v, r, grow, cyl)| {
+                    if cyl {
+                        Cone::cylinder(c, c + v, r, r + grow, 1.0, 1.0 + grow)
+                    } else {
+                        Cone::sphere(c, c + v, r, r + grow)
+                    }
+                })
+                .collect();
+            let obs = Obstacles::with_cones(&map, cones);
+            let fast = polylines_equivalent_among(
+                &obs, &a, &b, 0.1, threshold, &mut UvdScratch::default(),
+            );
+            let n = point_count(polyline_length(&a), polyline_length(&b), 0.1);
+            let (mut ra, mut rb) = (Vec::new(), Vec::new());
+            resample_polyline(&a, n, &mut ra);
+            resample_polyline(&b, n, &mut rb);
+            let slow = chords_visible(&ra, &rb, |p, q| obs.segment_clear(p, q, threshold));
+            proptest::prop_assert_eq!(fast, slow);
+        }
     }
 
     #[test]

@@ -116,6 +116,10 @@ impl<'a> Obstacles<'a> {
     pub fn distance_and_gradient(&self, p: &Vec3) -> (f64, Vec3) {
         let mut best = self.map.distance_and_gradient(p);
         for c in &self.cones {
+            // A cone is no closer than its box: skip it when the box is not closer than the best.
+            if c.aabb().distance_to_point(p) >= best.0 {
+                continue;
+            }
             let (d, g) = c.distance_and_gradient(p);
             if d < best.0 {
                 best = (d, g);

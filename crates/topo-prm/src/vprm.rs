@@ -33,7 +33,9 @@ pub struct VprmParams {
     /// Time budget of the roadmap construction (ms, monotonic clock). Fast-Planner: 5 ms
     /// (experiment E1 uses 20 ms).
     pub budget_ms: f64,
-    /// Sample budget of the roadmap construction. Fast-Planner: 2000.
+    /// Sample budget of the roadmap construction. Fast-Planner: 2000. V-PRM samples until this or
+    /// `budget_ms` binds, as Fast-Planner does (no stop when the roadmap stalls, unlike
+    /// [`crate::DevPrmParams::stall_samples`]).
     pub max_samples: usize,
     /// The depth-first search stops after this many raw paths. Fast-Planner: 300.
     pub max_raw_paths: usize,
@@ -154,6 +156,7 @@ impl VprmParams {
             resolution: self.resolution,
             budget: self.budget()?,
             max_samples: self.max_samples,
+            stall_samples: 0,
             search: GraphSearch::DepthFirst,
             max_raw_paths: self.max_raw_paths,
             keep_raw_paths: self.keep_raw_paths,

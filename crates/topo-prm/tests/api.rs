@@ -263,6 +263,49 @@ fn a_tiny_time_budget_stops_the_roadmap() {
 }
 
 #[test]
+fn devprm_stops_sampling_when_the_roadmap_stalls() {
+    // Open space: after the first connector every sample is redundant, so the roadmap stalls after
+    // `stall_samples` samples; with the stop switched off the sample cap binds.
+    let map = box_map(vec![Shape::from(
+        Cylinder::new(Vec3::new(10.0, 10.0, 5.0), 1.0, 5.0).unwrap(),
+    )]);
+    let q = query(Vec3::new(1.0, 10.0, 5.0), Vec3::new(19.0, 10.0, 5.0));
+    let scene = Scene::new(&map, &[], 0.0).unwrap();
+    let planner = |stall_samples: usize| {
+        DevPrm::new(DevPrmParams {
+            budget_ms: 10_000.0,
+            max_samples: 3000,
+            stall_samples,
+            ..DevPrmParams::default()
+        })
+        .unwrap()
+    };
+    let stalled = planner(100)
+        .search(&q, &scene, &mut Rng::seed_from_u64(4))
+        .unwrap();
+    assert!(!stalled.stats.budget_exhausted);
+    assert!(
+        (100..3000).contains(&stalled.stats.sample_count),
+        "{}",
+        stalled.stats.sample_count
+    );
+    assert!(stalled.paths.len() >= 2, "{} paths", stalled.paths.len());
+    let full = planner(0)
+        .search(&q, &scene, &mut Rng::seed_from_u64(4))
+        .unwrap();
+    assert!(full.stats.budget_exhausted);
+    assert_eq!(full.stats.sample_count, 3000);
+    assert!(
+        DevPrmParams {
+            stall_samples: 0,
+            ..DevPrmParams::default()
+        }
+        .validate()
+        .is_ok()
+    );
+}
+
+#[test]
 fn the_goal_guidance_surface_ends_paths_early() {
     let map =
         StaticMap::new(Aabb::new(Vec3::zeros(), Vec3::new(80.0, 20.0, 10.0)).unwrap()).unwrap();
