@@ -16,6 +16,11 @@
 //! - stops on the relative gradient test, on relative cost decrease over `past` iterations, on
 //!   iteration or evaluation budgets, or when a [`Monitor`] cancels.
 //!
+//! For an objective whose gradient is much more expensive than its cost, [`Lbfgs::minimize_split`]
+//! takes a [`SplitObjective`] (cost, then gradient on demand) and runs the very same iterations,
+//! computing the gradient only at trial points the line search may accept and telling the cost a
+//! bound above which it may stop summing (a rejected trial needs no exact cost).
+//!
 //! Failing to converge is a [`Termination`] value in the [`Report`], never an `Err`; on any
 //! failure the best point seen is returned with its own finite cost (LBFGS-Lite returns the last
 //! trial's cost, which can be NaN). `Err(`[`LbfgsError`]`)` means misuse: invalid parameters, a
@@ -61,6 +66,7 @@ pub mod test_functions;
 mod vector;
 
 pub use error::LbfgsError;
+pub use line_search::SplitObjective;
 pub use monitor::{Deadline, FnMonitor, Monitor, Progress, monitor_fn};
 pub use params::LbfgsParams;
 pub use report::{LineSearchFailure, Report, Termination};

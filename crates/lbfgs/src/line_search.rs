@@ -7,24 +7,93 @@ use crate::{LbfgsParams, LineSearchFailure, Termination};
 /// narrower than this fraction of `upper`.
 const BRACKET_RELATIVE_WIDTH: f64 = 1e-16;
 
-/// Wraps the fused cost-and-gradient function: zero-fills the gradient before each call, counts
-/// calls, and enforces the evaluation budget.
-pub(crate) struct Evaluator<F> {
-    f: F,
+/// How the solver gets costs and gradients: either both at once from a fused function
+/// ([`Fused`]) or the gradient on demand after the cost ([`Split`]).
+pub(crate) trait Evaluate {
+    /// The cost at `x`, exact if it is `<= bound`, otherwise any value `> bound` (see
+    /// [`SplitObjective::cost`]). A fused evaluation is always exact and also writes the gradient
+    /// into `g` (zero-filled first); a split one leaves `g` alone.
+    fn cost(&mut self, x: &[f64], g: &mut [f64], bound: f64) -> f64;
+
+    /// Makes `g` hold the gradient at the point of the last [`Evaluate::cost`] call (a no-op for
+    /// a fused evaluation, which wrote it already).
+    fn gradient(&mut self, g: &mut [f64]);
+}
+
+/// A fused `FnMut(&[f64], &mut [f64]) -> f64` cost-and-gradient function.
+pub(crate) struct Fused<F>(pub(crate) F);
+
+impl<F> Evaluate for Fused<F>
+where
+    F: FnMut(&[f64], &mut [f64]) -> f64,
+{
+    #[inline]
+    fn cost(&mut self, x: &[f64], g: &mut [f64], _bound: f64) -> f64 {
+        g.fill(0.0);
+        (self.0)(x, g)
+    }
+
+    #[inline]
+    fn gradient(&mut self, _g: &mut [f64]) {}
+}
+
+/// A [`SplitObjective`]: the gradient is computed only when the solver needs it.
+pub(crate) struct Split<'a, O: ?Sized>(pub(crate) &'a mut O);
+
+impl<O> Evaluate for Split<'_, O>
+where
+    O: SplitObjective + ?Sized,
+{
+    #[inline]
+    fn cost(&mut self, x: &[f64], _g: &mut [f64], bound: f64) -> f64 {
+        self.0.cost(x, bound)
+    }
+
+    #[inline]
+    fn gradient(&mut self, g: &mut [f64]) {
+        g.fill(0.0);
+        self.0.gradient(g);
+    }
+}
+
+/// An objective whose gradient can be computed after its cost, for
+/// [`crate::Lbfgs::minimize_split`]: the line search then asks for the gradient only at trial
+/// points that pass the sufficient-decrease (Armijo) test or improve on the best point seen,
+/// which saves the gradient work of every rejected trial.
+pub trait SplitObjective {
+    /// The cost at `x`. A NaN or infinite cost counts as "too far" (the step shrinks).
+    ///
+    /// `bound` says how much the solver needs: the exact cost if it is `<= bound`; otherwise
+    /// only that it exceeds `bound`, so an objective that is a sum of non-negative terms may stop
+    /// summing and return any value `> bound` (and need not be able to give the gradient there,
+    /// which the solver will not ask for). `bound` is `+∞` where the exact cost is needed (the
+    /// start point); in a line search it is the larger of the sufficient-decrease threshold and
+    /// the best cost seen. Returning the exact cost always is correct.
+    fn cost(&mut self, x: &[f64], bound: f64) -> f64;
+
+    /// Writes the gradient at the point of the **last** [`SplitObjective::cost`] call into `g`,
+    /// which is zero-filled before the call (so terms may be accumulated with `+=`).
+    fn gradient(&mut self, g: &mut [f64]);
+}
+
+/// Wraps an [`Evaluate`]: counts cost evaluations and enforces the evaluation budget.
+pub(crate) struct Evaluator<E> {
+    eval: E,
     count: usize,
     /// Maximum number of calls; 0 means unlimited.
     limit: usize,
 }
 
-impl<F> Evaluator<F>
-where
-    F: FnMut(&[f64], &mut [f64]) -> f64,
-{
-    pub(crate) fn new(f: F, limit: usize) -> Self {
-        Self { f, count: 0, limit }
+impl<E: Evaluate> Evaluator<E> {
+    pub(crate) fn new(eval: E, limit: usize) -> Self {
+        Self {
+            eval,
+            count: 0,
+            limit,
+        }
     }
 
-    /// Number of calls so far.
+    /// Number of cost evaluations so far.
     pub(crate) fn count(&self) -> usize {
         self.count
     }
@@ -34,11 +103,23 @@ where
         self.limit != 0 && self.count >= self.limit
     }
 
-    /// Evaluates the cost at `x`, writing the gradient into `g` (zero-filled first).
+    /// Evaluates the cost and the gradient at `x`, writing the gradient into `g`.
     pub(crate) fn evaluate(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
-        g.fill(0.0);
+        let cost = self.cost(x, g, f64::INFINITY);
+        self.eval.gradient(g);
+        cost
+    }
+
+    /// Evaluates the cost at `x` (exact up to `bound`, see [`SplitObjective::cost`]); call
+    /// [`Evaluator::gradient`] before reading `g`.
+    pub(crate) fn cost(&mut self, x: &[f64], g: &mut [f64], bound: f64) -> f64 {
         self.count += 1;
-        (self.f)(x, g)
+        self.eval.cost(x, g, bound)
+    }
+
+    /// Makes `g` hold the gradient at the point of the last [`Evaluator::cost`] call.
+    pub(crate) fn gradient(&mut self, g: &mut [f64]) {
+        self.eval.gradient(g);
     }
 }
 
@@ -87,18 +168,15 @@ pub(crate) enum SearchOutcome {
 /// trials stay within `[min_step, max_step]` (`max_step` itself may be tried once).
 ///
 /// `start.direction` must be a descent direction (`g₀ᵀd < 0`); `x` and `g` receive the trials.
-pub(crate) fn lewis_overton<F>(
-    evaluator: &mut Evaluator<F>,
+pub(crate) fn lewis_overton<E: Evaluate>(
+    evaluator: &mut Evaluator<E>,
     start: &SearchStart<'_>,
     initial_step: f64,
     params: &LbfgsParams,
     x: &mut [f64],
     g: &mut [f64],
     best: &mut BestPoint,
-) -> SearchOutcome
-where
-    F: FnMut(&[f64], &mut [f64]) -> f64,
-{
+) -> SearchOutcome {
     let slope0 = dot(start.gradient, start.direction);
     debug_assert!(slope0 < 0.0, "line search needs a descent direction");
     let armijo_slope = params.f_dec_coeff * slope0;
@@ -118,17 +196,27 @@ where
             break Termination::MaxEvaluations;
         }
         step_from(start.x, step, start.direction, x);
-        let cost = evaluator.evaluate(x, g);
+        // The exact cost and the gradient matter only if the trial may be accepted or become the
+        // best point; a split evaluation may stop early above this bound and computes the
+        // gradient only when needed (the decisions are the same either way).
+        let armijo_bound = start.cost + step * armijo_slope;
+        let cost = evaluator.cost(x, g, armijo_bound.max(best_cost));
         trials += 1;
 
-        let finite = cost.is_finite() && all_finite(g);
+        let armijo = cost <= armijo_bound;
+        let finite = if cost.is_finite() && (armijo || cost < best_cost) {
+            evaluator.gradient(g);
+            all_finite(g)
+        } else {
+            false
+        };
         if finite && cost < best_cost {
             best_cost = cost;
             best_is_trial = true;
             best.x.copy_from_slice(x);
             best.gradient.copy_from_slice(g);
         }
-        if !finite || cost > start.cost + step * armijo_slope {
+        if !finite || !armijo {
             upper = step;
             bracketed = true;
         } else if dot(g, start.direction) < curvature_slope {
@@ -183,7 +271,7 @@ mod tests {
         params: &LbfgsParams,
         initial_step: f64,
     ) -> (SearchOutcome, f64, usize) {
-        let mut evaluator = Evaluator::new(f, params.max_evaluations);
+        let mut evaluator = Evaluator::new(Fused(f), params.max_evaluations);
         let mut g0 = [0.0];
         let f0 = evaluator.evaluate(&[0.0], &mut g0);
         let start = SearchStart {
@@ -333,10 +421,10 @@ mod tests {
     #[test]
     fn gradient_is_zero_filled_before_each_call() {
         let mut evaluator = Evaluator::new(
-            |x: &[f64], g: &mut [f64]| {
+            Fused(|x: &[f64], g: &mut [f64]| {
                 g[0] += 2.0 * x[0];
                 x[0] * x[0]
-            },
+            }),
             0,
         );
         let mut g = [123.0];

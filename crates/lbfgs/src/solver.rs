@@ -1,7 +1,10 @@
 //! The L-BFGS driver: start checks, search directions, line searches, stopping tests.
 
 use crate::error::first_non_finite;
-use crate::line_search::{BestPoint, Evaluator, SearchOutcome, SearchStart, lewis_overton};
+use crate::line_search::{
+    BestPoint, Evaluate, Evaluator, Fused, SearchOutcome, SearchStart, Split, SplitObjective,
+    lewis_overton,
+};
 use crate::memory::CorrectionMemory;
 use crate::vector::{all_finite, dot, inf_norm, negate_into, norm2};
 use crate::{LbfgsError, LbfgsParams, LineSearchFailure, Monitor, Progress, Report, Termination};
@@ -85,8 +88,40 @@ impl Lbfgs {
     where
         F: FnMut(&[f64], &mut [f64]) -> f64,
     {
+        self.run(x, Fused(f), monitor)
+    }
+
+    /// [`Lbfgs::minimize`] for an objective that computes its gradient on demand after its cost
+    /// ([`SplitObjective`]): the same iterates, costs, gradients and report as `minimize` with the
+    /// fused function `|x, g| { let c = objective.cost(x, f64::INFINITY); objective.gradient(g);
+    /// c }`, but the gradient is computed only at trial points that pass the sufficient-decrease
+    /// test (or improve on the best point seen), and the cost of the other trials only as far as
+    /// the objective needs to see that it exceeds the bound it is given. Worth it when the
+    /// gradient is a large part of an evaluation and line searches often backtrack.
+    ///
+    /// # Errors
+    /// As [`Lbfgs::minimize`].
+    pub fn minimize_split<O>(
+        &mut self,
+        x: &mut [f64],
+        objective: &mut O,
+        monitor: &mut dyn Monitor,
+    ) -> Result<Report, LbfgsError>
+    where
+        O: SplitObjective + ?Sized,
+    {
+        self.run(x, Split(objective), monitor)
+    }
+
+    /// The solve behind [`Lbfgs::minimize`] and [`Lbfgs::minimize_split`].
+    fn run<E: Evaluate>(
+        &mut self,
+        x: &mut [f64],
+        eval: E,
+        monitor: &mut dyn Monitor,
+    ) -> Result<Report, LbfgsError> {
         self.check_start(x)?;
-        let mut evaluator = Evaluator::new(f, self.params.max_evaluations);
+        let mut evaluator = Evaluator::new(eval, self.params.max_evaluations);
         let start_cost = self.evaluate_start(x, &mut evaluator)?;
         let end = self.iterate(x, &mut evaluator, start_cost, monitor);
         Ok(Report {
@@ -100,16 +135,13 @@ impl Lbfgs {
 
     /// Iterates from the evaluated start (`x`, `cost`, `self.g`) until a stopping test holds.
     /// On return `x` and `self.g` hold the final point.
-    fn iterate<F>(
+    fn iterate<E: Evaluate>(
         &mut self,
         x: &mut [f64],
-        evaluator: &mut Evaluator<F>,
+        evaluator: &mut Evaluator<E>,
         mut cost: f64,
         monitor: &mut dyn Monitor,
-    ) -> End
-    where
-        F: FnMut(&[f64], &mut [f64]) -> f64,
-    {
+    ) -> End {
         self.memory.clear();
         if let Some(first) = self.past_costs.first_mut() {
             *first = cost;
@@ -177,14 +209,11 @@ impl Lbfgs {
     }
 
     /// Evaluates the start point into `self.g`; its cost and gradient must be finite.
-    fn evaluate_start<F>(
+    fn evaluate_start<E: Evaluate>(
         &mut self,
         x: &[f64],
-        evaluator: &mut Evaluator<F>,
-    ) -> Result<f64, LbfgsError>
-    where
-        F: FnMut(&[f64], &mut [f64]) -> f64,
-    {
+        evaluator: &mut Evaluator<E>,
+    ) -> Result<f64, LbfgsError> {
         let cost = evaluator.evaluate(x, &mut self.g);
         if !cost.is_finite() {
             return Err(LbfgsError::NonFiniteStartCost { value: cost });
@@ -197,16 +226,13 @@ impl Lbfgs {
 
     /// Saves the current point as the line-search start and searches along `self.d`; `x` and
     /// `self.g` receive the accepted (or best) point.
-    fn line_search<F>(
+    fn line_search<E: Evaluate>(
         &mut self,
         x: &mut [f64],
-        evaluator: &mut Evaluator<F>,
+        evaluator: &mut Evaluator<E>,
         cost: f64,
         initial_step: f64,
-    ) -> SearchOutcome
-    where
-        F: FnMut(&[f64], &mut [f64]) -> f64,
-    {
+    ) -> SearchOutcome {
         self.x_prev.copy_from_slice(x);
         self.g_prev.copy_from_slice(&self.g);
         let start = SearchStart {

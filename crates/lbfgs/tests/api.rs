@@ -8,7 +8,8 @@ use approx::assert_relative_eq;
 use proptest::prelude::*;
 use trust_lbfgs::test_functions::{rosenbrock, rosenbrock_start};
 use trust_lbfgs::{
-    Deadline, Lbfgs, LbfgsError, LbfgsParams, Progress, Report, Termination, minimize, monitor_fn,
+    Deadline, Lbfgs, LbfgsError, LbfgsParams, Progress, Report, SplitObjective, Termination,
+    minimize, monitor_fn,
 };
 
 /// Parameters that stop only on a tight gradient test, for accuracy checks.
@@ -587,6 +588,148 @@ fn solves_are_bit_identical_and_independent_of_earlier_solves() {
     let c = run(&mut first);
     assert_eq!(a.0, c.0);
     assert_eq!(a.1, c.1);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Split objectives (gradient on demand)
+
+/// A fused function as a [`SplitObjective`] that records how often each half is called and
+/// checks that every gradient is requested at the point of the last cost call.
+struct Recording<F> {
+    f: F,
+    last_x: Vec<f64>,
+    cost_count: usize,
+    gradient_count: usize,
+    /// Evaluations whose cost exceeded the bound.
+    cut_count: usize,
+}
+
+impl<F: FnMut(&[f64], &mut [f64]) -> f64> Recording<F> {
+    fn new(f: F) -> Self {
+        Self {
+            f,
+            last_x: Vec::new(),
+            cost_count: 0,
+            gradient_count: 0,
+            cut_count: 0,
+        }
+    }
+}
+
+impl<F: FnMut(&[f64], &mut [f64]) -> f64> SplitObjective for Recording<F> {
+    /// Above the bound, reports a deliberately wrong value (the bound's successor, or twice it):
+    /// the solver must not depend on it.
+    fn cost(&mut self, x: &[f64], bound: f64) -> f64 {
+        self.cost_count += 1;
+        self.last_x = x.to_vec();
+        let mut g = vec![0.0; x.len()];
+        let cost = (self.f)(x, &mut g);
+        if cost > bound {
+            self.cut_count += 1;
+            if bound.is_finite() {
+                bound.next_up().max(2.0 * bound)
+            } else {
+                cost
+            }
+        } else {
+            cost
+        }
+    }
+
+    fn gradient(&mut self, g: &mut [f64]) {
+        assert!(g.iter().all(|v| *v == 0.0), "g is zero-filled");
+        self.gradient_count += 1;
+        let x = self.last_x.clone();
+        (self.f)(&x, g);
+    }
+}
+
+/// `minimize_split` must follow `minimize` exactly (same iterates bit for bit, same report) on
+/// problems with backtracking line searches, NaN regions and kinks, while skipping the gradient
+/// of rejected trials and ignoring the cost reported above the bound.
+#[test]
+fn split_objective_gives_the_same_solve_with_fewer_gradients() {
+    let nan_outside = |x: &[f64], g: &mut [f64]| {
+        if x.iter().map(|v| v * v).sum::<f64>() >= 4.0 {
+            return f64::NAN;
+        }
+        let mut cost = 0.0;
+        for i in 0..x.len() {
+            g[i] = 2.0 * (x[i] - 3.0);
+            cost += (x[i] - 3.0).powi(2);
+        }
+        cost
+    };
+    let kinked = |x: &[f64], g: &mut [f64]| {
+        let (v, s) = smoothed_l1(x[0] - 1.0, 1e-3);
+        g[0] = 2.0 * x[0] + 1e4 * s;
+        g[1] = 2.0 * (x[1] + 0.5);
+        x[0] * x[0] + (x[1] + 0.5).powi(2) + 1e4 * v
+    };
+    type Problem = (Vec<f64>, LbfgsParams, fn(&[f64], &mut [f64]) -> f64);
+    let problems: Vec<Problem> = vec![
+        (rosenbrock_start(10), LbfgsParams::default(), rosenbrock),
+        (vec![0.0, 0.5, -0.5], LbfgsParams::default(), nan_outside),
+        (vec![3.0, 2.0], tight(), kinked),
+        (
+            rosenbrock_start(6),
+            LbfgsParams {
+                max_evaluations: 17,
+                ..LbfgsParams::default()
+            },
+            rosenbrock,
+        ),
+    ];
+    let (mut skipped, mut cut) = (0, 0);
+    for (start, params, f) in problems {
+        let mut fused_x = start.clone();
+        let mut fused = Lbfgs::new(start.len(), params.clone()).unwrap();
+        let fused_report = fused.minimize(&mut fused_x, f, &mut ()).unwrap();
+
+        let mut split_x = start.clone();
+        let mut split = Lbfgs::new(start.len(), params).unwrap();
+        let mut objective = Recording::new(f);
+        let split_report = split
+            .minimize_split(&mut split_x, &mut objective, &mut ())
+            .unwrap();
+
+        assert_eq!(split_report, fused_report);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&split_x), bits(&fused_x));
+        assert_eq!(bits(split.gradient()), bits(fused.gradient()));
+        assert_eq!(objective.cost_count, split_report.evaluation_count);
+        assert!(objective.gradient_count <= objective.cost_count);
+        skipped += objective.cost_count - objective.gradient_count;
+        cut += objective.cut_count;
+    }
+    assert!(
+        skipped > 0,
+        "some rejected trial must have skipped its gradient"
+    );
+    assert!(cut > 0, "some trial must have exceeded its bound");
+}
+
+#[test]
+fn split_objective_errors_like_the_fused_one() {
+    struct NanStart;
+    impl SplitObjective for NanStart {
+        fn cost(&mut self, _: &[f64], _: f64) -> f64 {
+            f64::NAN
+        }
+        fn gradient(&mut self, _: &mut [f64]) {}
+    }
+    let mut solver = Lbfgs::new(2, LbfgsParams::default()).unwrap();
+    let err = solver
+        .minimize_split(&mut [0.0, 0.0], &mut NanStart, &mut ())
+        .unwrap_err();
+    assert!(
+        matches!(err, LbfgsError::NonFiniteStartCost { .. }),
+        "{err}"
+    );
+    let err = solver
+        .minimize_split(&mut [0.0], &mut NanStart, &mut ())
+        .unwrap_err();
+    assert!(matches!(err, LbfgsError::DimensionMismatch { .. }), "{err}");
 }
 
 #[test]

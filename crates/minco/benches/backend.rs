@@ -12,18 +12,27 @@
 //! - `solve/utf_minco_e2_dynamic_warm`, `solve/utf_minco_e2_static_warm`: the manager's common
 //!   case, a re-solve one replanning period (0.1 s) later from the state the previous solution
 //!   reaches then, warm-started from that solution (`InitialGuess::WarmStart`).
+//! - `solve/utf_minco_random_dynamic_x8`, `solve/utf_minco_random_static_x8`: cold solves of the
+//!   first 8 random E2-like scenes of each kind (`scenes::random_e2_dynamic` / `random_e2_static`,
+//!   seeds 0..8), all 8 per iteration: a check on a spread of scenes rather than one case. The
+//!   per-scene distribution over 60 scenes is `examples/e2_compare.rs --random 60`.
 //!
 //! Smoke mode: `cargo bench -p trust-minco --bench backend -- --test`.
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 use trust_core::{
     Aabb, Forecast, InitialGuess, Limits, PolyTraj, Scene, State, StaticMap, TrajRequest,
     TrajectoryBackend, Vec3,
 };
 use trust_minco::backend::{Minco, UtfMinco, UtfMincoObjective, UtfMincoParams};
-use trust_minco::scenes::{E2Case, e2_dynamic, e2_static};
+use trust_minco::scenes::{E2Case, e2_dynamic, e2_static, random_e2_dynamic, random_e2_static};
+
+/// A random scene generator of `trust_minco::scenes`.
+type DrawScene = fn(&mut ChaCha8Rng) -> E2Case;
 
 const PIECES: usize = 16;
 
@@ -159,6 +168,23 @@ fn bench_solve(c: &mut Criterion) {
     group.bench_function("utf_minco_e2_static_warm", |b| {
         b.iter(|| black_box(warm_resolve(&stat, &utf, &previous)))
     });
+    let kinds: [(&str, DrawScene); 2] = [
+        ("utf_minco_random_dynamic_x8", random_e2_dynamic),
+        ("utf_minco_random_static_x8", random_e2_static),
+    ];
+    for (name, draw) in kinds {
+        let cases: Vec<E2Case> = (0..8)
+            .map(|seed| draw(&mut ChaCha8Rng::seed_from_u64(seed)))
+            .collect();
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                cases
+                    .iter()
+                    .map(|case| solve(case, &utf).duration())
+                    .sum::<f64>()
+            })
+        });
+    }
     group.finish();
 }
 

@@ -458,8 +458,13 @@ fn check_utf(
             f.breakdown()
         );
     }
-    let mut scratch = vec![0.0; x.len()];
-    check_gradient(|x| f.eval(x, &mut scratch), &x, &g, 2e-4, 1e-5)
+    // The split evaluation (what the L-BFGS solve uses) gives the same cost and gradient.
+    prop_assert_eq!(f.cost(&x).to_bits(), cost.to_bits());
+    let mut g_split = vec![0.0; x.len()];
+    f.gradient(&mut g_split)
+        .expect("gradient after a finite cost");
+    prop_assert_eq!(&g_split, &g);
+    check_gradient(|x| f.cost(x), &x, &g, 2e-4, 1e-5)
 }
 
 /// The full MINCO objective w.r.t. all decision variables (waypoints, `τ_i`).
@@ -500,8 +505,12 @@ fn check_minco(seed: u64, n: usize, weights: CostWeights) -> Result<(), TestCase
         "obstacles must be penetrated: {:?}",
         f.breakdown()
     );
-    let mut scratch = vec![0.0; x.len()];
-    check_gradient(|x| f.eval(x, &mut scratch), &x, &g, 2e-4, 1e-5)
+    prop_assert_eq!(f.cost(&x).to_bits(), cost.to_bits());
+    let mut g_split = vec![0.0; x.len()];
+    f.gradient(&mut g_split)
+        .expect("gradient after a finite cost");
+    prop_assert_eq!(&g_split, &g);
+    check_gradient(|x| f.cost(x), &x, &g, 2e-4, 1e-5)
 }
 
 /// Only one term weighted.
@@ -550,6 +559,44 @@ proptest! {
         check_minco(seed, n, CostWeights::default())?;
         check_minco(seed, n, only("obstacle"))?;
     }
+}
+
+/// The split evaluation's contract: a gradient needs a finite cost just before it (and is then
+/// consumed), wrong lengths are rejected, and a failed gradient leaves `g` zeroed.
+#[test]
+fn split_evaluation_needs_a_finite_cost_first() {
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let n = 3;
+    let prob = random_problem(&mut rng, n);
+    let map = big_map();
+    let scene = Scene::new(&map, &[], prob.start.t).expect("scene");
+    let limits = Limits::new(3.0, 4.0).expect("limits");
+    let params = utf_params(CostWeights::default());
+    let mut f = UtfMincoObjective::new(&scene, &prob.start, prob.goal, limits, &params, n)
+        .expect("objective");
+    let mut x = vec![0.0; f.dimension()];
+    f.encode(
+        &prob.waypoints,
+        &prob.end,
+        &prob.end_velocity,
+        prob.total,
+        &mut x,
+    )
+    .expect("encode");
+    let mut g = vec![1.0; x.len()];
+    assert!(f.gradient(&mut g).is_err(), "no cost evaluated yet");
+    assert!(g.iter().all(|v| *v == 0.0));
+    assert!(f.cost(&x).is_finite());
+    assert!(f.gradient(&mut g[1..]).is_err(), "wrong length");
+    f.gradient(&mut g).expect("after a finite cost");
+    assert!(f.gradient(&mut g).is_err(), "the gradient is consumed");
+    assert_eq!(f.cost(&x[1..]), f64::INFINITY);
+    assert!(f.gradient(&mut g).is_err(), "after an infinite cost");
+    let mut bad = x.clone();
+    bad[0] = f64::NAN;
+    assert_eq!(f.cost(&bad), f64::INFINITY);
+    assert_eq!(f.eval(&bad, &mut g), f64::INFINITY);
+    assert!(g.iter().all(|v| *v == 0.0));
 }
 
 /// Regression guard for the time coupling: on a fixed case, the explicit `∂I/∂T_0` of the moving

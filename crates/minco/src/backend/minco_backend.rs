@@ -58,13 +58,7 @@ impl TrajectoryBackend for Minco {
         let mut x = vec![0.0; f.dimension()];
         let durations = vec![init.total_duration / n as f64; n];
         f.encode(&init.waypoints, &durations, &mut x)?;
-        let report = run_lbfgs(
-            self.name(),
-            |x, g| f.eval(x, g),
-            &mut x,
-            &p.solver,
-            req.deadline,
-        )?;
+        let report = run_lbfgs(self.name(), &mut f, &mut x, &p.solver, req.deadline)?;
         let mut g = vec![0.0; x.len()];
         f.eval(&x, &mut g);
         Ok(Solution {

@@ -28,8 +28,10 @@ struct ObjectiveCore<'a> {
     grad_c: Vec<Vec3>,
     grad_t: Vec<f64>,
     grad: MincoGrad,
-    /// The cost terms of the last finite evaluation.
+    /// The cost terms of the last finite cost evaluation.
     last: CostBreakdown,
+    /// Whether the last cost evaluation was finite (its gradient may then be computed).
+    gradient_ready: bool,
 }
 
 impl<'a> ObjectiveCore<'a> {
@@ -56,6 +58,7 @@ impl<'a> ObjectiveCore<'a> {
             grad_t: vec![0.0; pieces],
             grad: MincoGrad::new(pieces),
             last: CostBreakdown::default(),
+            gradient_ready: false,
         })
     }
 
@@ -63,12 +66,28 @@ impl<'a> ObjectiveCore<'a> {
         self.durations.len()
     }
 
-    /// Solves MINCO for the current `tail`, `waypoints`, `durations`; returns the weighted
-    /// `λ_o I_o + λ_d I_d + λ_e I_e` and the unweighted `[I_o, I_d, I_e]`, and leaves the
-    /// gradient in `self.grad`.
-    fn evaluate(&mut self) -> Result<(f64, [f64; 3]), MincoError> {
+    /// Solves MINCO for the current `tail`, `waypoints`, `durations` and integrates the
+    /// penalties; returns the weighted `λ_o I_o + λ_d I_d + λ_e I_e` and the unweighted
+    /// `[I_o, I_d, I_e]`. Leaves `∂I/∂c`, `∂I/∂T` of the penalties in `grad_c`, `grad_t` for
+    /// [`Self::evaluate_gradient`].
+    ///
+    /// `base` is the rest of the cost (time and terminal terms) and `bound` the caller's bound
+    /// ([`UtfMincoObjective::cost_with_bound`]): as soon as `base` plus the energy and the
+    /// penalties summed so far exceed `bound` (by a margin far above rounding), it stops and
+    /// returns [`Partial::Above`] with that partial cost — every term is non-negative, so the
+    /// full cost exceeds `bound` too.
+    fn evaluate_cost(&mut self, base: f64, bound: f64) -> Result<Partial, MincoError> {
+        let limit = bound + CUT_MARGIN * bound.abs().max(1.0);
+        if base > limit {
+            return Ok(Partial::Above(base));
+        }
         self.minco
             .solve(&self.head, &self.tail, &self.waypoints, &self.durations)?;
+        let energy = self.minco.energy();
+        let before_penalties = base + self.weights.energy * energy;
+        if before_penalties > limit {
+            return Ok(Partial::Above(before_penalties));
+        }
         self.grad_c.fill(Vec3::zeros());
         self.grad_t.fill(0.0);
         self.penalties.reset_integrals();
@@ -77,24 +96,33 @@ impl<'a> ObjectiveCore<'a> {
             coeffs: self.minco.coeffs(),
             durations: self.minco.durations(),
         };
-        let sampled = self.integrator.integrate(
+        let (sampled, complete) = self.integrator.integrate_penalties(
             &view,
             &mut self.penalties,
             &mut self.grad_c,
             &mut self.grad_t,
+            limit - before_penalties,
         )?;
-        let energy = self.minco.accumulate_energy_grad(
+        if !complete {
+            return Ok(Partial::Above(before_penalties + sampled));
+        }
+        let integrals = self.penalties.integrals();
+        Ok(Partial::Complete(
+            sampled + self.weights.energy * energy,
+            [integrals.obstacle(), integrals.feasibility(), energy],
+        ))
+    }
+
+    /// After [`Self::evaluate_cost`]: adds the jerk energy's gradient and propagates everything
+    /// through MINCO's adjoint into `self.grad`.
+    fn evaluate_gradient(&mut self) -> Result<(), MincoError> {
+        self.minco.accumulate_energy_grad(
             self.weights.energy,
             &mut self.grad_c,
             &mut self.grad_t,
         )?;
         self.minco
-            .propagate_grad(&self.grad_c, &self.grad_t, &mut self.grad)?;
-        let integrals = self.penalties.integrals();
-        Ok((
-            sampled + self.weights.energy * energy,
-            [integrals.obstacle(), integrals.feasibility(), energy],
-        ))
+            .propagate_grad(&self.grad_c, &self.grad_t, &mut self.grad)
     }
 
     fn trajectory(&self) -> Result<PolyTraj, PlanError> {
@@ -109,6 +137,19 @@ impl<'a> ObjectiveCore<'a> {
             self.minco.to_pieces(),
         )
     }
+}
+
+/// Relative margin (of `max(1, |bound|)`) by which a partial cost must exceed the bound before
+/// an evaluation stops early: far above the rounding difference between the partial sums and
+/// the cost's own summation order.
+const CUT_MARGIN: f64 = 1e-9;
+
+/// What [`ObjectiveCore::evaluate_cost`] found.
+enum Partial {
+    /// The weighted `λ_o I_o + λ_d I_d + λ_e I_e` and the unweighted `[I_o, I_d, I_e]`.
+    Complete(f64, [f64; 3]),
+    /// A partial cost (including `base`) above the bound; no gradient available.
+    Above(f64),
 }
 
 fn component(e: MincoError) -> PlanError {
@@ -139,6 +180,12 @@ fn get(x: &[f64], i: usize) -> Vec3 {
 /// analytical-gradients, `∂J/∂P = ∂I/∂P`, `∂J/∂S = ∂H/∂S + ∂I/∂S` (tail rows of the adjoint, eq.
 /// analytical-gradients-I-to-S) and `∂J/∂T_Σ = λ_t + (1/n) Σ_i ∂I/∂T_i`, chained through `dT/dτ`.
 ///
+/// Evaluate with [`eval`](Self::eval) (cost and gradient), or in two halves —
+/// [`cost`](Self::cost) / [`cost_with_bound`](Self::cost_with_bound), then
+/// [`gradient`](Self::gradient) — as the backend's L-BFGS solve does
+/// ([`trust_lbfgs::Lbfgs::minimize_split`]): a line search needs the gradient, and the exact
+/// cost, only at some trial points. Both give the same numbers bit for bit.
+///
 /// ```
 /// use trust_core::{Limits, Scene, StaticMap, State, Aabb, Vec3};
 /// use trust_minco::backend::{UtfMincoObjective, UtfMincoParams};
@@ -154,6 +201,13 @@ fn get(x: &[f64], i: usize) -> Vec3 {
 /// let mut g = vec![0.0; f.dimension()];
 /// let j = f.eval(&x, &mut g);
 /// assert!(j.is_finite() && g.iter().all(|v| v.is_finite()));
+/// // The same in two halves.
+/// let mut g2 = vec![0.0; f.dimension()];
+/// assert_eq!(f.cost(&x), j);
+/// f.gradient(&mut g2)?;
+/// assert_eq!(g2, g);
+/// // Only "more than 1" is needed: the evaluation may stop early with any value above it.
+/// assert!(f.cost_with_bound(&x, 1.0) > 1.0);
 /// # Ok::<(), trust_core::PlanError>(())
 /// ```
 #[derive(Debug, Clone)]
@@ -161,6 +215,8 @@ pub struct UtfMincoObjective<'a> {
     core: ObjectiveCore<'a>,
     terminal: TerminalCost,
     min_total: f64,
+    /// `∂H_s/∂p_f`, `∂H_s/∂v_f` and `dT/dτ` at the last cost evaluation.
+    terminal_grad: (Vec3, Vec3, f64),
 }
 
 impl<'a> UtfMincoObjective<'a> {
@@ -189,6 +245,7 @@ impl<'a> UtfMincoObjective<'a> {
             )?,
             terminal: TerminalCost::new(goal, &start.p, &params.penalty),
             min_total: min_total(&params.pieces, pieces),
+            terminal_grad: (Vec3::zeros(), Vec3::zeros(), 0.0),
         })
     }
 
@@ -238,13 +295,31 @@ impl<'a> UtfMincoObjective<'a> {
     }
 
     /// `J(x)`; writes `∇J` into `g`. Returns `+∞` (with `g` zeroed) where MINCO cannot be solved
-    /// or the cost is not finite, so that a line search backs off; never NaN.
+    /// or the cost or its gradient is not finite, so that a line search backs off; never NaN.
+    /// The same as [`Self::cost`] followed by [`Self::gradient`].
     ///
     /// `x` and `g` must be [`dimension`](Self::dimension) long; otherwise the result is `+∞`.
     pub fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        eval_fused(self, x, g)
+    }
+
+    /// `J(x)` alone; `+∞` where MINCO cannot be solved, the cost is not finite or `x` has the
+    /// wrong length; never NaN. The gradient at `x` can then be had from [`Self::gradient`]
+    /// (the line search needs it only at some trial points:
+    /// [`trust_lbfgs::Lbfgs::minimize_split`]).
+    pub fn cost(&mut self, x: &[f64]) -> f64 {
+        self.cost_with_bound(x, f64::INFINITY)
+    }
+
+    /// [`Self::cost`] where only a cost up to `bound` is needed exactly: once the (non-negative)
+    /// terms summed so far exceed `bound`, the evaluation stops and returns that partial sum,
+    /// which is `> bound` (there is then no gradient at `x`). Costs `≤ bound` are exactly those of
+    /// [`Self::cost`]. This is what [`trust_lbfgs::SplitObjective::cost`] asks for: a line
+    /// search rejects such trial points without needing their exact cost.
+    pub fn cost_with_bound(&mut self, x: &[f64], bound: f64) -> f64 {
+        self.core.gradient_ready = false;
         let n = self.pieces();
-        if x.len() != self.dimension() || g.len() != self.dimension() {
-            g.fill(0.0);
+        if x.len() != self.dimension() {
             return f64::INFINITY;
         }
         for (i, w) in self.core.waypoints.iter_mut().enumerate() {
@@ -255,13 +330,34 @@ impl<'a> UtfMincoObjective<'a> {
         let total = self.min_total + t_map;
         self.core.durations.fill(total / n as f64);
         self.core.tail = [p_f, v_f, Vec3::zeros()];
-        let Ok((integral, terms)) = self.core.evaluate() else {
-            g.fill(0.0);
-            return f64::INFINITY;
-        };
-        let w = &self.core.weights;
         let (hs, hs_p, hs_v) = self.terminal.eval(&p_f, &v_f);
-        let cost = w.time * total + w.terminal * hs + integral;
+        let (w_time, w_terminal) = (self.core.weights.time, self.core.weights.terminal);
+        let base = w_time * total + w_terminal * hs;
+        let (integral, terms) = match self.core.evaluate_cost(base, bound) {
+            Ok(Partial::Complete(integral, terms)) => (integral, terms),
+            Ok(Partial::Above(partial)) => return partial,
+            Err(_) => return f64::INFINITY,
+        };
+        let cost = w_time * total + w_terminal * hs + integral;
+        self.terminal_grad = (hs_p, hs_v, dt_dtau);
+        record_cost(cost, &mut self.core, [total, hs], terms)
+    }
+
+    /// `∇J` at the point of the last [`Self::cost`] call, written into `g`.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] if `g` is not [`dimension`](Self::dimension) long;
+    /// [`PlanError::Component`] if the last cost was not finite (or none was evaluated) or the
+    /// gradient is not finite. `g` is then zeroed.
+    pub fn gradient(&mut self, g: &mut [f64]) -> Result<(), PlanError> {
+        let n = self.pieces();
+        check_len("g", self.dimension(), g.len())?;
+        if let Err(e) = begin_gradient(&mut self.core) {
+            g.fill(0.0);
+            return Err(e);
+        }
+        let w = &self.core.weights;
+        let (hs_p, hs_v, dt_dtau) = self.terminal_grad;
         let grad = &self.core.grad;
         for (i, gw) in grad.waypoints.iter().enumerate() {
             put(g, i, gw);
@@ -269,15 +365,18 @@ impl<'a> UtfMincoObjective<'a> {
         put(g, n - 1, &(grad.tail[0] + hs_p * w.terminal));
         put(g, n, &(grad.tail[1] + hs_v * w.terminal));
         g[3 * n + 3] = (w.time + grad.uniform_total_duration()) * dt_dtau;
-        finish(cost, g, &mut self.core.last, [total, hs], terms)
+        check_gradient(g)
     }
 
-    /// The unweighted cost terms and `J` at the last finite evaluation.
+    /// The unweighted cost terms and `J` at the last finite cost evaluation (one that did not
+    /// stop early at its bound).
     pub fn breakdown(&self) -> CostBreakdown {
         self.core.last
     }
 
-    /// The trajectory of the last evaluation (starts at `start.t`).
+    /// The trajectory of the last evaluation (starts at `start.t`); after a
+    /// `cost_with_bound` that stopped before solving MINCO (its time and terminal terms alone
+    /// exceeded the bound), that of the evaluation before.
     ///
     /// # Errors
     /// If no evaluation has succeeded yet.
@@ -298,6 +397,8 @@ pub struct MincoObjective<'a> {
     core: ObjectiveCore<'a>,
     terminal_cost: f64,
     min_duration: f64,
+    /// `dT_i/dτ_i` at the last cost evaluation.
+    duration_slopes: Vec<f64>,
 }
 
 impl<'a> MincoObjective<'a> {
@@ -330,6 +431,7 @@ impl<'a> MincoObjective<'a> {
             core,
             terminal_cost: terminal.eval(&end, &Vec3::zeros()).0,
             min_duration: params.pieces.min_piece_duration_s,
+            duration_slopes: vec![1.0; pieces],
         })
     }
 
@@ -368,46 +470,90 @@ impl<'a> MincoObjective<'a> {
     }
 
     /// `J(x)`; writes `∇J` into `g`. Returns `+∞` (with `g` zeroed) where MINCO cannot be solved
-    /// or the cost is not finite; never NaN.
+    /// or the cost or its gradient is not finite; never NaN. The same as [`Self::cost`] followed
+    /// by [`Self::gradient`].
     ///
     /// `x` and `g` must be [`dimension`](Self::dimension) long; otherwise the result is `+∞`.
     pub fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        eval_fused(self, x, g)
+    }
+
+    /// `J(x)` alone; `+∞` where MINCO cannot be solved, the cost is not finite or `x` has the
+    /// wrong length; never NaN. See [`UtfMincoObjective::cost`].
+    pub fn cost(&mut self, x: &[f64]) -> f64 {
+        self.cost_with_bound(x, f64::INFINITY)
+    }
+
+    /// [`Self::cost`], exact only up to `bound`; see [`UtfMincoObjective::cost_with_bound`].
+    pub fn cost_with_bound(&mut self, x: &[f64], bound: f64) -> f64 {
+        self.core.gradient_ready = false;
         let n = self.pieces();
-        if x.len() != self.dimension() || g.len() != self.dimension() {
-            g.fill(0.0);
+        if x.len() != self.dimension() {
             return f64::INFINITY;
         }
         for (i, w) in self.core.waypoints.iter_mut().enumerate() {
             *w = get(x, i);
         }
         let taus = &x[3 * (n - 1)..];
-        for (d, &tau) in self.core.durations.iter_mut().zip(taus) {
-            *d = self.min_duration + positive_time(tau).0;
+        for ((d, slope), &tau) in self
+            .core
+            .durations
+            .iter_mut()
+            .zip(self.duration_slopes.iter_mut())
+            .zip(taus)
+        {
+            let (t, dt_dtau) = positive_time(tau);
+            *d = self.min_duration + t;
+            *slope = dt_dtau;
         }
         let total: f64 = self.core.durations.iter().sum();
-        let Ok((integral, terms)) = self.core.evaluate() else {
-            g.fill(0.0);
-            return f64::INFINITY;
+        let (w_time, w_terminal) = (self.core.weights.time, self.core.weights.terminal);
+        let hs = self.terminal_cost;
+        let base = w_time * total + w_terminal * hs;
+        let (integral, terms) = match self.core.evaluate_cost(base, bound) {
+            Ok(Partial::Complete(integral, terms)) => (integral, terms),
+            Ok(Partial::Above(partial)) => return partial,
+            Err(_) => return f64::INFINITY,
         };
+        let cost = w_time * total + w_terminal * hs + integral;
+        record_cost(cost, &mut self.core, [total, hs], terms)
+    }
+
+    /// `∇J` at the point of the last [`Self::cost`] call, written into `g`.
+    ///
+    /// # Errors
+    /// As [`UtfMincoObjective::gradient`].
+    pub fn gradient(&mut self, g: &mut [f64]) -> Result<(), PlanError> {
+        let n = self.pieces();
+        check_len("g", self.dimension(), g.len())?;
+        if let Err(e) = begin_gradient(&mut self.core) {
+            g.fill(0.0);
+            return Err(e);
+        }
         let w = &self.core.weights;
-        let cost = w.time * total + w.terminal * self.terminal_cost + integral;
         let grad = &self.core.grad;
         for (i, gw) in grad.waypoints.iter().enumerate() {
             put(g, i, gw);
         }
-        for ((gi, &tau), dj) in g[3 * (n - 1)..].iter_mut().zip(taus).zip(&grad.durations) {
-            *gi = (w.time + dj) * positive_time(tau).1;
+        for ((gi, slope), dj) in g[3 * (n - 1)..]
+            .iter_mut()
+            .zip(&self.duration_slopes)
+            .zip(&grad.durations)
+        {
+            *gi = (w.time + dj) * slope;
         }
-        let hs = self.terminal_cost;
-        finish(cost, g, &mut self.core.last, [total, hs], terms)
+        check_gradient(g)
     }
 
-    /// The unweighted cost terms and `J` at the last finite evaluation.
+    /// The unweighted cost terms and `J` at the last finite cost evaluation (one that did not
+    /// stop early at its bound).
     pub fn breakdown(&self) -> CostBreakdown {
         self.core.last
     }
 
-    /// The trajectory of the last evaluation (starts at `start.t`).
+    /// The trajectory of the last evaluation (starts at `start.t`); after a
+    /// `cost_with_bound` that stopped before solving MINCO (its time and terminal terms alone
+    /// exceeded the bound), that of the evaluation before.
     ///
     /// # Errors
     /// If no evaluation has succeeded yet.
@@ -416,19 +562,55 @@ impl<'a> MincoObjective<'a> {
     }
 }
 
-/// Shared end of `eval`: reject non-finite results, record the breakdown.
-fn finish(
-    cost: f64,
-    g: &mut [f64],
-    last: &mut CostBreakdown,
-    [ht, hs]: [f64; 2],
-    [io, id, ie]: [f64; 3],
-) -> f64 {
-    if !cost.is_finite() || g.iter().any(|v| !v.is_finite()) {
+/// The two halves of an objective, for [`eval_fused`] and the split L-BFGS solve.
+pub(crate) trait SplitCost {
+    /// `J(x)`, exact up to `bound`, `+∞` where it cannot be evaluated.
+    fn cost(&mut self, x: &[f64], bound: f64) -> f64;
+    /// `∇J` at the last cost's point.
+    fn gradient(&mut self, g: &mut [f64]) -> Result<(), PlanError>;
+}
+
+impl SplitCost for UtfMincoObjective<'_> {
+    fn cost(&mut self, x: &[f64], bound: f64) -> f64 {
+        self.cost_with_bound(x, bound)
+    }
+
+    fn gradient(&mut self, g: &mut [f64]) -> Result<(), PlanError> {
+        UtfMincoObjective::gradient(self, g)
+    }
+}
+
+impl SplitCost for MincoObjective<'_> {
+    fn cost(&mut self, x: &[f64], bound: f64) -> f64 {
+        self.cost_with_bound(x, bound)
+    }
+
+    fn gradient(&mut self, g: &mut [f64]) -> Result<(), PlanError> {
+        MincoObjective::gradient(self, g)
+    }
+}
+
+/// Cost and gradient in one call: `+∞` with `g` zeroed if either is not available.
+fn eval_fused<O: SplitCost>(objective: &mut O, x: &[f64], g: &mut [f64]) -> f64 {
+    let cost = objective.cost(x, f64::INFINITY);
+    if !cost.is_finite() || objective.gradient(g).is_err() {
         g.fill(0.0);
         return f64::INFINITY;
     }
-    *last = CostBreakdown {
+    cost
+}
+
+/// Shared end of `cost`: reject a non-finite cost, record the breakdown, allow the gradient.
+fn record_cost(
+    cost: f64,
+    core: &mut ObjectiveCore<'_>,
+    [ht, hs]: [f64; 2],
+    [io, id, ie]: [f64; 3],
+) -> f64 {
+    if !cost.is_finite() {
+        return f64::INFINITY;
+    }
+    core.last = CostBreakdown {
         ht,
         hs,
         io,
@@ -436,7 +618,33 @@ fn finish(
         ie,
         total: cost,
     };
+    core.gradient_ready = true;
     cost
+}
+
+/// Shared start of `gradient`: the last cost must be finite; computes the core's gradient.
+fn begin_gradient(core: &mut ObjectiveCore<'_>) -> Result<(), PlanError> {
+    if !core.gradient_ready {
+        return Err(component(MincoError::NotSolved {
+            operation: "gradient (no finite cost evaluated)",
+        }));
+    }
+    core.gradient_ready = false;
+    core.evaluate_gradient().map_err(component)
+}
+
+/// Shared end of `gradient`: a non-finite gradient is an error (and `g` is zeroed).
+fn check_gradient(g: &mut [f64]) -> Result<(), PlanError> {
+    match g.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(index) => {
+            g.fill(0.0);
+            Err(component(MincoError::NonFiniteResult {
+                field: "gradient",
+                index,
+            }))
+        }
+    }
 }
 
 fn min_total(params: &PieceParams, pieces: usize) -> f64 {

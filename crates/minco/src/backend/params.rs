@@ -100,7 +100,7 @@ pub struct SolverParams {
 }
 
 impl Default for SolverParams {
-    /// - `max_evaluations = 1000`: ours, a hard cap (about 5 ms at the E2 problem size on this
+    /// - `max_evaluations = 1000`: ours, a hard cap (about 3 ms at the E2 problem size on this
     ///   machine); converged solves stop well before it (E2: 356 dynamic, 722 static; random
     ///   E2-like scenes: about 400–560 on average).
     /// - `lbfgs`: LBFGS-Lite's defaults (`g_epsilon = 1e-5`, `past = 3`, …; see [`LbfgsParams`])

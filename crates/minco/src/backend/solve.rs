@@ -6,8 +6,9 @@ use std::time::Instant;
 use trust_core::{
     InitialGuess, PlanError, Scene, SolveStatus, TrajRequest, check_finite, check_finite_vec,
 };
-use trust_lbfgs::{Deadline, Lbfgs, Report, Termination};
+use trust_lbfgs::{Deadline, Lbfgs, Report, SplitObjective, Termination};
 
+use super::objective::SplitCost;
 use super::params::SolverParams;
 
 /// Maps an L-BFGS [`Termination`] to the planner's [`SolveStatus`]:
@@ -62,27 +63,45 @@ pub fn validate_request(req: &TrajRequest<'_>, scene: &Scene<'_>) -> Result<(), 
     Ok(())
 }
 
-/// Runs L-BFGS on `f` from `x` with the evaluation budget of `solver` and the optional deadline.
-pub(crate) fn run_lbfgs<F>(
+/// Runs L-BFGS on `objective` from `x` with the evaluation budget of `solver` and the optional
+/// deadline. The solve is split ([`Lbfgs::minimize_split`]): the gradient (MINCO's adjoint
+/// solve, the energy gradient) is computed only at trial points the line search may accept, and
+/// the penalties of a rejected trial only until its cost is seen to exceed the line search's
+/// bound — with the same iterates as a fused solve.
+pub(crate) fn run_lbfgs<O: SplitCost>(
     component: &str,
-    f: F,
+    objective: &mut O,
     x: &mut [f64],
     solver: &SolverParams,
     deadline: Option<Instant>,
-) -> Result<Report, PlanError>
-where
-    F: FnMut(&[f64], &mut [f64]) -> f64,
-{
+) -> Result<Report, PlanError> {
     let wrap = |e: trust_lbfgs::LbfgsError| PlanError::Component {
         component: component.into(),
         source: Box::new(e),
     };
     let mut lbfgs = Lbfgs::new(x.len(), solver.effective_lbfgs()).map_err(wrap)?;
+    let mut split = Split(objective);
     match deadline {
-        Some(at) => lbfgs.minimize(x, f, &mut Deadline::new(at)),
-        None => lbfgs.minimize(x, f, &mut ()),
+        Some(at) => lbfgs.minimize_split(x, &mut split, &mut Deadline::new(at)),
+        None => lbfgs.minimize_split(x, &mut split, &mut ()),
     }
     .map_err(wrap)
+}
+
+/// An objective as a [`SplitObjective`]: a gradient that cannot be computed is reported to the
+/// solver as NaN, which makes it reject the trial point exactly as the fused `eval`'s `+∞` does.
+struct Split<'o, O>(&'o mut O);
+
+impl<O: SplitCost> SplitObjective for Split<'_, O> {
+    fn cost(&mut self, x: &[f64], bound: f64) -> f64 {
+        self.0.cost(x, bound)
+    }
+
+    fn gradient(&mut self, g: &mut [f64]) {
+        if self.0.gradient(g).is_err() {
+            g.fill(f64::NAN);
+        }
+    }
 }
 
 #[cfg(test)]

@@ -61,13 +61,7 @@ impl TrajectoryBackend for UtfMinco {
             init.total_duration,
             &mut x,
         )?;
-        let report = run_lbfgs(
-            self.name(),
-            |x, g| f.eval(x, g),
-            &mut x,
-            &p.solver,
-            req.deadline,
-        )?;
+        let report = run_lbfgs(self.name(), &mut f, &mut x, &p.solver, req.deadline)?;
         // Re-evaluate at the returned point: the breakdown and the trajectory belong to it.
         let mut g = vec![0.0; x.len()];
         f.eval(&x, &mut g);

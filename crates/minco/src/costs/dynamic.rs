@@ -95,31 +95,34 @@ impl<'a> DynamicObstacleTerm<'a> {
         &self.near_piece
     }
 
-    /// `L_o` at one node without broad phase: adds `weight · ∂L_o` into `grad` and returns the
-    /// unweighted `L_o` over the forecasts listed in `indices`.
-    #[inline]
+    /// `L_o` at `(p, t)` without broad phase: adds `weight · ∂L_o/∂p` into `grad_p` and
+    /// `weight · ∂L_o/∂t` into `grad_t` and returns the unweighted `L_o` over the forecasts listed
+    /// in `indices`.
+    #[inline(always)]
     fn accumulate(
         &self,
         indices: impl Iterator<Item = usize>,
-        s: &SampleState,
-        grad: &mut SampleGrad,
+        p: &Vec3,
+        t: f64,
         weight: f64,
+        grad_p: &mut Vec3,
+        grad_t: &mut f64,
     ) -> f64 {
         let mut total = 0.0;
         for o in indices {
             let forecast = &self.forecasts[o];
-            if outside_inflated(forecast, &s.p, s.t, self.clearance) {
+            if outside_inflated(forecast, p, t, self.clearance) {
                 continue;
             }
-            let (phi, phi_p, phi_t) = ddf_violation(forecast, &s.p, s.t, self.clearance);
+            let (phi, phi_p, phi_t) = ddf_violation(forecast, p, t, self.clearance);
             if phi <= 0.0 {
                 continue;
             }
             let (value, slope) = self.smoothing.eval(phi);
             total += value;
             let k = weight * slope;
-            grad.p += phi_p * k;
-            grad.t += phi_t * k;
+            *grad_p += phi_p * k;
+            *grad_t += phi_t * k;
         }
         total
     }
@@ -134,7 +137,9 @@ impl<'a> DynamicObstacleTerm<'a> {
         }
     }
 
-    /// Broad phase for one piece; `true` if any forecast survived.
+    /// Broad phase for one piece; `true` if any forecast survived: the forecasts of the
+    /// trajectory's broad phase whose [`swept_box`] over `[t_begin, t_end]` (inflated by the
+    /// clearance) meets `samples_box` (computed inline, without building the box).
     pub(crate) fn begin_piece_impl(
         &mut self,
         t_begin: f64,
@@ -142,8 +147,23 @@ impl<'a> DynamicObstacleTerm<'a> {
         samples_box: &Aabb,
     ) -> bool {
         self.near_piece.clear();
+        let (b_min, b_max) = (samples_box.min, samples_box.max);
+        let t_max = t_begin.max(t_end);
         for &o in &self.near_trajectory {
-            if swept_box(&self.forecasts[o], t_begin, t_end, self.clearance).intersects(samples_box)
+            let f = &self.forecasts[o];
+            let (da, db) = (t_begin - f.t0, t_end - f.t0);
+            let r = f.radius(t_max) + self.clearance;
+            let rz = f.vertical_half_extent(t_max) + self.clearance;
+            // Per axis: the centre's range over the window, grown by the half-extent, must meet
+            // the box.
+            let meets = |p0: f64, v0: f64, half: f64, lo: f64, hi: f64| {
+                let (a, b) = (p0 + v0 * da, p0 + v0 * db);
+                let (c_lo, c_hi) = if a <= b { (a, b) } else { (b, a) };
+                c_lo - half <= hi && lo <= c_hi + half
+            };
+            if meets(f.p0.x, f.v0.x, r, b_min.x, b_max.x)
+                && meets(f.p0.y, f.v0.y, r, b_min.y, b_max.y)
+                && meets(f.p0.z, f.v0.z, rz, b_min.z, b_max.z)
             {
                 self.near_piece.push(o);
             }
@@ -151,21 +171,90 @@ impl<'a> DynamicObstacleTerm<'a> {
         !self.near_piece.is_empty()
     }
 
-    /// `L_o` at one node over the current piece's candidates, gradient scaled by `weight`.
-    #[inline]
-    pub(crate) fn sample_weighted(
+    /// `L_o` at `(p, t)` over the current piece's candidates; adds the gradient scaled by
+    /// `weight` into `grad_p` and `grad_t`.
+    #[inline(always)]
+    pub(crate) fn at(
         &self,
-        s: &SampleState,
-        grad: &mut SampleGrad,
+        p: &Vec3,
+        t: f64,
         weight: f64,
+        grad_p: &mut Vec3,
+        grad_t: &mut f64,
     ) -> f64 {
-        self.accumulate(self.near_piece.iter().copied(), s, grad, weight)
+        self.accumulate(
+            self.near_piece.iter().copied(),
+            p,
+            t,
+            weight,
+            grad_p,
+            grad_t,
+        )
+    }
+
+    /// Sets `flags[k]` for every node `k` (position `(x[k], y[k], z[k])`, time `t[k]`) that is
+    /// not provably farther than the clearance plus
+    /// [`FILTER_MARGIN_M`](crate::costs::integrate::FILTER_MARGIN_M) from a forecast kept by
+    /// the piece's broad phase (the rejection of [`outside_inflated`], column by column).
+    #[expect(
+        clippy::neg_cmp_op_on_partial_ord,
+        reason = "a NaN must count as possibly active"
+    )]
+    pub(crate) fn flag_nodes(
+        &self,
+        x: &[f64],
+        y: &[f64],
+        z: &[f64],
+        t: &[f64],
+        flags: &mut [bool],
+    ) {
+        let m = flags.len();
+        let (x, y, z, t) = (&x[..m], &y[..m], &z[..m], &t[..m]);
+        let grow = self.clearance + crate::costs::integrate::FILTER_MARGIN_M;
+        for &o in &self.near_piece {
+            let f = &self.forecasts[o];
+            let (p0, v0, t0) = (f.p0, f.v0, f.t0);
+            match f.shape {
+                ObstacleShape::Sphere => {
+                    for (k, flag) in flags.iter_mut().enumerate() {
+                        let dt = t[k] - t0;
+                        let (qx, qy, qz) = (
+                            x[k] - (p0.x + v0.x * dt),
+                            y[k] - (p0.y + v0.y * dt),
+                            z[k] - (p0.z + v0.z * dt),
+                        );
+                        let r = f.radius(t[k]) + grow;
+                        *flag |= !(qx * qx + qy * qy + qz * qz >= r * r);
+                    }
+                }
+                ObstacleShape::Cylinder { .. } => {
+                    for (k, flag) in flags.iter_mut().enumerate() {
+                        let dt = t[k] - t0;
+                        let (qx, qy, qz) = (
+                            x[k] - (p0.x + v0.x * dt),
+                            y[k] - (p0.y + v0.y * dt),
+                            z[k] - (p0.z + v0.z * dt),
+                        );
+                        let r = f.radius(t[k]) + grow;
+                        let h = f.vertical_half_extent(t[k]) + grow;
+                        *flag |= !(qx * qx + qy * qy >= r * r || qz.abs() >= h);
+                    }
+                }
+            }
+        }
     }
 
     /// `L_o` at one node over **all** forecasts (no broad phase), gradient added into `grad`.
     /// Used to check the broad phase; prefer integrating the term.
     pub fn sample_all(&self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
-        self.accumulate(0..self.forecasts.len(), s, grad, 1.0)
+        self.accumulate(
+            0..self.forecasts.len(),
+            &s.p,
+            s.t,
+            1.0,
+            &mut grad.p,
+            &mut grad.t,
+        )
     }
 }
 
@@ -180,7 +269,7 @@ impl Integrand for DynamicObstacleTerm<'_> {
 
     #[inline]
     fn sample(&mut self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
-        self.sample_weighted(s, grad, 1.0)
+        self.at(&s.p, s.t, 1.0, &mut grad.p, &mut grad.t)
     }
 }
 

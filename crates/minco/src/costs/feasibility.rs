@@ -46,25 +46,28 @@ impl FeasibilityTerm {
         self.smoothing.mu()
     }
 
-    /// Unweighted `(f_max(φ_v), f_max(φ_a))` at one node; adds `weight · ∂L_d` into `grad`.
-    #[inline]
-    pub(crate) fn sample_parts(
+    /// Unweighted `(f_max(φ_v), f_max(φ_a))` at velocity `v` and acceleration `a`; adds
+    /// `weight · ∂L_d/∂v` into `grad_v` and `weight · ∂L_d/∂a` into `grad_a`.
+    #[inline(always)]
+    pub(crate) fn at(
         &self,
-        s: &SampleState,
-        grad: &mut SampleGrad,
+        v: &Vec3,
+        a: &Vec3,
         weight: f64,
+        grad_v: &mut Vec3,
+        grad_a: &mut Vec3,
     ) -> (f64, f64) {
-        let phi_v = s.v.norm_squared() * self.inv_v2 - 1.0;
-        let phi_a = s.a.norm_squared() * self.inv_a2 - 1.0;
+        let phi_v = v.norm_squared() * self.inv_v2 - 1.0;
+        let phi_a = a.norm_squared() * self.inv_a2 - 1.0;
         let mut out = (0.0, 0.0);
         if phi_v > 0.0 {
             let (value, slope) = self.smoothing.eval(phi_v);
-            grad.v += s.v * (2.0 * self.inv_v2 * weight * slope);
+            *grad_v += v * (2.0 * self.inv_v2 * weight * slope);
             out.0 = value;
         }
         if phi_a > 0.0 {
             let (value, slope) = self.smoothing.eval(phi_a);
-            grad.a += s.a * (2.0 * self.inv_a2 * weight * slope);
+            *grad_a += a * (2.0 * self.inv_a2 * weight * slope);
             out.1 = value;
         }
         out
@@ -74,7 +77,7 @@ impl FeasibilityTerm {
 impl Integrand for FeasibilityTerm {
     #[inline]
     fn sample(&mut self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
-        let (v, a) = self.sample_parts(s, grad, 1.0);
+        let (v, a) = self.at(&s.v, &s.a, 1.0, &mut grad.v, &mut grad.a);
         v + a
     }
 }

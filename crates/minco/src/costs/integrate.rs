@@ -5,6 +5,10 @@ use trust_core::{Aabb, Vec3};
 
 use crate::error::MincoError;
 
+mod fused;
+
+pub(crate) use fused::FILTER_MARGIN_M;
+
 /// A piecewise-quintic trajectory as the integrator reads it: absolute start time, `6n`
 /// coefficient rows (piece `i`, power `k` at row `6i + k`, ascending powers of local time) and `n`
 /// durations. This is the layout of [`crate::MincoS3::coeffs`].
@@ -129,6 +133,11 @@ pub trait Integrand {
 /// `∂I/∂c` is gathered per piece as the moments `Σ_k ω_k h ∂L/∂(d-th derivative) u_k^e`, which
 /// are turned into coefficient gradients once per piece (`β_d` of `s = uT` factorizes into
 /// `u^e T^e`).
+///
+/// The backends' objectives use a crate-private fast path for their fused penalties
+/// ([`PenaltyIntegrand`](crate::costs::PenaltyIntegrand)) that evaluates only the nodes where a
+/// penalty can be active and gives the same result bit for bit (module `fused`, tested against
+/// this generic path).
 #[derive(Debug, Clone)]
 pub struct TrapezoidIntegrator {
     kappa: usize,
@@ -140,13 +149,17 @@ pub struct TrapezoidIntegrator {
     boxes: Vec<Aabb>,
     /// Per piece, `Σ_k ω_k (T_i/κ) ∂L/∂t` (the dI-c coupling it sends to earlier pieces).
     coupling: Vec<f64>,
+    /// Scaled coefficients of every piece ([`TrapezoidIntegrator::integrate_penalties`]).
+    scaled: Vec<ScaledPiece>,
+    /// Column-wise node scratch of [`TrapezoidIntegrator::integrate_penalties`].
+    columns: fused::NodeColumns,
 }
 
 impl TrapezoidIntegrator {
     /// An integrator with `kappa` intervals per piece (`κ + 1` nodes); `kappa = 0` is raised to 1.
     pub fn new(kappa: usize) -> Self {
         let kappa = kappa.max(1);
-        let u_powers = (0..=kappa)
+        let u_powers: Vec<[f64; 6]> = (0..=kappa)
             .map(|k| {
                 let u = k as f64 / kappa as f64;
                 let mut pw = [1.0; 6];
@@ -158,10 +171,12 @@ impl TrapezoidIntegrator {
             .collect();
         Self {
             kappa,
+            columns: fused::NodeColumns::new(&u_powers),
             u_powers,
             nodes: Vec::new(),
             boxes: Vec::new(),
             coupling: Vec::new(),
+            scaled: Vec::new(),
         }
     }
 
@@ -334,6 +349,7 @@ fn integrate_piece<I: Integrand + ?Sized>(
 
 /// A piece's coefficients rescaled to the node fraction `u = s/T`: position, velocity,
 /// acceleration and jerk are `Σ_e X_e u^e` with the `X` below.
+#[derive(Debug, Clone, Copy)]
 struct ScaledPiece {
     p: [Vec3; 6],
     v: [Vec3; 5],
@@ -387,6 +403,67 @@ impl ScaledPiece {
         let j = self.j[0] + self.j[1] * u[1] + self.j[2] * u[2];
         [p, v, a, j]
     }
+
+    /// Position at the node with powers `u`.
+    #[inline(always)]
+    fn position(&self, u: &[f64; 6]) -> Vec3 {
+        self.p[0]
+            + self.p[1] * u[1]
+            + self.p[2] * u[2]
+            + self.p[3] * u[3]
+            + self.p[4] * u[4]
+            + self.p[5] * u[5]
+    }
+
+    /// Velocity at the node with powers `u`.
+    #[inline(always)]
+    fn velocity(&self, u: &[f64; 6]) -> Vec3 {
+        self.v[0] + self.v[1] * u[1] + self.v[2] * u[2] + self.v[3] * u[3] + self.v[4] * u[4]
+    }
+
+    /// Acceleration at the node with powers `u`.
+    #[inline(always)]
+    fn acceleration(&self, u: &[f64; 6]) -> Vec3 {
+        self.a[0] + self.a[1] * u[1] + self.a[2] * u[2] + self.a[3] * u[3]
+    }
+
+    /// Jerk at the node with powers `u`.
+    #[inline(always)]
+    fn jerk(&self, u: &[f64; 6]) -> Vec3 {
+        self.j[0] + self.j[1] * u[1] + self.j[2] * u[2]
+    }
+
+    /// The position's Bernstein (Bézier) control points on `u ∈ [0, 1]`,
+    /// `b_k = Σ_{e ≤ k} C(k, e)/C(5, e) X_e`: by the convex-hull property their convex hull
+    /// contains the whole piece, hence every node.
+    #[inline(always)]
+    fn bernstein_positions(&self) -> [Vec3; 6] {
+        let [p0, p1, p2, p3, p4, p5] = self.p;
+        [
+            p0,
+            p0 + p1 * 0.2,
+            p0 + p1 * 0.4 + p2 * 0.1,
+            p0 + p1 * 0.6 + p2 * 0.3 + p3 * 0.1,
+            p0 + p1 * 0.8 + p2 * 0.6 + p3 * 0.4 + p4 * 0.2,
+            p0 + p1 + p2 + p3 + p4 + p5,
+        ]
+    }
+}
+
+/// The box of a set of points (empty: inverted infinite box; NaN coordinates are skipped).
+#[inline(always)]
+fn points_box(points: &[Vec3]) -> Aabb {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for q in points {
+        for k in 0..3 {
+            lo[k] = if q[k] < lo[k] { q[k] } else { lo[k] };
+            hi[k] = if q[k] > hi[k] { q[k] } else { hi[k] };
+        }
+    }
+    Aabb {
+        min: Vec3::from(lo),
+        max: Vec3::from(hi),
+    }
 }
 
 /// Per-piece moments `M_{d,e} = Σ_k w_k ∂L/∂(d-th derivative)_k u_k^e` (`d = 0..3`,
@@ -424,6 +501,21 @@ impl Moments {
             for (m, ue) in self.j.iter_mut().zip(u) {
                 *m += gj * *ue;
             }
+        }
+    }
+
+    /// Adds the moments of one derivative order `d` (0: position, 1: velocity, 2:
+    /// acceleration) for the partial derivative `g` at a node of weight `w` and powers `u`.
+    #[inline(always)]
+    fn add_order(&mut self, order: usize, g: &Vec3, w: f64, u: &[f64; 6]) {
+        let gw = g * w;
+        let moments: &mut [Vec3] = match order {
+            0 => &mut self.p,
+            1 => &mut self.v,
+            _ => &mut self.a,
+        };
+        for (m, ue) in moments.iter_mut().zip(u) {
+            *m += gw * *ue;
         }
     }
 

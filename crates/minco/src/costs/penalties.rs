@@ -1,7 +1,7 @@
 //! All sampled penalties of the objective in one integrand: moving obstacles, static map, speed
 //! and acceleration, with their weights and their separate (unweighted) integrals.
 
-use trust_core::{Aabb, Forecast, Limits, StaticMap};
+use trust_core::{Aabb, Forecast, Limits, StaticMap, Vec3};
 
 use super::dynamic::DynamicObstacleTerm;
 use super::feasibility::FeasibilityTerm;
@@ -85,37 +85,119 @@ impl<'a> PenaltyIntegrand<'a> {
     pub fn integrals(&self) -> PenaltyIntegrals {
         self.integrals
     }
-}
 
-impl Integrand for PenaltyIntegrand<'_> {
-    fn begin_trajectory(&mut self, t_begin: f64, t_end: f64, samples_box: &Aabb) {
+    /// `(v_max², a_max²)` of the feasibility term.
+    #[inline]
+    pub(crate) fn squared_limits(&self) -> (f64, f64) {
+        let l = self.feasibility.limits();
+        (l.v_max * l.v_max, l.a_max * l.a_max)
+    }
+
+    /// Sets `flags[k]` for every node `k` (position `(x[k], y[k], z[k])`, time `t[k]`) that
+    /// may be within the clearance of an obstacle kept by the current piece's broad phase
+    /// (conservative: obstacles grown by a margin far above rounding; non-finite input is
+    /// flagged).
+    pub(crate) fn flag_obstacle_nodes(
+        &self,
+        x: &[f64],
+        y: &[f64],
+        z: &[f64],
+        t: &[f64],
+        flags: &mut [bool],
+    ) {
+        if self.dynamic_active {
+            self.dynamic.flag_nodes(x, y, z, t, flags);
+        }
+        if self.static_active {
+            self.static_map.flag_nodes(x, y, z, flags);
+        }
+    }
+
+    /// Broad phase of the moving-obstacle term for the whole trajectory (time window and box of
+    /// all samples).
+    #[inline]
+    pub(crate) fn begin_trajectory_obstacles(
+        &mut self,
+        t_begin: f64,
+        t_end: f64,
+        samples_box: &Aabb,
+    ) {
         self.dynamic
             .begin_trajectory_impl(t_begin, t_end, samples_box);
     }
 
-    fn begin_piece(&mut self, _piece: usize, t_begin: f64, t_end: f64, samples_box: &Aabb) -> bool {
+    /// Broad phase of the obstacle terms for one piece; `true` if any obstacle may be violated
+    /// at its samples (the feasibility term is evaluated at every sample regardless).
+    #[inline]
+    pub(crate) fn begin_piece_obstacles(
+        &mut self,
+        t_begin: f64,
+        t_end: f64,
+        samples_box: &Aabb,
+    ) -> bool {
         self.dynamic_active = self.dynamic.begin_piece_impl(t_begin, t_end, samples_box);
         self.static_active = self.static_map.begin_piece_impl(samples_box);
+        self.dynamic_active || self.static_active
+    }
+
+    /// `λ_o (L_o + L_s)` at position `p` and time `t` of a node of quadrature weight `w`; adds
+    /// `λ_o ∂/∂p` into `grad_p` and `λ_o ∂/∂t` into `grad_t`, records the unweighted integrals.
+    #[inline(always)]
+    pub(crate) fn obstacles_at(
+        &mut self,
+        p: &Vec3,
+        t: f64,
+        w: f64,
+        grad_p: &mut Vec3,
+        grad_t: &mut f64,
+    ) -> f64 {
+        let wo = self.obstacle_weight;
+        let mut total = 0.0;
+        if self.dynamic_active {
+            let l = self.dynamic.at(p, t, wo, grad_p, grad_t);
+            self.integrals.dynamic += w * l;
+            total += wo * l;
+        }
+        if self.static_active {
+            let l = self.static_map.at(p, wo, grad_p);
+            self.integrals.static_map += w * l;
+            total += wo * l;
+        }
+        total
+    }
+
+    /// `λ_d L_d` at velocity `v` and acceleration `a` of a node of quadrature weight `w`; adds
+    /// `λ_d ∂/∂v` into `grad_v` and `λ_d ∂/∂a` into `grad_a`, records the unweighted integrals.
+    #[inline(always)]
+    pub(crate) fn feasibility_at(
+        &mut self,
+        v: &Vec3,
+        a: &Vec3,
+        w: f64,
+        grad_v: &mut Vec3,
+        grad_a: &mut Vec3,
+    ) -> f64 {
+        let wd = self.feasibility_weight;
+        let (lv, la) = self.feasibility.at(v, a, wd, grad_v, grad_a);
+        self.integrals.speed += w * lv;
+        self.integrals.acceleration += w * la;
+        wd * (lv + la)
+    }
+}
+
+impl Integrand for PenaltyIntegrand<'_> {
+    fn begin_trajectory(&mut self, t_begin: f64, t_end: f64, samples_box: &Aabb) {
+        self.begin_trajectory_obstacles(t_begin, t_end, samples_box);
+    }
+
+    fn begin_piece(&mut self, _piece: usize, t_begin: f64, t_end: f64, samples_box: &Aabb) -> bool {
+        self.begin_piece_obstacles(t_begin, t_end, samples_box);
         true
     }
 
     #[inline]
     fn sample(&mut self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
-        let (wo, wd) = (self.obstacle_weight, self.feasibility_weight);
-        let mut total = 0.0;
-        if self.dynamic_active {
-            let l = self.dynamic.sample_weighted(s, grad, wo);
-            self.integrals.dynamic += s.weight * l;
-            total += wo * l;
-        }
-        if self.static_active {
-            let l = self.static_map.sample_weighted(s, grad, wo);
-            self.integrals.static_map += s.weight * l;
-            total += wo * l;
-        }
-        let (lv, la) = self.feasibility.sample_parts(s, grad, wd);
-        self.integrals.speed += s.weight * lv;
-        self.integrals.acceleration += s.weight * la;
-        total + wd * (lv + la)
+        let obstacles = self.obstacles_at(&s.p, s.t, s.weight, &mut grad.p, &mut grad.t);
+        obstacles + self.feasibility_at(&s.v, &s.a, s.weight, &mut grad.v, &mut grad.a)
     }
 }

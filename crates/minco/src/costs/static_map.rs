@@ -55,34 +55,79 @@ impl<'a> StaticObstacleTerm<'a> {
         self.use_esdf || !self.near.is_empty()
     }
 
-    /// Unweighted `L_s` at one node; adds `weight · ∂L_s/∂p` into `grad`.
-    #[inline]
-    pub(crate) fn sample_weighted(
-        &self,
-        s: &SampleState,
-        grad: &mut SampleGrad,
-        weight: f64,
-    ) -> f64 {
+    /// Unweighted `L_s` at `p`; adds `weight · ∂L_s/∂p` into `grad_p`.
+    #[inline(always)]
+    pub(crate) fn at(&self, p: &Vec3, weight: f64, grad_p: &mut Vec3) -> f64 {
         let shapes = self.map.shapes();
         let mut total = 0.0;
         let mut add = |(d, g): (f64, Vec3)| {
             let (value, slope) = self.smoothing.eval(self.clearance - d);
             if slope != 0.0 || value != 0.0 {
                 total += value;
-                grad.p -= g * (weight * slope);
+                *grad_p -= g * (weight * slope);
             }
         };
         for &i in &self.near {
-            if !beyond_clearance(&shapes[i], &s.p, self.clearance) {
-                add(shapes[i].distance_and_gradient(&s.p));
+            if !beyond_clearance(&shapes[i], p, self.clearance) {
+                add(shapes[i].distance_and_gradient(p));
             }
         }
         if self.use_esdf
             && let Some(esdf) = self.map.esdf()
         {
-            add(esdf.distance_and_gradient(&s.p));
+            add(esdf.distance_and_gradient(p));
         }
         total
+    }
+
+    /// Sets `flags[k]` for every node `k` (position `(x[k], y[k], z[k])`) that is not provably
+    /// farther than the clearance plus
+    /// [`FILTER_MARGIN_M`](crate::costs::integrate::FILTER_MARGIN_M) from a shape kept by the
+    /// piece's broad phase (the rejection of [`beyond_clearance`], column by column); every node
+    /// if the map has a voxel ESDF in use.
+    #[expect(
+        clippy::neg_cmp_op_on_partial_ord,
+        reason = "a NaN must count as possibly active"
+    )]
+    pub(crate) fn flag_nodes(&self, x: &[f64], y: &[f64], z: &[f64], flags: &mut [bool]) {
+        if self.use_esdf {
+            flags.fill(true);
+            return;
+        }
+        let m = flags.len();
+        let (x, y, z) = (&x[..m], &y[..m], &z[..m]);
+        let grow = self.clearance + crate::costs::integrate::FILTER_MARGIN_M;
+        let shapes = self.map.shapes();
+        for &i in &self.near {
+            match &shapes[i] {
+                Shape::Sphere(s) => {
+                    let (c, r) = (s.center, s.radius + grow);
+                    for (k, flag) in flags.iter_mut().enumerate() {
+                        let (qx, qy, qz) = (x[k] - c.x, y[k] - c.y, z[k] - c.z);
+                        *flag |= !(qx * qx + qy * qy + qz * qz >= r * r);
+                    }
+                }
+                Shape::Cylinder(cyl) => {
+                    let (c, r, h) = (cyl.center, cyl.radius + grow, cyl.half_height + grow);
+                    for (k, flag) in flags.iter_mut().enumerate() {
+                        let (qx, qy, qz) = (x[k] - c.x, y[k] - c.y, z[k] - c.z);
+                        *flag |= !(qx * qx + qy * qy >= r * r || qz.abs() >= h);
+                    }
+                }
+                Shape::AaBox(b) => {
+                    let (lo, hi) = (b.min.add_scalar(-grow), b.max.add_scalar(grow));
+                    for (k, flag) in flags.iter_mut().enumerate() {
+                        let outside = x[k] <= lo.x
+                            || x[k] >= hi.x
+                            || y[k] <= lo.y
+                            || y[k] >= hi.y
+                            || z[k] <= lo.z
+                            || z[k] >= hi.z;
+                        *flag |= !outside;
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -120,7 +165,7 @@ impl Integrand for StaticObstacleTerm<'_> {
 
     #[inline]
     fn sample(&mut self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
-        self.sample_weighted(s, grad, 1.0)
+        self.at(&s.p, 1.0, &mut grad.p)
     }
 }
 
