@@ -3,12 +3,12 @@
 
 use std::time::Instant;
 
-use trust_core::{PlanError, Scene, Solution, SolveStats, TrajRequest, TrajectoryBackend};
+use trust_core::{PlanError, Scene, Solution, TrajRequest, TrajectoryBackend};
 
 use super::init::initial_trajectory;
 use super::objective::MincoObjective;
 use super::params::MincoParams;
-use super::solve::{run_lbfgs, solve_status, validate_request};
+use super::solve::{solve_and_package, validate_request};
 
 /// MINCO (Wang et al., 2022) as the paper compares it: the trajectory ends **at rest at the end
 /// of the guide** (or of the warm-start trajectory); the inner waypoints and every piece duration
@@ -58,18 +58,13 @@ impl TrajectoryBackend for Minco {
         let mut x = vec![0.0; f.dimension()];
         let durations = vec![init.total_duration / n as f64; n];
         f.encode(&init.waypoints, &durations, &mut x)?;
-        let report = run_lbfgs(self.name(), &mut f, &mut x, &p.solver, req.deadline)?;
-        let mut g = vec![0.0; x.len()];
-        f.eval(&x, &mut g);
-        Ok(Solution {
-            traj: f.trajectory()?,
-            costs: f.breakdown(),
-            stats: SolveStats {
-                iteration_count: report.iteration_count,
-                evaluation_count: report.evaluation_count + 1,
-                elapsed: started.elapsed(),
-                status: solve_status(report.termination),
-            },
-        })
+        solve_and_package(
+            self.name(),
+            &mut f,
+            &mut x,
+            &p.solver,
+            req.deadline,
+            started,
+        )
     }
 }

@@ -568,6 +568,12 @@ pub(crate) trait SplitCost {
     fn cost(&mut self, x: &[f64], bound: f64) -> f64;
     /// `∇J` at the last cost's point.
     fn gradient(&mut self, g: &mut [f64]) -> Result<(), PlanError>;
+    /// Fused cost and gradient (sets the state that `trajectory` and `breakdown` read).
+    fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64;
+    /// The trajectory at the last evaluated point.
+    fn trajectory(&self) -> Result<PolyTraj, PlanError>;
+    /// The cost breakdown at the last evaluated point.
+    fn breakdown(&self) -> CostBreakdown;
 }
 
 impl SplitCost for UtfMincoObjective<'_> {
@@ -578,6 +584,18 @@ impl SplitCost for UtfMincoObjective<'_> {
     fn gradient(&mut self, g: &mut [f64]) -> Result<(), PlanError> {
         UtfMincoObjective::gradient(self, g)
     }
+
+    fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        UtfMincoObjective::eval(self, x, g)
+    }
+
+    fn trajectory(&self) -> Result<PolyTraj, PlanError> {
+        UtfMincoObjective::trajectory(self)
+    }
+
+    fn breakdown(&self) -> CostBreakdown {
+        UtfMincoObjective::breakdown(self)
+    }
 }
 
 impl SplitCost for MincoObjective<'_> {
@@ -587,6 +605,18 @@ impl SplitCost for MincoObjective<'_> {
 
     fn gradient(&mut self, g: &mut [f64]) -> Result<(), PlanError> {
         MincoObjective::gradient(self, g)
+    }
+
+    fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        MincoObjective::eval(self, x, g)
+    }
+
+    fn trajectory(&self) -> Result<PolyTraj, PlanError> {
+        MincoObjective::trajectory(self)
+    }
+
+    fn breakdown(&self) -> CostBreakdown {
+        MincoObjective::breakdown(self)
     }
 }
 

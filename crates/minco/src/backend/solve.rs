@@ -4,7 +4,8 @@
 use std::time::Instant;
 
 use trust_core::{
-    InitialGuess, PlanError, Scene, SolveStatus, TrajRequest, check_finite, check_finite_vec,
+    InitialGuess, PlanError, Scene, Solution, SolveStats, SolveStatus, TrajRequest, check_finite,
+    check_finite_vec,
 };
 use trust_lbfgs::{Deadline, Lbfgs, Report, SplitObjective, Termination};
 
@@ -86,6 +87,31 @@ pub(crate) fn run_lbfgs<O: SplitCost>(
         None => lbfgs.minimize_split(x, &mut split, &mut ()),
     }
     .map_err(wrap)
+}
+
+/// Runs [`run_lbfgs`] from `x`, re-evaluates at the returned point (the breakdown and the
+/// trajectory belong to it) and packages the [`Solution`] with its statistics since `started`.
+pub(crate) fn solve_and_package<O: SplitCost>(
+    component: &str,
+    objective: &mut O,
+    x: &mut [f64],
+    solver: &SolverParams,
+    deadline: Option<Instant>,
+    started: Instant,
+) -> Result<Solution, PlanError> {
+    let report = run_lbfgs(component, objective, x, solver, deadline)?;
+    let mut g = vec![0.0; x.len()];
+    objective.eval(x, &mut g);
+    Ok(Solution {
+        traj: objective.trajectory()?,
+        costs: objective.breakdown(),
+        stats: SolveStats {
+            iteration_count: report.iteration_count,
+            evaluation_count: report.evaluation_count + 1,
+            elapsed: started.elapsed(),
+            status: solve_status(report.termination),
+        },
+    })
 }
 
 /// An objective as a [`SplitObjective`]: a gradient that cannot be computed is reported to the

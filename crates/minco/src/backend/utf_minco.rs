@@ -3,12 +3,12 @@
 
 use std::time::Instant;
 
-use trust_core::{PlanError, Scene, Solution, SolveStats, TrajRequest, TrajectoryBackend};
+use trust_core::{PlanError, Scene, Solution, TrajRequest, TrajectoryBackend};
 
 use super::init::initial_trajectory;
 use super::objective::UtfMincoObjective;
 use super::params::UtfMincoParams;
-use super::solve::{run_lbfgs, solve_status, validate_request};
+use super::solve::{solve_and_package, validate_request};
 
 /// UTF-MINCO: minimizes `J = λ · [H_t, H_s, I_o, I_d, I_e]` (paper eq. design-of-J) over the
 /// inner waypoints, the free terminal position and velocity and the total duration
@@ -61,19 +61,13 @@ impl TrajectoryBackend for UtfMinco {
             init.total_duration,
             &mut x,
         )?;
-        let report = run_lbfgs(self.name(), &mut f, &mut x, &p.solver, req.deadline)?;
-        // Re-evaluate at the returned point: the breakdown and the trajectory belong to it.
-        let mut g = vec![0.0; x.len()];
-        f.eval(&x, &mut g);
-        Ok(Solution {
-            traj: f.trajectory()?,
-            costs: f.breakdown(),
-            stats: SolveStats {
-                iteration_count: report.iteration_count,
-                evaluation_count: report.evaluation_count + 1,
-                elapsed: started.elapsed(),
-                status: solve_status(report.termination),
-            },
-        })
+        solve_and_package(
+            self.name(),
+            &mut f,
+            &mut x,
+            &p.solver,
+            req.deadline,
+            started,
+        )
     }
 }
