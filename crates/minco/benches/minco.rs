@@ -6,11 +6,18 @@
 //! - `energy_grads_propagation`: energy, `∂E/∂c`, explicit `∂E/∂T`, and the adjoint propagation to
 //!   waypoints, durations and head/tail (coefficients already solved);
 //! - `whole_chain`: both of the above.
+//! - `library_lu`: why we have our own banded LU — the same MINCO system `A(T) c = b` (6n × 6n,
+//!   3 right-hand sides) factorized and solved by faer's dense partial-pivoting LU (the fastest
+//!   pure-Rust dense LU we know; nalgebra has no banded solver either), against our general
+//!   [`BandedMatrix`] and the structured elimination inside [`MincoS3`] (`coefficients`).
 
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use faer::Mat;
+use faer::prelude::Solve;
 use nalgebra::Vector3;
+use trust_minco::BandedMatrix;
 use trust_minco::minco::{BoundaryState, MincoGrad, MincoS3};
 
 struct Problem {
@@ -121,11 +128,46 @@ fn bench_minco(c: &mut Criterion) {
     group.finish();
 }
 
+fn bench_library_lu(c: &mut Criterion) {
+    // Single-threaded, like our solver (and fair to faer: no thread-pool overhead on 96 × 96).
+    faer::set_global_parallelism(faer::Par::Seq);
+    let mut group = c.benchmark_group("library_lu");
+    for &n in &[8usize, 16, 32] {
+        let p = reference_problem(n);
+        let mut minco = MincoS3::new(n).expect("n >= 1");
+        solve(&mut minco, &p);
+        let (banded, rhs): (BandedMatrix, Vec<Vector3<f64>>) = minco.system();
+        let size = banded.size();
+        let dense = Mat::from_fn(size, size, |i, j| banded.get(i, j).unwrap_or(0.0));
+        let dense_rhs = Mat::from_fn(size, 3, |i, j| rhs[i][j]);
+        group.bench_with_input(BenchmarkId::new("faer_dense_plu", n), &n, |bench, _| {
+            bench.iter(|| {
+                let lu = black_box(&dense).partial_piv_lu();
+                black_box(lu.solve(black_box(&dense_rhs)));
+            });
+        });
+        group.bench_with_input(
+            BenchmarkId::new("ours_general_banded", n),
+            &n,
+            |bench, _| {
+                bench.iter(|| {
+                    let mut a = black_box(&banded).clone();
+                    a.factorize().expect("MINCO system factorizes");
+                    let mut x = rhs.clone();
+                    a.solve_vec3(&mut x).expect("factorized");
+                    black_box(x);
+                });
+            },
+        );
+    }
+    group.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default()
         .warm_up_time(std::time::Duration::from_millis(500))
         .measurement_time(std::time::Duration::from_secs(2));
-    targets = bench_minco
+    targets = bench_minco, bench_library_lu
 }
 criterion_main!(benches);
