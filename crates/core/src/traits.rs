@@ -58,6 +58,9 @@ pub struct SearchStats {
     pub elapsed: Duration,
     /// Whether the time or sample budget stopped the roadmap construction.
     pub budget_exhausted: bool,
+    /// Whether sampling stopped because the roadmap stopped growing (DEV-PRM's `stall_samples`
+    /// rule) rather than on a budget.
+    pub stalled: bool,
 }
 
 /// Finds homotopy-distinct guide paths from the start toward the goal (paper Sec. III-B).

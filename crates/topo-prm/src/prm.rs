@@ -268,6 +268,7 @@ pub(crate) fn run(
     if random >= setup.max_samples {
         stats.budget_exhausted = true;
     }
+    stats.stalled = stall.stalled();
     let graph = builder.finish();
     stats.node_count = graph.alive_count();
 

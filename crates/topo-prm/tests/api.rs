@@ -284,6 +284,7 @@ fn devprm_stops_sampling_when_the_roadmap_stalls() {
         .search(&q, &scene, &mut Rng::seed_from_u64(4))
         .unwrap();
     assert!(!stalled.stats.budget_exhausted);
+    assert!(stalled.stats.stalled);
     assert!(
         (100..3000).contains(&stalled.stats.sample_count),
         "{}",
@@ -294,6 +295,7 @@ fn devprm_stops_sampling_when_the_roadmap_stalls() {
         .search(&q, &scene, &mut Rng::seed_from_u64(4))
         .unwrap();
     assert!(full.stats.budget_exhausted);
+    assert!(!full.stats.stalled);
     assert_eq!(full.stats.sample_count, 3000);
     assert!(
         DevPrmParams {
