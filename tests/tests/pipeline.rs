@@ -37,6 +37,7 @@ fn request<'a>(case: &E2Case, guide: &'a GuidePath) -> TrajRequest<'a> {
         limits: case.limits,
         initial: InitialGuess::Guide(guide),
         deadline: None,
+        horizon_s: None,
     }
 }
 
@@ -158,6 +159,7 @@ fn dev_prm_guides_utf_minco_to_collision_free_trajectories() {
             limits: query.limits,
             initial: InitialGuess::Guide(path),
             deadline: None,
+            horizon_s: None,
         };
         let sol = backend.optimize(&req, &scene).unwrap();
         assert!(min_static_clearance(&sol.traj, &scene) > -1e-3);

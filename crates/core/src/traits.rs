@@ -126,6 +126,13 @@ pub struct TrajRequest<'a> {
     /// Optional hard deadline on a monotonic clock; the backend returns its best iterate with
     /// [`crate::SolveStatus::TimeLimit`] when it passes.
     pub deadline: Option<Instant>,
+    /// Planning horizon `T_h` (s) of a receding-horizon planner, or `None` to plan all the way to
+    /// the goal. With a horizon, a free-terminal backend (UTF-MINCO) pulls its terminal only to
+    /// the goal guidance surface `‖p − p_g‖ = r_des`, `r_des = max(0, ‖p_s − p_g‖ − T_h·v_max)`
+    /// (paper Sec. III-B, the surface DEV-PRM's paths end on), so that the trajectory covers about
+    /// one horizon instead of the whole remaining distance; near the goal (`r_des = 0`) it is the
+    /// paper's `H_s` toward the goal itself. Fixed-terminal backends ignore it.
+    pub horizon_s: Option<f64>,
 }
 
 impl TrajRequest<'_> {
@@ -134,6 +141,9 @@ impl TrajRequest<'_> {
         self.start.validate("request.start")?;
         check_finite_vec("request.goal", &self.goal)?;
         self.limits.validate()?;
+        if let Some(h) = self.horizon_s {
+            check_positive("request.horizon_s", h)?;
+        }
         Ok(())
     }
 }

@@ -118,6 +118,7 @@ fn solve(case: &E2Case, backend: &dyn TrajectoryBackend) -> PolyTraj {
         limits: case.limits,
         initial: InitialGuess::Guide(&guide),
         deadline: None,
+        horizon_s: None,
     };
     backend
         .optimize(&req, &case.scene())
@@ -134,6 +135,7 @@ fn warm_resolve(case: &E2Case, backend: &dyn TrajectoryBackend, previous: &PolyT
         limits: case.limits,
         initial: InitialGuess::WarmStart(previous),
         deadline: None,
+        horizon_s: None,
     };
     let scene = Scene {
         t0: t,

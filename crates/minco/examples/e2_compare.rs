@@ -69,6 +69,7 @@ fn warm_resolve(
         limits: case.limits,
         initial: InitialGuess::WarmStart(previous),
         deadline: None,
+        horizon_s: None,
     };
     let scene = Scene {
         t0: t,
@@ -101,6 +102,7 @@ fn run(case: &E2Case, backend: &dyn TrajectoryBackend, repeats: usize) -> Result
         limits: case.limits,
         initial: InitialGuess::Guide(&guide),
         deadline: None,
+        horizon_s: None,
     };
     let scene = case.scene();
     let mut times = Vec::with_capacity(repeats);
@@ -192,6 +194,7 @@ fn random_stats(
             limits: case.limits,
             initial: InitialGuess::Guide(&guide),
             deadline: None,
+            horizon_s: None,
         };
         let scene = case.scene();
         let mut times = Vec::with_capacity(repeats);

@@ -27,6 +27,7 @@
 //!     limits: case.limits,
 //!     initial: InitialGuess::Guide(&guide),
 //!     deadline: None,
+//!     horizon_s: None,
 //! };
 //! let solution = UtfMinco::default().optimize(&req, &case.scene())?;
 //! assert!(solution.traj.duration() > 0.0);
@@ -47,4 +48,4 @@ pub use objective::{MincoObjective, UtfMincoObjective};
 pub use params::{MincoParams, PieceParams, SolverParams, UtfMincoParams};
 pub use solve::{solve_status, validate_request};
 pub use time_map::{positive_time, positive_time_inverse};
-pub use utf_minco::UtfMinco;
+pub use utf_minco::{UtfMinco, guidance_radius};

@@ -140,6 +140,7 @@
 //!     limits: case.limits,
 //!     initial: InitialGuess::Guide(&guide),
 //!     deadline: None,
+//!     horizon_s: None,
 //! };
 //! let scene = case.scene();
 //! let solution = UtfMinco::default().optimize(&req, &scene)?;

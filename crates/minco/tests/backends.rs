@@ -19,6 +19,7 @@ fn request<'a>(case: &E2Case, guide: &'a GuidePath) -> TrajRequest<'a> {
         limits: case.limits,
         initial: InitialGuess::Guide(guide),
         deadline: None,
+        horizon_s: None,
     }
 }
 
@@ -166,6 +167,7 @@ fn start_on_the_goal_hovers() {
             limits: Limits::default(),
             initial: InitialGuess::Guide(&guide),
             deadline: None,
+            horizon_s: None,
         };
         let solution = backend.optimize(&req, &scene).expect("valid");
         assert_valid(&solution, &start, &req.limits, &scene, backend.name());
@@ -199,6 +201,7 @@ fn single_point_guide_with_a_moving_start() {
             limits: Limits::default(),
             initial: InitialGuess::Guide(&guide),
             deadline: None,
+            horizon_s: None,
         };
         let solution = backend.optimize(&req, &scene).expect("valid");
         assert_valid(&solution, &start, &req.limits, &scene, backend.name());
@@ -209,6 +212,7 @@ fn single_point_guide_with_a_moving_start() {
         limits: Limits::default(),
         initial: InitialGuess::Guide(&guide),
         deadline: None,
+        horizon_s: None,
     };
     let utf = UtfMinco::default().optimize(&req, &scene).expect("valid");
     let end = utf.traj.position(utf.traj.t_end());
@@ -231,6 +235,7 @@ fn no_obstacles_straight_flight() {
         limits: Limits::default(),
         initial: InitialGuess::Guide(&guide),
         deadline: None,
+        horizon_s: None,
     };
     for backend in backends() {
         let solution = backend.optimize(&req, &scene).expect("valid");
@@ -421,6 +426,7 @@ fn evaluation_budget_and_deadline_are_respected() {
     for backend in backends() {
         let req = TrajRequest {
             deadline: Some(Instant::now()),
+            horizon_s: None,
             ..request(&case, &guide)
         };
         let solution = backend.optimize(&req, &case.scene()).expect("valid");
@@ -452,6 +458,7 @@ fn warm_start_from_a_previous_solution() {
         limits: case.limits,
         initial: InitialGuess::WarmStart(&first.traj),
         deadline: None,
+        horizon_s: None,
     };
     let second = backend.optimize(&req, &case.scene()).expect("valid");
     assert_valid(&second, &start, &case.limits, &case.scene(), "warm start");
@@ -501,6 +508,7 @@ fn forecasts_matter_only_when_near() {
         limits: Limits::default(),
         initial: InitialGuess::Guide(&guide),
         deadline: None,
+        horizon_s: None,
     };
     let a = UtfMinco::default()
         .optimize(&req, &Scene::new(&map, &[], 0.0).expect("scene"))

@@ -412,9 +412,27 @@ fn check_utf(
     obstacles: bool,
     limits: Limits,
 ) -> Result<(), TestCaseError> {
+    check_utf_with_surface(seed, n, weights, obstacles, limits, false)
+}
+
+/// [`check_utf`], optionally with the goal guidance surface of a receding-horizon request placed
+/// within ±1.5 m of the terminal (both sides and the smoothing band get exercised).
+fn check_utf_with_surface(
+    seed: u64,
+    n: usize,
+    weights: CostWeights,
+    obstacles: bool,
+    limits: Limits,
+    surface: bool,
+) -> Result<(), TestCaseError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let prob = random_problem(&mut rng, n);
     let params = utf_params(weights);
+    let surface_radius = if surface {
+        ((prob.end - prob.goal).norm() + rng.random_range(-1.5..1.5)).max(0.1)
+    } else {
+        0.0
+    };
     // First pass without obstacles, to place them on the trajectory.
     let empty = big_map();
     let scene = Scene::new(&empty, &[], 0.0).expect("scene");
@@ -449,6 +467,7 @@ fn check_utf(
     let scene = Scene::new(&map, &forecasts, prob.start.t).expect("scene");
     let mut f = UtfMincoObjective::new(&scene, &prob.start, prob.goal, limits, &params, n)
         .expect("objective");
+    f.set_guidance_surface(surface_radius);
     let cost = f.eval(&x, &mut g);
     prop_assert!(cost.is_finite());
     if obstacles {
@@ -551,6 +570,15 @@ proptest! {
             check_utf(seed, n, only(term), true, Limits::new(3.0, 4.0).expect("limits"))
                 .map_err(|e| TestCaseError::fail(format!("{term}: {e}")))?;
         }
+    }
+
+    /// Full UTF-MINCO objective of a receding-horizon request (terminal pulled to the goal
+    /// guidance surface), all terms and the terminal term alone.
+    #[test]
+    fn utf_minco_guidance_surface_gradient(seed in any::<u64>(), n in 1usize..6) {
+        let limits = Limits::new(3.0, 4.0).expect("limits");
+        check_utf_with_surface(seed, n, CostWeights::default(), true, limits, true)?;
+        check_utf_with_surface(seed, n, only("terminal"), false, limits, true)?;
     }
 
     /// Full MINCO objective with penetrated obstacles w.r.t. every decision variable.

@@ -264,6 +264,13 @@ impl<'a> UtfMincoObjective<'a> {
         &self.terminal
     }
 
+    /// Pulls the free terminal only to the goal guidance surface of radius `radius` (m) around
+    /// the goal instead of the goal itself ([`TerminalCost::eval_objective`]); 0 restores the
+    /// paper's `H_s`. [`crate::UtfMinco`] sets it from [`trust_core::TrajRequest::horizon_s`].
+    pub fn set_guidance_surface(&mut self, radius: f64) {
+        self.terminal = self.terminal.clone().with_guidance_surface(radius);
+    }
+
     /// Writes the decision vector for the given waypoints, terminal state and total duration
     /// (clamped to just above the minimum `n·T_min`).
     ///
@@ -330,16 +337,22 @@ impl<'a> UtfMincoObjective<'a> {
         let total = self.min_total + t_map;
         self.core.durations.fill(total / n as f64);
         self.core.tail = [p_f, v_f, Vec3::zeros()];
-        let (hs, hs_p, hs_v) = self.terminal.eval(&p_f, &v_f);
+        let (hs_objective, hs_p, hs_v) = self.terminal.eval_objective(&p_f, &v_f);
         let (w_time, w_terminal) = (self.core.weights.time, self.core.weights.terminal);
-        let base = w_time * total + w_terminal * hs;
+        let base = w_time * total + w_terminal * hs_objective;
         let (integral, terms) = match self.core.evaluate_cost(base, bound) {
             Ok(Partial::Complete(integral, terms)) => (integral, terms),
             Ok(Partial::Above(partial)) => return partial,
             Err(_) => return f64::INFINITY,
         };
-        let cost = w_time * total + w_terminal * hs + integral;
+        let cost = w_time * total + w_terminal * hs_objective + integral;
         self.terminal_grad = (hs_p, hs_v, dt_dtau);
+        // The breakdown reports the paper's H_s (toward the goal itself) for branch ranking.
+        let hs = if self.terminal.surface_radius > 0.0 {
+            self.terminal.eval(&p_f, &v_f).0
+        } else {
+            hs_objective
+        };
         record_cost(cost, &mut self.core, [total, hs], terms)
     }
 

@@ -3,12 +3,19 @@
 
 use std::time::Instant;
 
-use trust_core::{PlanError, Scene, Solution, TrajRequest, TrajectoryBackend};
+use trust_core::{Limits, PlanError, Scene, Solution, TrajRequest, TrajectoryBackend, Vec3};
 
 use super::init::initial_trajectory;
 use super::objective::UtfMincoObjective;
 use super::params::UtfMincoParams;
 use super::solve::{solve_and_package, validate_request};
+
+/// Radius `r_des = max(0, ‖p_s − p_g‖ − T_h·v_max)` of the goal guidance surface for a vehicle at
+/// `start` with horizon `horizon_s` (paper Algorithm 2, line 1); 0 for non-finite input.
+pub fn guidance_radius(start: &Vec3, goal: &Vec3, horizon_s: f64, limits: &Limits) -> f64 {
+    let r = (start - goal).norm() - horizon_s * limits.v_max;
+    if r.is_finite() { r.max(0.0) } else { 0.0 }
+}
 
 /// UTF-MINCO: minimizes `J = λ · [H_t, H_s, I_o, I_d, I_e]` (paper eq. design-of-J) over the
 /// inner waypoints, the free terminal position and velocity and the total duration
@@ -18,6 +25,9 @@ use super::solve::{solve_and_package, validate_request};
 ///   a previous trajectory sampled at uniform times).
 /// - Budget: `params.solver.max_evaluations` and the request's deadline (checked once per
 ///   iteration); the status says which stopped the solve.
+/// - Receding horizon: with [`TrajRequest::horizon_s`] the terminal is pulled to the goal
+///   guidance surface ([`guidance_radius`], [`crate::costs::TerminalCost::eval_objective`]) so the
+///   trajectory spans about one horizon; the reported `H_s` is the paper's, toward the goal.
 /// - The returned trajectory starts at `req.start` (position, velocity, acceleration, time) and
 ///   is finite; the cost breakdown is evaluated at it.
 #[derive(Debug, Clone, Default)]
@@ -53,6 +63,14 @@ impl TrajectoryBackend for UtfMinco {
         let init = initial_trajectory(&req.initial, &req.start, &req.limits, &p.pieces);
         let mut f =
             UtfMincoObjective::new(scene, &req.start, req.goal, req.limits, p, init.pieces())?;
+        if let Some(horizon) = req.horizon_s {
+            f.set_guidance_surface(guidance_radius(
+                &req.start.p,
+                &req.goal,
+                horizon,
+                &req.limits,
+            ));
+        }
         let mut x = vec![0.0; f.dimension()];
         f.encode(
             &init.waypoints,

@@ -83,6 +83,10 @@ pub struct PenaltyParams {
     /// `ε` of the smoothed norm `√(xᵀKx + ε²) − ε` that replaces `‖x‖_K` in `H_s` (the plain
     /// norm is not differentiable at 0, where L-BFGS would stall on the goal).
     pub terminal_norm_epsilon: f64,
+    /// Width (m) of the smoothed max that measures how far the free terminal lies outside the
+    /// goal guidance surface when the request has a planning horizon
+    /// ([`crate::costs::TerminalCost::eval_objective`]).
+    pub guidance_smoothing_m: f64,
 }
 
 impl Default for PenaltyParams {
@@ -95,6 +99,9 @@ impl Default for PenaltyParams {
     ///   distances `v²/(2a) = 3.3 m` at the paper's limits (10 m/s, 15 m/s²).
     /// - `K_p = K_ṗ = I`: the paper gives no values; the weight `λ_s` scales both.
     /// - `terminal_norm_epsilon = 1e-2`: ours (1 cm / 1 cm/s of smoothing).
+    /// - `guidance_smoothing_m = 1`: ours. The terminal settles where the surface term's slope
+    ///   balances the time cost, a few centimetres outside the surface at the default weights; a
+    ///   width of the order of the piece spacing keeps the term's curvature moderate for L-BFGS.
     fn default() -> Self {
         Self {
             samples_per_piece: 16,
@@ -105,6 +112,7 @@ impl Default for PenaltyParams {
             terminal_position_gains: Vec3::new(1.0, 1.0, 1.0),
             terminal_velocity_gains: Vec3::new(1.0, 1.0, 1.0),
             terminal_norm_epsilon: 1e-2,
+            guidance_smoothing_m: 1.0,
         }
     }
 }
@@ -140,6 +148,10 @@ impl PenaltyParams {
         check_positive(
             &format!("{prefix}.terminal_norm_epsilon"),
             self.terminal_norm_epsilon,
+        )?;
+        check_positive(
+            &format!("{prefix}.guidance_smoothing_m"),
+            self.guidance_smoothing_m,
         )?;
         Ok(())
     }

@@ -3,7 +3,7 @@
 
 use trust_core::Vec3;
 
-use super::PenaltyParams;
+use super::{PenaltyParams, SmoothedL1};
 
 /// `H_t = T_Σ` and `∂H_t/∂T_Σ = 1` (paper Sec. III-D, "Flight duration cost").
 #[inline]
@@ -50,6 +50,11 @@ pub struct TerminalCost {
     pub alpha: f64,
     /// Smoothing `ε` of the norms.
     pub epsilon: f64,
+    /// Radius `r_des` (m) of the goal guidance surface the objective pulls the terminal to
+    /// ([`TerminalCost::eval_objective`]); 0: the goal itself (the paper's `H_s`).
+    pub surface_radius: f64,
+    /// Width (m) of the smoothed max at the surface.
+    pub surface_smoothing: f64,
 }
 
 impl TerminalCost {
@@ -62,7 +67,20 @@ impl TerminalCost {
             velocity_gains: params.terminal_velocity_gains,
             alpha: terminal_velocity_weight((start_position - goal).norm(), params.goal_radius_m),
             epsilon: params.terminal_norm_epsilon,
+            surface_radius: 0.0,
+            surface_smoothing: params.guidance_smoothing_m,
         }
+    }
+
+    /// The same cost with the terminal pulled only to the goal guidance surface of radius
+    /// `radius` (m; non-finite or negative values mean 0): see [`Self::eval_objective`].
+    pub fn with_guidance_surface(mut self, radius: f64) -> Self {
+        self.surface_radius = if radius.is_finite() {
+            radius.max(0.0)
+        } else {
+            0.0
+        };
+        self
     }
 
     /// `(H_s, ∂H_s/∂p_f, ∂H_s/∂ṗ_f)`.
@@ -71,6 +89,28 @@ impl TerminalCost {
             smoothed_weighted_norm(&(p_f - self.goal), &self.position_gains, self.epsilon);
         let (hv, gv) = smoothed_weighted_norm(v_f, &self.velocity_gains, self.epsilon);
         (hp + self.alpha * hv, gp, gv * self.alpha)
+    }
+
+    /// The terminal term the backend minimizes and its gradients `(H̃_s, ∂/∂p_f, ∂/∂ṗ_f)`.
+    ///
+    /// Without a guidance surface (`surface_radius == 0`) it is [`Self::eval`]. With one, the
+    /// position part measures how far the terminal is *outside the ball* of radius `r_des`
+    /// around the goal: `f_max(‖p_f − p_g‖_{K,ε} − r_des) + α‖ṗ_f‖_{K,ε}` with the C² smoothed
+    /// max of width `surface_smoothing` ([`SmoothedL1`]). A receding-horizon planner thereby ends
+    /// its trajectory on the goal guidance surface of paper Sec. III-B (where DEV-PRM's guide
+    /// paths end) instead of stretching it over the whole remaining distance: inside the ball only
+    /// the flight time `H_t` acts, which pulls the terminal back onto the surface. The reported
+    /// `H_s` stays the paper's ([`Self::eval`]), so branch ranking is unchanged.
+    pub fn eval_objective(&self, p_f: &Vec3, v_f: &Vec3) -> (f64, Vec3, Vec3) {
+        if self.surface_radius <= 0.0 {
+            return self.eval(p_f, v_f);
+        }
+        let (hp, gp) =
+            smoothed_weighted_norm(&(p_f - self.goal), &self.position_gains, self.epsilon);
+        let (outside, slope) =
+            SmoothedL1::new(self.surface_smoothing).eval(hp - self.surface_radius);
+        let (hv, gv) = smoothed_weighted_norm(v_f, &self.velocity_gains, self.epsilon);
+        (outside + self.alpha * hv, gp * slope, gv * self.alpha)
     }
 }
 
@@ -97,6 +137,68 @@ mod tests {
         let exact = x.dot(&k.component_mul(&x)).sqrt();
         let (v, _) = smoothed_weighted_norm(&x, &k, 0.01);
         assert!((v - exact).abs() <= 0.01);
+    }
+
+    #[test]
+    fn guidance_surface_relaxes_only_the_position_part() {
+        let params = PenaltyParams::default();
+        let goal = Vec3::new(50.0, 0.0, 0.0);
+        let plain = TerminalCost::new(goal, &Vec3::zeros(), &params);
+        let relaxed = plain.clone().with_guidance_surface(20.0);
+        let v = Vec3::new(1.0, 0.0, 0.0);
+        // r_des = 0 is the paper's H_s, bit for bit.
+        let p = Vec3::new(10.0, 3.0, 0.0);
+        assert_eq!(
+            plain
+                .clone()
+                .with_guidance_surface(0.0)
+                .eval_objective(&p, &v),
+            plain.eval(&p, &v)
+        );
+        assert_eq!(
+            plain.clone().with_guidance_surface(f64::NAN).surface_radius,
+            0.0
+        );
+        // Inside the ball: no position cost and no position gradient.
+        let (h, gp, _) = relaxed.eval_objective(&Vec3::new(40.0, 0.0, 0.0), &v);
+        assert_eq!((h, gp), (0.0, Vec3::zeros()));
+        // Far outside: the distance to the surface minus half the smoothing width.
+        let (h, gp, _) = relaxed.eval_objective(&Vec3::zeros(), &v);
+        // (The smoothed norm is `ε` short of the distance.)
+        assert_relative_eq!(h, 30.0 - params.guidance_smoothing_m / 2.0, epsilon = 2e-2);
+        assert_relative_eq!(gp, Vec3::new(-1.0, 0.0, 0.0), epsilon = 1e-6);
+    }
+
+    #[test]
+    fn guidance_surface_gradient_matches_finite_differences() {
+        let mut params = PenaltyParams::default();
+        params.goal_radius_m = 100.0; // α > 0: the velocity part is active too
+        let goal = Vec3::new(12.0, -3.0, 2.0);
+        let cost =
+            TerminalCost::new(goal, &Vec3::new(1.0, 0.0, 0.0), &params).with_guidance_surface(10.0);
+        // Points on both sides of the surface and inside the smoothing band.
+        for p in [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.7, -2.9, 1.0),
+            Vec3::new(2.3, -3.0, 2.0),
+            Vec3::new(12.0, 6.8, 2.1),
+        ] {
+            let v = Vec3::new(0.3, -2.0, 1.0);
+            let (_, gp, gv) = cost.eval_objective(&p, &v);
+            let h = 1e-6;
+            for k in 0..3 {
+                let mut e = Vec3::zeros();
+                e[k] = h;
+                let fd_p = (cost.eval_objective(&(p + e), &v).0
+                    - cost.eval_objective(&(p - e), &v).0)
+                    / (2.0 * h);
+                let fd_v = (cost.eval_objective(&p, &(v + e)).0
+                    - cost.eval_objective(&p, &(v - e)).0)
+                    / (2.0 * h);
+                assert_relative_eq!(gp[k], fd_p, epsilon = 1e-6);
+                assert_relative_eq!(gv[k], fd_v, epsilon = 1e-6);
+            }
+        }
     }
 
     #[test]
