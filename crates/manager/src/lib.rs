@@ -1,7 +1,73 @@
-//! # trust-manager — multi-branch spatio-temporal trajectory manager (not built yet)
+//! # trust-manager — the multi-branch spatio-temporal trajectory manager of TRUST-Planner
 //!
-//! This crate will hold Algorithm 1 of the paper (Sec. III-A, "Incremental Planning of TRUST-Planner"):
-//! a priority queue of up to N homotopy-distinct trajectory branches, marched, replanned and explored
-//! every cycle. It is generic over the three traits of `trust-core` and is filled by the manager issue;
-//! today it exports nothing, so that nothing pretends to work.
+//! [`Manager`] implements Algorithm 1 of the paper (Sec. III-A, "Incremental Planning of
+//! TRUST-Planner", Fig. topological-update): a priority queue of up to `N` trajectory branches of
+//! distinct spatio-temporal homotopy, ranked by `J = λ_t·H_t + λ_s·H_s + λ_e·I_e` (Table Sim-B-1).
+//! Every cycle it marches the main branch forward, replans the sub-branches from the current
+//! state, explores new branches from the frontend's paths, deduplicates them with the homotopy
+//! checker and keeps the `N` best; the main branch is the plan the vehicle flies.
+//!
+//! It is generic over the three traits of `trust-core` — `Manager<F: PathFrontend,
+//! B: TrajectoryBackend, H: HomotopyChecker>` — so the paper's baselines are the same manager with
+//! other parts and parameters ([`ManagerParams::single_branch`] with a straight-line or sparse-A*
+//! frontend for baselines 1 and 2, [`ManagerParams::multi_branch_without_history`] for baseline 3).
+//!
+//! Beyond the paper (each documented where it lives):
+//! - plans join continuously: the replan starts from the committed plan at `now + latency`;
+//! - every kept branch passes a safety check each cycle, continuous in time with a proven step
+//!   ([`check_trajectory`]), against the static map and the current forecasts;
+//! - the main branch switches with hysteresis ([`ManagerParams::hysteresis`]);
+//! - with no feasible branch the plan is a braking fallback along the last safe trajectory
+//!   ([`brake_along`]), and the report says whether it is collision-free under the forecasts;
+//! - each cycle returns a serializable [`StepReport`] (branches, events, timing split).
+//!
+//! ```
+//! use trust_core::{Aabb, Limits, Scene, State, StaticMap, Vec3};
+//! use trust_manager::{Manager, ManagerParams};
+//! # use trust_core::*;
+//! # struct Line;
+//! # impl PathFrontend for Line {
+//! #     fn name(&self) -> &str { "line" }
+//! #     fn search(&self, q: &PathQuery, _: &Scene<'_>, _: &mut Rng) -> Result<SearchResult, PlanError> {
+//! #         Ok(SearchResult { paths: vec![GuidePath::new(vec![q.start.p, q.goal])?], ..Default::default() })
+//! #     }
+//! # }
+//! # struct Hold;
+//! # impl TrajectoryBackend for Hold {
+//! #     fn name(&self) -> &str { "hold" }
+//! #     fn optimize(&self, r: &TrajRequest<'_>, _: &Scene<'_>) -> Result<Solution, PlanError> {
+//! #         Ok(Solution { traj: PolyTraj::hold(r.start.t, r.start.p, 1.0)?, costs: CostBreakdown::default(),
+//! #             stats: SolveStats { iteration_count: 0, evaluation_count: 0, elapsed: Default::default(), status: SolveStatus::Converged } })
+//! #     }
+//! # }
+//! # struct Never;
+//! # impl HomotopyChecker for Never {
+//! #     fn name(&self) -> &str { "never" }
+//! #     fn equivalent(&self, _: &dyn Curve, _: &dyn Curve, _: &Scene<'_>) -> Result<bool, PlanError> { Ok(false) }
+//! # }
+//! // Any frontend, backend and checker (here toy ones; in practice DevPrm, UtfMinco, Tvd).
+//! let mut manager = Manager::new(Line, Hold, Never, Limits::default(), ManagerParams::default())?;
+//! let map = StaticMap::empty(Aabb::new(Vec3::zeros(), Vec3::new(20.0, 20.0, 10.0))?)?;
+//! let scene = Scene::new(&map, &[], 0.0)?;
+//! let report = manager.step(0.0, &State::at_rest(0.0, Vec3::new(1.0, 1.0, 1.0)), &Vec3::new(15.0, 10.0, 2.0), &scene)?;
+//! assert!(report.main.is_some());
+//! let plan = manager.plan().expect("a plan");
+//! assert_eq!(plan.t_start(), report.replan_start.t);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 #![warn(missing_docs)]
+
+pub mod brake;
+mod manager;
+mod params;
+mod report;
+pub mod safety;
+
+pub use brake::{brake_along, brake_straight, hermite_quintic};
+pub use manager::{Branch, Manager};
+pub use params::{ManagerParams, ReanchorParams, SafetyParams};
+pub use report::{
+    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, Origin,
+    StepReport,
+};
+pub use safety::{Hit, SafetyVerdict, Violation, check_trajectory};

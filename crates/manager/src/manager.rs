@@ -1,0 +1,721 @@
+//! [`Manager`]: Algorithm 1 of the paper, one cycle per [`Manager::step`].
+
+use std::time::{Duration, Instant};
+
+use rand::SeedableRng;
+use rayon::prelude::*;
+use trust_core::{
+    Aabb, Forecast, GuidePath, HomotopyChecker, InitialGuess, Limits, PathFrontend, PathQuery,
+    PlanError, PolyTraj, RankingWeights, Rng, Scene, Solution, State, TrajRequest,
+    TrajectoryBackend, Vec3, check_finite, check_finite_vec,
+};
+
+use crate::brake::{brake_along, brake_straight};
+use crate::report::{
+    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, Origin,
+    StepReport,
+};
+use crate::safety::{SafetyVerdict, check_trajectory, window_bounds};
+use crate::ManagerParams;
+
+/// One kept trajectory branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Branch {
+    /// Stable id ([`BranchId`]).
+    pub id: BranchId,
+    /// The backend's solution (trajectory, cost terms, statistics).
+    pub solution: Solution,
+    /// Ranking cost `J`.
+    pub j: f64,
+    /// How the trajectory was made in the last cycle.
+    pub origin: Origin,
+    /// Whether that solve was warm-started.
+    pub warm_started: bool,
+    /// Its safety check in the last cycle.
+    pub verdict: SafetyVerdict,
+}
+
+impl Branch {
+    /// The branch's trajectory.
+    pub fn traj(&self) -> &PolyTraj {
+        &self.solution.traj
+    }
+
+    fn report(&self, main: bool) -> BranchReport {
+        BranchReport {
+            id: self.id,
+            main,
+            origin: self.origin,
+            j: self.j,
+            costs: self.solution.costs,
+            status: self.solution.stats.status,
+            solve_ms: ms(self.solution.stats.elapsed),
+            evaluation_count: self.solution.stats.evaluation_count,
+            warm_started: self.warm_started,
+            min_margin_m: self.verdict.min_margin_m(),
+            duration_s: self.solution.traj.duration(),
+        }
+    }
+}
+
+/// A solved (or failed) candidate of this cycle.
+struct Candidate {
+    result: Result<(Solution, SafetyVerdict), PlanError>,
+    check_time: Duration,
+}
+
+/// The multi-branch spatio-temporal trajectory manager (paper Sec. III-A, Algorithm 1), generic
+/// over the frontend `F`, the backend `B` and the homotopy checker `H`.
+///
+/// It keeps up to `N` branches of distinct spatio-temporal homotopy sorted by the ranking cost
+/// `J = λ_t·H_t + λ_s·H_s + λ_e·I_e` and commits the main branch as the plan the vehicle flies.
+/// Each [`Manager::step`] is one cycle:
+///
+/// 1. **Replan start.** The new trajectories start from the state the vehicle will be in when they
+///    take effect: the committed plan at `now + latency` (so consecutive plans join with continuous
+///    position, velocity and acceleration). If the measured state has drifted from the committed
+///    plan by more than [`crate::ReanchorParams`], the replan starts instead from the measured state
+///    propagated over the latency at constant acceleration (`Reanchored` event): continuity is then
+///    given up in favour of the truth.
+/// 2. **FwdMarch** of the main branch and **BwdReplan** of every sub-branch: warm-started re-solves
+///    from the replan start (the main branch's free terminal moves on toward the goal as the goal
+///    guidance surface shrinks), run in parallel with **FwdExplore**: the frontend's paths from the
+///    replan start, each solved cold. With `history = false` only FwdExplore runs.
+/// 3. **Safety.** Every result is checked continuously in time ([`check_trajectory`]) against the
+///    static map, the bounds and the *current* forecasts, and against the limits; a failing branch
+///    is dropped (`DroppedCollision`).
+/// 4. **Distinct classes.** Re-solved branches that slid into the same class as a better one are
+///    merged (`MergedEquivalent`); then **AddNewBranch** for each explored trajectory, in the frontend's order: if the checker finds
+///    it equivalent to a kept branch with a `J` at least as low it is discarded; if it is equivalent
+///    only to worse branches it replaces the best-ranked of them (which keeps its id); otherwise it
+///    is added. Beyond `N` branches the worst is dropped (`PopBack`), never the main branch.
+/// 5. **Main branch.** The incumbent stays main unless a challenger's excess cost is below the
+///    hysteresis factor times the incumbent's, or the incumbent was dropped.
+/// 6. **Fallback.** With no feasible branch the plan is a braking trajectory ([`crate::brake`]):
+///    along the committed plan (or along a rejected trajectory of this cycle, or straight), the first
+///    that passes the safety check against the current forecasts, else the one with the largest
+///    margin. The report says which and whether it is collision-free; it is collision-free for as
+///    long as the forecasts hold only in the first case.
+///
+/// Optimizations of one cycle run in parallel on the current rayon pool; results are merged in a
+/// fixed order (warm branches by rank, then explored paths by the frontend's order), so the outcome
+/// does not depend on the number of threads or their timing as long as no time budget binds (set
+/// [`ManagerParams::enforce_budget`] to `false` and give the frontend count-based budgets for
+/// bit-reproducible runs).
+pub struct Manager<F, B, H> {
+    frontend: F,
+    backend: B,
+    checker: H,
+    limits: Limits,
+    params: ManagerParams,
+    rng: Rng,
+    branches: Vec<Branch>,
+    main: Option<BranchId>,
+    committed: Option<PolyTraj>,
+    next_id: BranchId,
+}
+
+impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Manager")
+            .field("limits", &self.limits)
+            .field("params", &self.params)
+            .field("branches", &self.branches.len())
+            .field("main", &self.main)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H> {
+    /// A manager with no branches and no plan yet.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] naming the invalid field of `limits` or `params`.
+    pub fn new(
+        frontend: F,
+        backend: B,
+        checker: H,
+        limits: Limits,
+        params: ManagerParams,
+    ) -> Result<Self, PlanError> {
+        limits.validate()?;
+        params.validate()?;
+        Ok(Manager {
+            frontend,
+            backend,
+            checker,
+            limits,
+            rng: Rng::seed_from_u64(params.seed),
+            params,
+            branches: Vec::new(),
+            main: None,
+            committed: None,
+            next_id: 0,
+        })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &ManagerParams {
+        &self.params
+    }
+
+    /// The vehicle's limits.
+    pub fn limits(&self) -> &Limits {
+        &self.limits
+    }
+
+    /// The kept branches, sorted by `J`.
+    pub fn branches(&self) -> &[Branch] {
+        &self.branches
+    }
+
+    /// The main branch's id (`None` before the first plan and while braking).
+    pub fn main(&self) -> Option<BranchId> {
+        self.main
+    }
+
+    /// The committed plan: the main branch's trajectory or the braking fallback.
+    pub fn plan(&self) -> Option<&PolyTraj> {
+        self.committed.as_ref()
+    }
+
+    /// Forgets every branch and the plan (a new flight); the random stream continues.
+    pub fn reset(&mut self) {
+        self.branches.clear();
+        self.main = None;
+        self.committed = None;
+    }
+
+    /// Runs one cycle of Algorithm 1 at time `now` with the measured vehicle state (taken at
+    /// `now`), toward `goal`, seeing `scene` (the static map and the current forecasts).
+    ///
+    /// Planning failures are reported in the [`StepReport`] (events, fallback); the committed plan
+    /// afterwards is [`Manager::plan`].
+    ///
+    /// # Errors
+    /// Only for invalid input: non-finite `now`, state or goal (named), a goal outside the map
+    /// bounds ([`PlanError::OutOfBounds`]) or inside a static obstacle
+    /// ([`PlanError::InCollision`]).
+    pub fn step(
+        &mut self,
+        now: f64,
+        measured: &State,
+        goal: &Vec3,
+        scene: &Scene<'_>,
+    ) -> Result<StepReport, PlanError> {
+        let started = Instant::now();
+        check_finite("now", now)?;
+        measured.validate("state")?;
+        check_finite_vec("goal", goal)?;
+        scene.check_in_bounds("goal", goal)?;
+        scene.check_static_free("goal", goal, 0.0)?;
+
+        let weights = self.params.ranking_weights(&self.limits);
+        let mut events = Vec::new();
+        let (start, reanchored) = self.replan_start(now, measured, &mut events);
+        let deadline = self
+            .params
+            .enforce_budget
+            .then(|| started + Duration::from_secs_f64(self.params.cycle_budget_ms * 1e-3));
+
+        // Warm re-solves (FwdMarch, BwdReplan) in parallel with the frontend, then the cold solves.
+        let history = self.params.history;
+        let warm: Vec<(BranchId, Origin, PolyTraj)> = if history {
+            self.branches
+                .iter()
+                .map(|b| {
+                    let origin = if Some(b.id) == self.main {
+                        Origin::Marched
+                    } else {
+                        Origin::Replanned
+                    };
+                    (b.id, origin, b.solution.traj.clone())
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let query = PathQuery {
+            start,
+            goal: *goal,
+            limits: self.limits,
+            horizon_s: self.params.horizon_s,
+        };
+        let solver = Solver {
+            backend: &self.backend,
+            scene,
+            start,
+            goal: *goal,
+            limits: self.limits,
+            horizon_s: self.params.horizon_s,
+            deadline,
+            params: &self.params,
+        };
+        let frontend = &self.frontend;
+        let rng = &mut self.rng;
+        let (search, warm_out) = rayon::join(
+            || {
+                let t = Instant::now();
+                let r = frontend.search(&query, scene, rng);
+                (r, t.elapsed())
+            },
+            || {
+                warm.par_iter()
+                    .map(|(_, _, traj)| solver.solve(InitialGuess::WarmStart(traj)))
+                    .collect::<Vec<_>>()
+            },
+        );
+        let (search, frontend_time) = search;
+        let (paths, frontend_report) = match search {
+            Ok(mut result) => {
+                let path_count = result.paths.len();
+                result.paths.truncate(self.params.max_explored_paths);
+                let report = FrontendReport {
+                    name: self.frontend.name().to_string(),
+                    path_count,
+                    explored_count: result.paths.len(),
+                    stats: result.stats,
+                };
+                (result.paths, Some(report))
+            }
+            Err(e) => {
+                events.push(Event::FrontendFailed {
+                    error: e.to_string(),
+                });
+                (Vec::new(), None)
+            }
+        };
+        let cold_out: Vec<Candidate> = paths
+            .par_iter()
+            .map(|p: &GuidePath| solver.solve(InitialGuess::Guide(p)))
+            .collect();
+
+        let mut timing = CycleTiming {
+            frontend_ms: ms(frontend_time),
+            ..CycleTiming::default()
+        };
+        let mut rejected: Vec<(&'static str, PolyTraj)> = Vec::new();
+
+        // Kept branches, re-solved.
+        let mut kept: Vec<Branch> = Vec::new();
+        for ((id, origin, _), cand) in warm.into_iter().zip(warm_out) {
+            timing.add(&cand);
+            match cand.result {
+                Err(e) => events.push(Event::SolveFailed {
+                    id: Some(id),
+                    error: e.to_string(),
+                }),
+                Ok((solution, verdict)) if verdict.safe => kept.push(Branch {
+                    id,
+                    j: solution.costs.ranking_cost(&weights),
+                    solution,
+                    origin,
+                    warm_started: true,
+                    verdict,
+                }),
+                Ok((solution, verdict)) => {
+                    events.push(Event::DroppedCollision {
+                        id: Some(id),
+                        violation: verdict.violation,
+                    });
+                    rejected.push(("branch", solution.traj));
+                }
+            }
+        }
+        sort_by_j(&mut kept);
+        let mut check_time = Duration::ZERO;
+        if kept.len() > 1 {
+            let t = Instant::now();
+            kept = self.dedupe(kept, scene, &mut events);
+            check_time += t.elapsed();
+        }
+
+        // AddNewBranch for each explored trajectory.
+        let incumbent = if history { self.main } else { None };
+        for cand in cold_out {
+            timing.add(&cand);
+            match cand.result {
+                Err(e) => events.push(Event::SolveFailed {
+                    id: None,
+                    error: e.to_string(),
+                }),
+                Ok((solution, verdict)) if !verdict.safe => {
+                    events.push(Event::DroppedCollision {
+                        id: None,
+                        violation: verdict.violation,
+                    });
+                    rejected.push(("candidate", solution.traj));
+                }
+                Ok((solution, verdict)) => {
+                    let t = Instant::now();
+                    let new = Branch {
+                        id: 0,
+                        j: solution.costs.ranking_cost(&weights),
+                        solution,
+                        origin: Origin::Explored,
+                        warm_started: false,
+                        verdict,
+                    };
+                    self.add_new_branch(&mut kept, new, scene, incumbent, &mut events);
+                    check_time += t.elapsed();
+                }
+            }
+        }
+        timing.checker_ms += ms(check_time);
+
+        // The main branch, with hysteresis.
+        let new_main = self.select_main(&kept, &start, goal, &weights, &mut events);
+        pop_back(&mut kept, self.params.max_branches, new_main, &mut events);
+
+        let mut fallback = None;
+        match new_main.and_then(|id| kept.iter().find(|b| b.id == id)) {
+            Some(main) => {
+                self.committed = Some(main.solution.traj.clone());
+                self.main = Some(main.id);
+            }
+            None => {
+                let t = Instant::now();
+                let report = self.fallback(&start, reanchored, &rejected, scene, &mut events);
+                timing.checker_ms += ms(t.elapsed());
+                fallback = report;
+                self.main = None;
+            }
+        }
+        self.branches = kept;
+        timing.wall_ms = ms(started.elapsed());
+        Ok(StepReport {
+            t: now,
+            replan_start: start,
+            main: self.main,
+            branches: self
+                .branches
+                .iter()
+                .map(|b| b.report(Some(b.id) == self.main))
+                .collect(),
+            events,
+            frontend: frontend_report,
+            timing,
+            fallback,
+        })
+    }
+
+    /// The state the new plan starts from, and whether it was re-anchored on the measurement.
+    fn replan_start(&self, now: f64, measured: &State, events: &mut Vec<Event>) -> (State, bool) {
+        let latency = self.params.latency();
+        let t_eff = now + latency;
+        if let Some(plan) = &self.committed {
+            let expected = plan.state(now);
+            let dp = (measured.p - expected.p).norm();
+            let dv = (measured.v - expected.v).norm();
+            if dp <= self.params.reanchor.position_m && dv <= self.params.reanchor.velocity_mps {
+                let mut s = plan.state(t_eff);
+                s.t = t_eff;
+                return (s, false);
+            }
+            events.push(Event::Reanchored {
+                position_drift_m: dp,
+                velocity_drift_mps: dv,
+            });
+        }
+        let l = latency;
+        let start = State {
+            t: t_eff,
+            p: measured.p + measured.v * l + measured.a * (0.5 * l * l),
+            v: measured.v + measured.a * l,
+            a: measured.a,
+        };
+        (start, self.committed.is_some())
+    }
+
+    /// Keeps the re-solved branches homotopy-distinct: a warm re-solve can slide into another
+    /// branch's class, and the queue must hold one branch per class. Walking in `J` order, a
+    /// branch equivalent to an already kept one is dropped (`MergedEquivalent`).
+    fn dedupe(&self, sorted: Vec<Branch>, scene: &Scene<'_>, events: &mut Vec<Event>) -> Vec<Branch> {
+        let mut out: Vec<Branch> = Vec::with_capacity(sorted.len());
+        'branches: for b in sorted {
+            for k in &out {
+                match self.equivalent(&b.solution.traj, &k.solution.traj, scene) {
+                    Ok(true) => {
+                        events.push(Event::MergedEquivalent {
+                            dropped: b.id,
+                            kept: k.id,
+                        });
+                        continue 'branches;
+                    }
+                    Ok(false) => {}
+                    Err(e) => events.push(Event::CheckerFailed {
+                        error: e.to_string(),
+                    }),
+                }
+            }
+            out.push(b);
+        }
+        out
+    }
+
+    /// AddNewBranch of Algorithm 1 (see the type's docs), then PopBack beyond `N` protecting the
+    /// incumbent main branch.
+    fn add_new_branch(
+        &mut self,
+        kept: &mut Vec<Branch>,
+        mut new: Branch,
+        scene: &Scene<'_>,
+        incumbent: Option<BranchId>,
+        events: &mut Vec<Event>,
+    ) {
+        let mut worse_equivalent = None;
+        for (i, b) in kept.iter().enumerate() {
+            match self.equivalent(&new.solution.traj, &b.solution.traj, scene) {
+                Ok(true) if b.j <= new.j => {
+                    events.push(Event::DiscardedEquivalent {
+                        equivalent_to: b.id,
+                    });
+                    return;
+                }
+                Ok(true) => {
+                    worse_equivalent.get_or_insert(i);
+                }
+                Ok(false) => {}
+                Err(e) => events.push(Event::CheckerFailed {
+                    error: e.to_string(),
+                }),
+            }
+        }
+        match worse_equivalent {
+            Some(i) => {
+                new.id = kept[i].id;
+                events.push(Event::Replaced {
+                    id: new.id,
+                    j_old: kept[i].j,
+                    j_new: new.j,
+                });
+                kept[i] = new;
+            }
+            None => {
+                new.id = self.next_id;
+                self.next_id += 1;
+                events.push(Event::Added { id: new.id });
+                kept.push(new);
+            }
+        }
+        sort_by_j(kept);
+        pop_back(kept, self.params.max_branches, incumbent, events);
+    }
+
+    /// The checker on a scene restricted to the forecasts that can reach the two trajectories.
+    fn equivalent(&self, a: &PolyTraj, b: &PolyTraj, scene: &Scene<'_>) -> Result<bool, PlanError> {
+        let from = a.t_start().min(b.t_start());
+        let until = a.t_end().max(b.t_end());
+        let (_, box_a) = window_bounds(a, from, until);
+        let (_, box_b) = window_bounds(b, from, until);
+        let region: Aabb = box_a.union(&box_b);
+        let near: Vec<Forecast> = scene
+            .forecasts
+            .iter()
+            .filter(|f| {
+                f.aabb_over(from, until)
+                    .map(|x| x.intersects(&region))
+                    .unwrap_or(true)
+            })
+            .copied()
+            .collect();
+        let sub = Scene {
+            map: scene.map,
+            forecasts: &near,
+            t0: scene.t0,
+        };
+        self.checker.equivalent(a, b, &sub)
+    }
+
+    /// The new main branch (hysteresis), with its event.
+    fn select_main(
+        &self,
+        kept: &[Branch],
+        start: &State,
+        goal: &Vec3,
+        weights: &RankingWeights,
+        events: &mut Vec<Event>,
+    ) -> Option<BranchId> {
+        let best = kept.first()?;
+        let history = self.params.history;
+        let incumbent = self
+            .main
+            .filter(|_| history)
+            .and_then(|id| kept.iter().find(|b| b.id == id));
+        let ideal = weights.lambda_s.min(weights.lambda_t / self.limits.v_max)
+            * (start.p - goal).norm();
+        let excess = |b: &Branch| (b.j - ideal).max(0.0);
+        match incumbent {
+            Some(inc) if inc.id == best.id => Some(inc.id),
+            Some(inc) => {
+                if excess(best) < self.params.hysteresis * excess(inc) {
+                    events.push(Event::SwitchedMain {
+                        from: Some(inc.id),
+                        to: best.id,
+                        reason: "better".into(),
+                    });
+                    Some(best.id)
+                } else {
+                    Some(inc.id)
+                }
+            }
+            None => {
+                if history {
+                    let reason = if self.main.is_some() {
+                        "incumbent_dropped"
+                    } else {
+                        "first"
+                    };
+                    events.push(Event::SwitchedMain {
+                        from: self.main,
+                        to: best.id,
+                        reason: reason.into(),
+                    });
+                }
+                Some(best.id)
+            }
+        }
+    }
+
+    /// Builds the braking fallback, commits it and reports it.
+    fn fallback(
+        &mut self,
+        start: &State,
+        reanchored: bool,
+        rejected: &[(&'static str, PolyTraj)],
+        scene: &Scene<'_>,
+        events: &mut Vec<Event>,
+    ) -> Option<FallbackReport> {
+        let hold_s = self.params.horizon_s;
+        let a_max = self.limits.a_max;
+        let mut options: Vec<(&'static str, PolyTraj)> = Vec::new();
+        if let Some(plan) = self.committed.as_ref().filter(|_| !reanchored)
+            && let Ok(b) = brake_along(plan, start.t, a_max, hold_s)
+        {
+            options.push(("committed", b));
+        }
+        for (kind, traj) in rejected {
+            if let Ok(b) = brake_along(traj, start.t, a_max, hold_s) {
+                options.push((kind, b));
+            }
+        }
+        if let Ok(b) = brake_straight(start, a_max, hold_s) {
+            options.push(("straight", b));
+        }
+        let mut best: Option<(usize, SafetyVerdict)> = None;
+        for (i, (_, traj)) in options.iter().enumerate() {
+            let v = check_trajectory(
+                traj,
+                scene,
+                start.t,
+                traj.t_end(),
+                &self.limits,
+                &self.params.safety,
+            );
+            if v.violation.is_none() {
+                best = Some((i, v));
+                break;
+            }
+            if best.as_ref().is_none_or(|(_, b)| v.min_margin_m() > b.min_margin_m()) {
+                best = Some((i, v));
+            }
+        }
+        let (i, verdict) = best?;
+        let (along, traj) = options.swap_remove(i);
+        let collision_free = verdict.violation.is_none();
+        let stop_time = traj.t_end() - hold_s;
+        events.push(Event::Fallback {
+            along: along.into(),
+            collision_free,
+            min_margin_m: verdict.min_margin_m(),
+        });
+        self.committed = Some(traj);
+        Some(FallbackReport {
+            along: along.into(),
+            collision_free,
+            min_margin_m: verdict.min_margin_m(),
+            stop_time,
+        })
+    }
+}
+
+/// Everything a parallel solve needs, shared read-only.
+struct Solver<'s, 'a, B> {
+    backend: &'s B,
+    scene: &'s Scene<'a>,
+    start: State,
+    goal: Vec3,
+    limits: Limits,
+    horizon_s: f64,
+    deadline: Option<Instant>,
+    params: &'s ManagerParams,
+}
+
+impl<B: TrajectoryBackend> Solver<'_, '_, B> {
+    fn solve(&self, initial: InitialGuess<'_>) -> Candidate {
+        let req = TrajRequest {
+            start: self.start,
+            goal: self.goal,
+            limits: self.limits,
+            initial,
+            deadline: self.deadline,
+            horizon_s: Some(self.horizon_s),
+        };
+        match self.backend.optimize(&req, self.scene) {
+            Err(e) => Candidate {
+                result: Err(e),
+                check_time: Duration::ZERO,
+            },
+            Ok(solution) => {
+                let t = Instant::now();
+                let traj = &solution.traj;
+                let verdict = check_trajectory(
+                    traj,
+                    self.scene,
+                    self.start.t,
+                    traj.t_end(),
+                    &self.limits,
+                    &self.params.safety,
+                );
+                Candidate {
+                    check_time: t.elapsed(),
+                    result: Ok((solution, verdict)),
+                }
+            }
+        }
+    }
+}
+
+impl CycleTiming {
+    fn add(&mut self, cand: &Candidate) {
+        self.checker_ms += ms(cand.check_time);
+        if let Ok((s, _)) = &cand.result {
+            self.backend_ms += ms(s.stats.elapsed);
+            self.solve_count += 1;
+        }
+    }
+}
+
+fn sort_by_j(branches: &mut [Branch]) {
+    branches.sort_by(|a, b| a.j.total_cmp(&b.j).then(a.id.cmp(&b.id)));
+}
+
+/// Drops the worst branches beyond `n`, never `protect`.
+fn pop_back(
+    kept: &mut Vec<Branch>,
+    n: usize,
+    protect: Option<BranchId>,
+    events: &mut Vec<Event>,
+) {
+    while kept.len() > n {
+        let Some(i) = kept.iter().rposition(|b| Some(b.id) != protect) else {
+            return;
+        };
+        let b = kept.remove(i);
+        events.push(Event::DroppedPopBack { id: b.id });
+    }
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}

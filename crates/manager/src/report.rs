@@ -1,0 +1,250 @@
+//! What one cycle of the manager did ([`StepReport`]), for logs, tests and studies.
+
+use serde::{Deserialize, Serialize};
+use trust_core::{CostBreakdown, SearchStats, SolveStatus, State};
+
+use crate::safety::Violation;
+
+/// Stable identifier of a branch: it keeps its id while it is marched, replanned or replaced by an
+/// equivalent better trajectory; new branches get fresh ids in increasing order.
+pub type BranchId = u64;
+
+/// How a branch's current trajectory was made this cycle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Origin {
+    /// `FwdMarch`: the main branch re-solved from the replan start, warm-started.
+    Marched,
+    /// `BwdReplan`: a sub-branch re-anchored at the replan start, warm-started.
+    Replanned,
+    /// `FwdExplore`: a new trajectory from a frontend path (cold start).
+    Explored,
+}
+
+/// One kept branch after the cycle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BranchReport {
+    /// Stable id.
+    pub id: BranchId,
+    /// Whether it is the main branch (the one the vehicle flies).
+    pub main: bool,
+    /// How its trajectory was made this cycle.
+    pub origin: Origin,
+    /// Ranking cost `J = λ_t·H_t + λ_s·H_s + λ_e·I_e`.
+    pub j: f64,
+    /// The backend's cost terms.
+    pub costs: CostBreakdown,
+    /// How the solve ended.
+    pub status: SolveStatus,
+    /// Solve time (ms).
+    pub solve_ms: f64,
+    /// Cost evaluations of the solve.
+    pub evaluation_count: usize,
+    /// Whether the solve was warm-started from the branch's previous trajectory.
+    pub warm_started: bool,
+    /// Smallest clearance margin found by the safety check (m).
+    pub min_margin_m: f64,
+    /// Trajectory duration (s).
+    pub duration_s: f64,
+}
+
+/// Something the manager did or decided this cycle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "event", rename_all = "snake_case")]
+pub enum Event {
+    /// The replan started from the measured state: it had drifted from the committed trajectory.
+    Reanchored {
+        /// Position drift (m).
+        position_drift_m: f64,
+        /// Velocity drift (m/s).
+        velocity_drift_mps: f64,
+    },
+    /// A new homotopy class joined the branch set.
+    Added {
+        /// Its id.
+        id: BranchId,
+    },
+    /// An equivalent (same-class) branch was replaced by a better new trajectory.
+    Replaced {
+        /// The branch that got the new trajectory.
+        id: BranchId,
+        /// Its old `J`.
+        j_old: f64,
+        /// The new `J`.
+        j_new: f64,
+    },
+    /// A new trajectory was equivalent to a kept branch at least as good, and discarded.
+    DiscardedEquivalent {
+        /// The kept branch.
+        equivalent_to: BranchId,
+    },
+    /// Two re-solved branches had become equivalent; the worse was dropped.
+    MergedEquivalent {
+        /// The dropped branch.
+        dropped: BranchId,
+        /// The branch it was equivalent to (kept, lower `J`).
+        kept: BranchId,
+    },
+    /// A branch (or a new candidate, `id = None`) failed the safety check and was dropped.
+    DroppedCollision {
+        /// The branch, or `None` for a candidate from the frontend.
+        id: Option<BranchId>,
+        /// The first violation (`None` when only the limits were exceeded).
+        violation: Option<Violation>,
+    },
+    /// A branch fell off the end of the queue (more than `N`).
+    DroppedPopBack {
+        /// The branch.
+        id: BranchId,
+    },
+    /// A solve returned an error (invalid input for the backend) and its branch was dropped.
+    SolveFailed {
+        /// The branch, or `None` for a candidate.
+        id: Option<BranchId>,
+        /// The error message.
+        error: String,
+    },
+    /// The frontend returned an error; the cycle went on with the kept branches.
+    FrontendFailed {
+        /// The error message.
+        error: String,
+    },
+    /// A homotopy check returned an error; the pair was treated as distinct.
+    CheckerFailed {
+        /// The error message.
+        error: String,
+    },
+    /// The main branch changed.
+    SwitchedMain {
+        /// The previous main branch (`None` on the first plan or without history).
+        from: Option<BranchId>,
+        /// The new one.
+        to: BranchId,
+        /// `"better"` (beat the incumbent by the hysteresis factor), `"incumbent_dropped"`
+        /// or `"first"`.
+        reason: String,
+    },
+    /// No branch was feasible: the plan is a braking fallback.
+    Fallback {
+        /// What it brakes along: `"committed"`, `"branch"`, `"candidate"` or `"straight"`.
+        along: String,
+        /// Whether it passed the safety check against the current forecasts.
+        collision_free: bool,
+        /// Its smallest clearance margin (m).
+        min_margin_m: f64,
+    },
+}
+
+impl Event {
+    /// A short tag for logs (`"switched"`, `"fallback"`, ...).
+    pub fn tag(&self) -> &'static str {
+        match self {
+            Event::Reanchored { .. } => "reanchored",
+            Event::Added { .. } => "added",
+            Event::Replaced { .. } => "replaced",
+            Event::DiscardedEquivalent { .. } => "discarded_equivalent",
+            Event::MergedEquivalent { .. } => "merged_equivalent",
+            Event::DroppedCollision { .. } => "dropped_collision",
+            Event::DroppedPopBack { .. } => "dropped_popback",
+            Event::SolveFailed { .. } => "solve_failed",
+            Event::FrontendFailed { .. } => "frontend_failed",
+            Event::CheckerFailed { .. } => "checker_failed",
+            Event::SwitchedMain { .. } => "switched",
+            Event::Fallback { .. } => "fallback",
+        }
+    }
+}
+
+/// The frontend's part of a cycle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FrontendReport {
+    /// The frontend's name.
+    pub name: String,
+    /// Paths it returned.
+    pub path_count: usize,
+    /// Paths optimized (at most `max_explored_paths`).
+    pub explored_count: usize,
+    /// Its counters.
+    pub stats: SearchStats,
+}
+
+/// Where a cycle's time went (ms, monotonic clock).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct CycleTiming {
+    /// The whole `step` call.
+    pub wall_ms: f64,
+    /// The frontend search.
+    pub frontend_ms: f64,
+    /// Sum of all trajectory solves (CPU time across threads).
+    pub backend_ms: f64,
+    /// Sum of homotopy checks and safety checks (CPU time across threads).
+    pub checker_ms: f64,
+    /// Trajectories optimized this cycle.
+    pub solve_count: usize,
+}
+
+impl CycleTiming {
+    /// Mean solve time per trajectory (ms), 0 without solves.
+    pub fn solve_ms_per_trajectory(&self) -> f64 {
+        if self.solve_count == 0 {
+            0.0
+        } else {
+            self.backend_ms / self.solve_count as f64
+        }
+    }
+
+    /// CPU time of the cycle per trajectory optimized, frontend and checks included (ms): the
+    /// paper's "CPU time per trajectory" (Fig. baseline-test-3 (c)).
+    pub fn cpu_ms_per_trajectory(&self) -> f64 {
+        let cpu = self.frontend_ms + self.backend_ms + self.checker_ms;
+        cpu / self.solve_count.max(1) as f64
+    }
+}
+
+/// The braking fallback in use.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FallbackReport {
+    /// What it brakes along (see [`Event::Fallback`]).
+    pub along: String,
+    /// Whether it passed the safety check against the current forecasts.
+    pub collision_free: bool,
+    /// Its smallest clearance margin (m).
+    pub min_margin_m: f64,
+    /// Time (s) at which it is at rest.
+    pub stop_time: f64,
+}
+
+/// What one [`crate::Manager::step`] did.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StepReport {
+    /// The cycle's time (s).
+    pub t: f64,
+    /// The state the new plan starts from (at `t + latency`).
+    pub replan_start: State,
+    /// The main branch, or `None` when the plan is a fallback.
+    pub main: Option<BranchId>,
+    /// The kept branches, sorted by `J`.
+    pub branches: Vec<BranchReport>,
+    /// What happened, in order.
+    pub events: Vec<Event>,
+    /// The frontend's part (`None` if it was not run).
+    pub frontend: Option<FrontendReport>,
+    /// Where the time went.
+    pub timing: CycleTiming,
+    /// The braking fallback, when no branch was feasible.
+    pub fallback: Option<FallbackReport>,
+}
+
+impl StepReport {
+    /// The event tags in order (the run log's `events`).
+    pub fn event_tags(&self) -> Vec<&'static str> {
+        self.events.iter().map(Event::tag).collect()
+    }
+
+    /// Whether the main branch changed this cycle.
+    pub fn switched(&self) -> bool {
+        self.events
+            .iter()
+            .any(|e| matches!(e, Event::SwitchedMain { .. }))
+    }
+}
