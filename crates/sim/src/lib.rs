@@ -5,3 +5,5 @@
 //! experiments. It is filled by the simulator and ablation issues; today it exports nothing, so that
 //! nothing pretends to work.
 #![warn(missing_docs)]
+
+pub mod plot;
