@@ -6,4 +6,5 @@
 //! nothing pretends to work.
 #![warn(missing_docs)]
 
+pub mod plot;
 pub mod vehicle;
