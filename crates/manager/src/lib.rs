@@ -64,7 +64,7 @@ mod report;
 pub mod safety;
 
 pub use brake::{brake_along, brake_straight, hermite_quintic};
-pub use manager::{Branch, Manager};
+pub use manager::{Branch, MainDecision, Manager, choose_main};
 pub use params::{ManagerParams, ReanchorParams, SafetyParams};
 pub use report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, Origin,

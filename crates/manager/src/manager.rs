@@ -285,6 +285,25 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 (Vec::new(), None)
             }
         };
+        let mut paths = paths;
+        let mut fallback_guide = false;
+        if paths.is_empty() && self.params.straight_guide_when_empty {
+            // Beyond the paper: never explore empty-handed. The frontend's cones are
+            // conservative (an obstacle's whole sweep over the horizon), so in crowded moments it
+            // may find no path while a trajectory that passes behind an obstacle exists; the
+            // straight guide lets the backend look for it in time.
+            let reach = self.params.horizon_s * self.limits.v_max;
+            let d = (goal - start.p).norm();
+            let end = if d <= reach || d == 0.0 {
+                *goal
+            } else {
+                start.p + (goal - start.p) * (reach / d)
+            };
+            if let Ok(g) = GuidePath::new(vec![start.p, end]) {
+                paths.push(g);
+                fallback_guide = true;
+            }
+        }
         let cold_out: Vec<Candidate> = paths
             .par_iter()
             .map(|p: &GuidePath| solver.solve(InitialGuess::Guide(p)))
@@ -394,6 +413,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 .collect(),
             events,
             frontend: frontend_report,
+            straight_guide: fallback_guide,
             timing,
             fallback,
         })
@@ -536,45 +556,24 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         weights: &RankingWeights,
         events: &mut Vec<Event>,
     ) -> Option<BranchId> {
-        let best = kept.first()?;
-        let history = self.params.history;
-        let incumbent = self
-            .main
-            .filter(|_| history)
-            .and_then(|id| kept.iter().find(|b| b.id == id));
         let ideal = weights.lambda_s.min(weights.lambda_t / self.limits.v_max)
             * (start.p - goal).norm();
-        let excess = |b: &Branch| (b.j - ideal).max(0.0);
-        match incumbent {
-            Some(inc) if inc.id == best.id => Some(inc.id),
-            Some(inc) => {
-                if excess(best) < self.params.hysteresis * excess(inc) {
-                    events.push(Event::SwitchedMain {
-                        from: Some(inc.id),
-                        to: best.id,
-                        reason: "better".into(),
-                    });
-                    Some(best.id)
-                } else {
-                    Some(inc.id)
-                }
-            }
-            None => {
-                if history {
-                    let reason = if self.main.is_some() {
-                        "incumbent_dropped"
-                    } else {
-                        "first"
-                    };
-                    events.push(Event::SwitchedMain {
-                        from: self.main,
-                        to: best.id,
-                        reason: reason.into(),
-                    });
-                }
-                Some(best.id)
-            }
+        let ranked: Vec<(BranchId, f64)> = kept.iter().map(|b| (b.id, b.j)).collect();
+        let incumbent = self.main.filter(|_| self.params.history);
+        let decision = choose_main(&ranked, incumbent, ideal, self.params.hysteresis)?;
+        if decision.switched && self.params.history {
+            let reason = match (incumbent, decision.incumbent_kept) {
+                (None, _) => "first",
+                (Some(_), true) => "better",
+                (Some(_), false) => "incumbent_dropped",
+            };
+            events.push(Event::SwitchedMain {
+                from: self.main,
+                to: decision.main,
+                reason: reason.into(),
+            });
         }
+        Some(decision.main)
     }
 
     /// Builds the braking fallback, commits it and reports it.
@@ -696,6 +695,47 @@ impl CycleTiming {
     }
 }
 
+/// The outcome of [`choose_main`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MainDecision {
+    /// The main branch.
+    pub main: BranchId,
+    /// Whether it differs from the incumbent (or there was none).
+    pub switched: bool,
+    /// Whether the incumbent is still among the ranked branches.
+    pub incumbent_kept: bool,
+}
+
+/// The main-branch rule with hysteresis, on branches `ranked` by ascending `J` (`(id, J)`): the
+/// incumbent stays unless the best branch's excess cost `J − ideal` is below `hysteresis` times the
+/// incumbent's, or the incumbent is gone; without an incumbent the best branch is chosen. `None`
+/// for no branches.
+pub fn choose_main(
+    ranked: &[(BranchId, f64)],
+    incumbent: Option<BranchId>,
+    ideal: f64,
+    hysteresis: f64,
+) -> Option<MainDecision> {
+    let &(best, best_j) = ranked.first()?;
+    let excess = |j: f64| (j - ideal).max(0.0);
+    let kept = incumbent.and_then(|id| ranked.iter().find(|(i, _)| *i == id));
+    Some(match kept {
+        Some(&(inc, inc_j)) => {
+            let switch = inc != best && excess(best_j) < hysteresis * excess(inc_j);
+            MainDecision {
+                main: if switch { best } else { inc },
+                switched: switch,
+                incumbent_kept: true,
+            }
+        }
+        None => MainDecision {
+            main: best,
+            switched: true,
+            incumbent_kept: false,
+        },
+    })
+}
+
 fn sort_by_j(branches: &mut [Branch]) {
     branches.sort_by(|a, b| a.j.total_cmp(&b.j).then(a.id.cmp(&b.id)));
 }
@@ -718,4 +758,33 @@ fn pop_back(
 
 fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hysteresis_keeps_the_incumbent_unless_clearly_beaten() {
+        // Ideal 20: excesses 1.0 (incumbent 7) and 0.8 (challenger 3).
+        let ranked = [(3, 20.8), (7, 21.0)];
+        let keep = choose_main(&ranked, Some(7), 20.0, 0.75).unwrap();
+        assert_eq!((keep.main, keep.switched), (7, false));
+        // Without hysteresis the better one wins.
+        let switch = choose_main(&ranked, Some(7), 20.0, 1.0).unwrap();
+        assert_eq!((switch.main, switch.switched), (3, true));
+        // A clear win (excess 0.5 < 0.75) switches even with hysteresis.
+        let ranked = [(3, 20.5), (7, 21.0)];
+        let d = choose_main(&ranked, Some(7), 20.0, 0.75).unwrap();
+        assert_eq!((d.main, d.switched, d.incumbent_kept), (3, true, true));
+        // A dropped incumbent is replaced by the best.
+        let d = choose_main(&ranked, Some(9), 20.0, 0.75).unwrap();
+        assert_eq!((d.main, d.switched, d.incumbent_kept), (3, true, false));
+        // First plan; no branches.
+        assert_eq!(choose_main(&ranked, None, 20.0, 0.75).unwrap().main, 3);
+        assert!(choose_main(&[], Some(1), 0.0, 0.75).is_none());
+        // An incumbent at the ideal cost cannot be beaten by a better-ranked tie.
+        let ranked = [(1, 20.0), (2, 20.0)];
+        assert_eq!(choose_main(&ranked, Some(2), 20.0, 0.75).unwrap().main, 2);
+    }
 }

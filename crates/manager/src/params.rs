@@ -23,6 +23,11 @@ pub struct ManagerParams {
     /// Most frontend paths optimized per cycle (`FwdExplore`); the frontend's first paths (its
     /// best) are taken. Ours: 5, DEV-PRM's own cap on selected paths is 6.
     pub max_explored_paths: usize,
+    /// When the frontend returns no path, explore the straight guide toward the goal (truncated to
+    /// `T_h·v_max`) instead (beyond the paper). DEV-PRM's predictive cones are conservative — an
+    /// obstacle's whole sweep over the horizon — so in crowded moments it can find no path while a
+    /// trajectory passing behind an obstacle exists in space-time. Default `true`.
+    pub straight_guide_when_empty: bool,
     /// Weights of the ranking cost `J = λ_t·H_t + λ_s·H_s + λ_e·I_e`; `None` uses the paper's rule
     /// (Table Sim-B-1: `λ_t = 1`, `λ_s = 1/v_max`, `λ_e = 1e-4`) with the vehicle's `v_max`.
     pub ranking: Option<RankingWeights>,
@@ -69,6 +74,7 @@ impl ManagerParams {
             max_branches: 5,
             history: true,
             max_explored_paths: 5,
+            straight_guide_when_empty: true,
             ranking: None,
             horizon_s: 4.0,
             cycle_budget_ms: 50.0,

@@ -227,8 +227,11 @@ pub struct StepReport {
     pub branches: Vec<BranchReport>,
     /// What happened, in order.
     pub events: Vec<Event>,
-    /// The frontend's part (`None` if it was not run).
+    /// The frontend's part (`None` if it failed).
     pub frontend: Option<FrontendReport>,
+    /// Whether the straight guide toward the goal was explored because the frontend found no path
+    /// ([`crate::ManagerParams::straight_guide_when_empty`]).
+    pub straight_guide: bool,
     /// Where the time went.
     pub timing: CycleTiming,
     /// The braking fallback, when no branch was feasible.

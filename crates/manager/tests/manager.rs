@@ -1,0 +1,503 @@
+//! The manager's public API on scripted scenes, with the real frontend, backend and checker
+//! (DEV-PRM, UTF-MINCO, TVD) and with small test doubles where a situation must be forced.
+
+use rand::SeedableRng;
+use trust_core::{
+    Aabb, CostBreakdown, Forecast, GuidePath, Limits, ObstacleShape, PathFrontend, PathQuery,
+    PlanError, PolyTraj, Rng, Scene, SearchResult, Solution, SolveStats, SolveStatus, State,
+    StaticMap, TrajRequest, TrajectoryBackend, Vec3,
+};
+use trust_geometry::{AaBox, Shape};
+use trust_manager::{Event, Manager, ManagerParams, StepReport, check_trajectory};
+use trust_minco::UtfMinco;
+use trust_topo_prm::scenes::{SceneParams, random_dynamic_scene};
+use trust_topo_prm::{DevPrm, DevPrmParams, StraightLine, Tvd};
+
+/// Count-bounded (machine-independent) parameters.
+fn reproducible(mut p: ManagerParams) -> ManagerParams {
+    p.enforce_budget = false;
+    p.safety.static_clearance_m = 0.2;
+    p
+}
+
+fn dev_prm() -> DevPrm {
+    DevPrm::new(DevPrmParams {
+        budget_ms: 10_000.0,
+        ..DevPrmParams::default()
+    })
+    .expect("valid")
+}
+
+type Planner = Manager<DevPrm, UtfMinco, Tvd>;
+
+/// UTF-MINCO keeping 0.3 m from the static map, more than the 0.2 m the safety check requires.
+fn utf_minco() -> UtfMinco {
+    let mut p = trust_minco::UtfMincoParams::default();
+    p.penalty.static_clearance_m = 0.3;
+    UtfMinco::new(p).expect("valid")
+}
+
+fn planner(params: ManagerParams) -> Planner {
+    Manager::new(
+        dev_prm(),
+        utf_minco(),
+        Tvd::default(),
+        Limits::default(),
+        reproducible(params),
+    )
+    .expect("valid")
+}
+
+/// A 40 × 12 × 6 m corridor with a wall at x ∈ [14, 15] that has two gaps, y ∈ [-4, -1] and
+/// y ∈ [1, 4]: two homotopy classes from (2, 0, 3) to (38, 0, 3).
+fn two_gap_corridor() -> StaticMap {
+    let bounds = Aabb::new(Vec3::new(0.0, -6.0, 0.0), Vec3::new(40.0, 6.0, 6.0)).unwrap();
+    let wall = |y0: f64, y1: f64| {
+        Shape::AaBox(AaBox::new(Vec3::new(14.0, y0, 0.0), Vec3::new(15.0, y1, 6.0)).unwrap())
+    };
+    StaticMap::from_shapes(bounds, vec![wall(-6.0, -4.0), wall(-1.0, 1.0), wall(4.0, 6.0)])
+        .unwrap()
+}
+
+const START: Vec3 = Vec3::new(2.0, 0.0, 3.0);
+const GOAL: Vec3 = Vec3::new(38.0, 0.0, 3.0);
+
+/// Flies the plan perfectly for `cycles` cycles of 0.1 s, calling `scene_at(t)` for the forecasts.
+fn fly<F, B, H>(
+    m: &mut Manager<F, B, H>,
+    map: &StaticMap,
+    goal: Vec3,
+    start: State,
+    cycles: usize,
+    forecasts_at: impl Fn(f64) -> Vec<Forecast>,
+) -> Vec<StepReport>
+where
+    F: PathFrontend,
+    B: TrajectoryBackend,
+    H: trust_core::HomotopyChecker,
+{
+    let mut state = start;
+    let mut reports = Vec::new();
+    for k in 0..cycles {
+        let t = start.t + 0.1 * k as f64;
+        let forecasts = forecasts_at(t);
+        let scene = Scene::new(map, &forecasts, t).unwrap();
+        reports.push(m.step(t, &state, &goal, &scene).expect("valid input"));
+        state = m.plan().expect("a plan").state(t + 0.1);
+    }
+    reports
+}
+
+fn gap_side(traj: &PolyTraj) -> f64 {
+    // y where the trajectory crosses the wall's plane x = 14.5.
+    let mut t = traj.t_start();
+    while t < traj.t_end() {
+        let p = traj.position(t);
+        if p.x >= 14.5 {
+            return p.y;
+        }
+        t += 0.01;
+    }
+    f64::NAN
+}
+
+#[test]
+fn keeps_both_gaps_and_switches_to_the_kept_branch_when_the_main_gap_is_blocked() {
+    let map = two_gap_corridor();
+    let mut m = planner(ManagerParams::trust());
+    let start = State::at_rest(0.0, START);
+    let reports = fly(&mut m, &map, GOAL, start, 5, |_| Vec::new());
+    let last = reports.last().unwrap();
+    assert!(
+        last.branches.len() >= 2,
+        "both gap classes kept: {:?}",
+        last.branches
+    );
+    let main_id = m.main().expect("a main branch");
+    let main_side = gap_side(m.plan().unwrap()).signum();
+    let sub = m
+        .branches()
+        .iter()
+        .find(|b| b.id != main_id && gap_side(b.traj()).signum() == -main_side)
+        .expect("a sub-branch through the other gap");
+    let sub_id = sub.id;
+
+    // An obstacle turns into the main branch's gap and parks there.
+    let t = 0.5;
+    let blocker = Forecast::new(
+        ObstacleShape::Sphere,
+        Vec3::new(14.5, 2.5 * main_side, 3.0),
+        Vec3::zeros(),
+        t,
+        1.6,
+        0.3,
+        0.1,
+    )
+    .unwrap();
+    let forecasts = [blocker];
+    let scene = Scene::new(&map, &forecasts, t).unwrap();
+    let state = m.plan().unwrap().state(t);
+    let report = m.step(t, &state, &GOAL, &scene).unwrap();
+    assert_eq!(report.main, Some(sub_id), "events: {:?}", report.events);
+    assert!(report.switched(), "{:?}", report.events);
+    let plan = m.plan().unwrap();
+    assert_eq!(gap_side(plan).signum(), -main_side);
+    let verdict = check_trajectory(
+        plan,
+        &scene,
+        plan.t_start(),
+        plan.t_end(),
+        &Limits::default(),
+        &m.params().safety,
+    );
+    assert!(verdict.safe, "{verdict:?}");
+}
+
+#[test]
+fn consecutive_plans_join_continuously() {
+    let map = two_gap_corridor();
+    let mut m = planner(ManagerParams::trust());
+    let mut state = State::at_rest(0.0, START);
+    let mut previous: Option<PolyTraj> = None;
+    for k in 0..12 {
+        let t = 0.1 * k as f64;
+        let scene = Scene::new(&map, &[], t).unwrap();
+        let report = m.step(t, &state, &GOAL, &scene).unwrap();
+        let plan = m.plan().unwrap().clone();
+        let t0 = report.replan_start.t;
+        assert_eq!(plan.t_start(), t0);
+        if let Some(prev) = &previous {
+            let (a, b) = (prev.state(t0), plan.state(t0));
+            assert!((a.p - b.p).norm() < 1e-9, "position jump at {t0}");
+            assert!((a.v - b.v).norm() < 1e-9, "velocity jump at {t0}");
+            assert!((a.a - b.a).norm() < 1e-9, "acceleration jump at {t0}");
+        }
+        state = plan.state(t + 0.1);
+        previous = Some(plan);
+    }
+}
+
+fn summary(reports: &[StepReport]) -> Vec<String> {
+    reports
+        .iter()
+        .map(|r| {
+            let branches: Vec<String> = r
+                .branches
+                .iter()
+                .map(|b| format!("{}:{}:{:016x}", b.id, b.main, b.j.to_bits()))
+                .collect();
+            format!("{:?} {:?} {}", r.main, r.event_tags(), branches.join(","))
+        })
+        .collect()
+}
+
+#[test]
+fn same_seed_same_branches_with_one_and_two_threads() {
+    let params = SceneParams {
+        size: Vec3::new(40.0, 20.0, 10.0),
+        r_safe: 0.3,
+        ..SceneParams::default()
+    };
+    for seed in [3u64, 11] {
+        let scene_rng = &mut Rng::seed_from_u64(seed);
+        let sc = random_dynamic_scene(8, &params, scene_rng).unwrap();
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut m = planner(ManagerParams {
+                    seed,
+                    ..ManagerParams::trust()
+                });
+                let reports = fly(&mut m, &sc.map, sc.query.goal, sc.query.start, 8, |_| {
+                    sc.forecasts.clone()
+                });
+                (summary(&reports), m.plan().unwrap().clone())
+            })
+        };
+        let (one, plan_one) = run(1);
+        let (two, plan_two) = run(2);
+        assert_eq!(one, two, "seed {seed}");
+        assert_eq!(plan_one, plan_two, "seed {seed}");
+    }
+}
+
+#[test]
+fn never_more_than_n_branches() {
+    // Two classes (the two gaps) but room for one branch: the other is popped every time it is
+    // found, and the main branch is never the one popped.
+    let map = two_gap_corridor();
+    let mut m = planner(ManagerParams {
+        max_branches: 1,
+        ..ManagerParams::trust()
+    });
+    let reports = fly(&mut m, &map, GOAL, State::at_rest(0.0, START), 6, |_| Vec::new());
+    assert!(reports.iter().all(|r| r.branches.len() <= 1));
+    assert!(reports.iter().all(|r| r.main.is_some()));
+    assert!(
+        reports
+            .iter()
+            .flat_map(|r| &r.events)
+            .any(|e| matches!(e, Event::DroppedPopBack { .. })),
+        "the second class must have been found and popped"
+    );
+    let mut m = planner(ManagerParams {
+        max_branches: 2,
+        ..ManagerParams::trust()
+    });
+    let reports = fly(&mut m, &map, GOAL, State::at_rest(0.0, START), 6, |_| Vec::new());
+    assert!(reports.iter().all(|r| r.branches.len() <= 2));
+    assert_eq!(reports.last().unwrap().branches.len(), 2);
+}
+
+/// A backend that ignores obstacles: it continues the start state for 4 s (constant
+/// acceleration), so every trajectory drives into whatever is ahead.
+struct Blind;
+
+impl TrajectoryBackend for Blind {
+    fn name(&self) -> &str {
+        "blind"
+    }
+
+    fn optimize(&self, req: &TrajRequest<'_>, _scene: &Scene<'_>) -> Result<Solution, PlanError> {
+        let s = req.start;
+        let piece = [
+            s.p,
+            s.v,
+            s.a * 0.5,
+            Vec3::zeros(),
+            Vec3::zeros(),
+            Vec3::zeros(),
+        ];
+        Ok(Solution {
+            traj: PolyTraj::new(s.t, vec![4.0], vec![piece])?,
+            costs: CostBreakdown {
+                ht: 4.0,
+                hs: (s.p + s.v * 4.0 - req.goal).norm(),
+                ..CostBreakdown::default()
+            },
+            stats: SolveStats {
+                iteration_count: 0,
+                evaluation_count: 1,
+                elapsed: std::time::Duration::ZERO,
+                status: SolveStatus::Converged,
+            },
+        })
+    }
+}
+
+#[test]
+fn braking_fallback_when_every_branch_collides() {
+    let bounds = Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(100.0, 10.0, 10.0)).unwrap();
+    let map = StaticMap::empty(bounds).unwrap();
+    let mut m = Manager::new(
+        StraightLine,
+        Blind,
+        Tvd::default(),
+        Limits::default(),
+        reproducible(ManagerParams::single_branch()),
+    )
+    .unwrap();
+    // Flying at 8 m/s along x with a clear scene: the blind plan is fine.
+    let start = State {
+        t: 0.0,
+        p: Vec3::new(5.0, 0.0, 5.0),
+        v: Vec3::new(8.0, 0.0, 0.0),
+        a: Vec3::zeros(),
+    };
+    let goal = Vec3::new(95.0, 0.0, 5.0);
+    let scene = Scene::new(&map, &[], 0.0).unwrap();
+    let r = m.step(0.0, &start, &goal, &scene).unwrap();
+    assert!(r.main.is_some() && r.fallback.is_none());
+
+    // A wall of obstacles appears 12 m ahead across the whole corridor.
+    let t = 0.1;
+    let wall: Vec<Forecast> = (-5..=5)
+        .flat_map(|y| (0..=5).map(move |z| (y, z)))
+        .map(|(y, z)| {
+            Forecast::new(
+                ObstacleShape::Sphere,
+                Vec3::new(18.0, 2.0 * y as f64, 2.0 * z as f64),
+                Vec3::zeros(),
+                t,
+                1.5,
+                0.3,
+                0.0,
+            )
+            .unwrap()
+        })
+        .collect();
+    let scene = Scene::new(&map, &wall, t).unwrap();
+    let state = m.plan().unwrap().state(t);
+    let r = m.step(t, &state, &goal, &scene).unwrap();
+    assert!(r.main.is_none());
+    let fallback = r.fallback.as_ref().expect("fallback");
+    assert!(fallback.collision_free, "{fallback:?}");
+    assert_eq!(fallback.along, "committed");
+    assert!(r.events.iter().any(|e| matches!(e, Event::Fallback { .. })));
+    let plan = m.plan().unwrap();
+    let end = plan.state(plan.t_end());
+    assert!(end.v.norm() < 1e-9 && end.p.x < 16.0, "{end:?}");
+    // It keeps braking (and stays clear) in the next cycles.
+    let state = plan.state(t + 0.1);
+    let scene = Scene::new(&map, &wall, t + 0.1).unwrap();
+    let r = m.step(t + 0.1, &state, &goal, &scene).unwrap();
+    assert!(r.fallback.as_ref().is_some_and(|f| f.collision_free));
+}
+
+/// A frontend that never finds a path.
+struct Nothing;
+
+impl PathFrontend for Nothing {
+    fn name(&self) -> &str {
+        "nothing"
+    }
+
+    fn search(
+        &self,
+        _q: &PathQuery,
+        _scene: &Scene<'_>,
+        _rng: &mut Rng,
+    ) -> Result<SearchResult, PlanError> {
+        Ok(SearchResult::default())
+    }
+}
+
+#[test]
+fn an_empty_frontend_result_holds_still_safely() {
+    let map = two_gap_corridor();
+    let mut m = Manager::new(
+        Nothing,
+        utf_minco(),
+        Tvd::default(),
+        Limits::default(),
+        reproducible(ManagerParams {
+            straight_guide_when_empty: false,
+            ..ManagerParams::trust()
+        }),
+    )
+    .unwrap();
+    let scene = Scene::new(&map, &[], 0.0).unwrap();
+    let r = m.step(0.0, &State::at_rest(0.0, START), &GOAL, &scene).unwrap();
+    assert!(r.main.is_none() && r.branches.is_empty());
+    let f = r.fallback.expect("fallback");
+    assert!(f.collision_free);
+    assert_eq!(f.along, "straight");
+    let plan = m.plan().unwrap();
+    assert!((plan.position(plan.t_end()) - START).norm() < 1e-9);
+}
+
+#[test]
+fn an_empty_frontend_result_falls_back_on_the_straight_guide() {
+    let bounds = Aabb::new(Vec3::zeros(), Vec3::new(40.0, 20.0, 10.0)).unwrap();
+    let map = StaticMap::empty(bounds).unwrap();
+    let mut m = Manager::new(
+        Nothing,
+        utf_minco(),
+        Tvd::default(),
+        Limits::default(),
+        reproducible(ManagerParams::trust()),
+    )
+    .unwrap();
+    let goal = Vec3::new(38.0, 10.0, 5.0);
+    let reports = fly(&mut m, &map, goal, State::at_rest(0.0, Vec3::new(2.0, 10.0, 5.0)), 5, |_| {
+        Vec::new()
+    });
+    assert!(reports.iter().all(|r| r.straight_guide && r.main.is_some()));
+    assert!(m.plan().unwrap().position(2.0).x > 2.5);
+}
+
+#[test]
+fn start_on_the_goal_hovers() {
+    let map = two_gap_corridor();
+    let mut m = planner(ManagerParams::trust());
+    let scene = Scene::new(&map, &[], 0.0).unwrap();
+    let r = m.step(0.0, &State::at_rest(0.0, GOAL), &GOAL, &scene).unwrap();
+    let plan = m.plan().expect("a plan");
+    for k in 0..=20 {
+        let t = plan.t_start() + plan.duration() * k as f64 / 20.0;
+        assert!((plan.position(t) - GOAL).norm() < 0.05, "drifts at {t}");
+    }
+    assert!(r.fallback.is_none() || r.fallback.unwrap().collision_free);
+}
+
+#[test]
+fn without_obstacles_the_plan_heads_straight_for_the_goal() {
+    let bounds = Aabb::new(Vec3::zeros(), Vec3::new(40.0, 20.0, 10.0)).unwrap();
+    let map = StaticMap::empty(bounds).unwrap();
+    let mut m = planner(ManagerParams::trust());
+    let start = State::at_rest(0.0, Vec3::new(2.0, 10.0, 5.0));
+    let goal = Vec3::new(38.0, 10.0, 5.0);
+    let reports = fly(&mut m, &map, goal, start, 30, |_| Vec::new());
+    assert!(reports.iter().all(|r| r.fallback.is_none()));
+    let plan = m.plan().unwrap();
+    for k in 0..=20 {
+        let t = plan.t_start() + plan.duration() * k as f64 / 20.0;
+        let p = plan.position(t);
+        assert!((p.y - 10.0).abs() < 0.1 && (p.z - 5.0).abs() < 0.1, "{p:?}");
+    }
+    // It is on its way.
+    assert!(plan.position(3.0).x > 8.0);
+}
+
+#[test]
+fn bad_input_is_an_error_naming_the_field() {
+    let map = two_gap_corridor();
+    let mut m = planner(ManagerParams::trust());
+    let scene = Scene::new(&map, &[], 0.0).unwrap();
+    let inside_wall = Vec3::new(14.5, 0.0, 3.0);
+    let e = m
+        .step(0.0, &State::at_rest(0.0, START), &inside_wall, &scene)
+        .unwrap_err();
+    assert!(matches!(e, PlanError::InCollision { ref field, .. } if field == "goal"), "{e}");
+    let e = m
+        .step(0.0, &State::at_rest(0.0, START), &Vec3::new(50.0, 0.0, 3.0), &scene)
+        .unwrap_err();
+    assert!(matches!(e, PlanError::OutOfBounds { .. }), "{e}");
+    let mut nan = State::at_rest(0.0, START);
+    nan.v.y = f64::NAN;
+    let e = m.step(0.0, &nan, &GOAL, &scene).unwrap_err().to_string();
+    assert!(e.contains("state.v"), "{e}");
+    let e = m
+        .step(f64::INFINITY, &State::at_rest(0.0, START), &GOAL, &scene)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("now"), "{e}");
+    // Nothing was committed by the failed calls.
+    assert!(m.plan().is_none());
+    let e = Manager::new(
+        dev_prm(),
+        UtfMinco::default(),
+        Tvd::default(),
+        Limits::default(),
+        ManagerParams {
+            max_branches: 0,
+            ..ManagerParams::trust()
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("manager.max_branches"), "{e}");
+}
+
+#[test]
+fn a_start_inside_a_static_obstacle_is_survived_not_fatal() {
+    // The vehicle was pushed into a wall (a disturbance): the frontend refuses the start, the
+    // cycle goes on and reports it instead of failing.
+    let map = two_gap_corridor();
+    let mut m = planner(ManagerParams::trust());
+    let scene = Scene::new(&map, &[], 0.0).unwrap();
+    let r = m
+        .step(0.0, &State::at_rest(0.0, Vec3::new(14.5, 0.0, 3.0)), &GOAL, &scene)
+        .expect("not an input error");
+    assert!(
+        r.events
+            .iter()
+            .any(|e| matches!(e, Event::FrontendFailed { .. }))
+    );
+    assert!(m.plan().is_some());
+    let _ = GuidePath::new(vec![START]).unwrap();
+}
+
