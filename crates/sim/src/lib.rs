@@ -6,5 +6,7 @@
 //! nothing pretends to work.
 #![warn(missing_docs)]
 
+pub mod audit;
 pub mod plot;
+pub mod runlog;
 pub mod vehicle;
