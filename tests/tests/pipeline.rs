@@ -38,6 +38,7 @@ fn request<'a>(case: &E2Case, guide: &'a GuidePath) -> TrajRequest<'a> {
         initial: InitialGuess::Guide(guide),
         deadline: None,
         horizon_s: None,
+        max_evaluations: None,
     }
 }
 
@@ -160,6 +161,7 @@ fn dev_prm_guides_utf_minco_to_collision_free_trajectories() {
             initial: InitialGuess::Guide(path),
             deadline: None,
             horizon_s: None,
+            max_evaluations: None,
         };
         let sol = backend.optimize(&req, &scene).unwrap();
         assert!(min_static_clearance(&sol.traj, &scene) > -1e-3);

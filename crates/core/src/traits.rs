@@ -133,6 +133,10 @@ pub struct TrajRequest<'a> {
     /// one horizon instead of the whole remaining distance; near the goal (`r_des = 0`) it is the
     /// paper's `H_s` toward the goal itself. Fixed-terminal backends ignore it.
     pub horizon_s: Option<f64>,
+    /// Optional cap on cost evaluations for this request; the smaller of it and the backend's own
+    /// budget applies. A manager re-solving a branch from a warm start needs far fewer evaluations
+    /// than a cold solve, and refines it again next cycle.
+    pub max_evaluations: Option<usize>,
 }
 
 impl TrajRequest<'_> {
@@ -143,6 +147,13 @@ impl TrajRequest<'_> {
         self.limits.validate()?;
         if let Some(h) = self.horizon_s {
             check_positive("request.horizon_s", h)?;
+        }
+        if self.max_evaluations == Some(0) {
+            return Err(PlanError::invalid(
+                "request.max_evaluations",
+                0,
+                "at least 1 evaluation",
+            ));
         }
         Ok(())
     }

@@ -131,7 +131,8 @@ fn brake(
     let beta_max = target / v0;
     let ramp = beta_max / RAMP_S;
 
-    let mut knots: Vec<(f64, [Vec3; 3])> = vec![(0.0, [p_start, v_start, initial_accel.unwrap_or(a_start)])];
+    let mut knots: Vec<(f64, [Vec3; 3])> =
+        vec![(0.0, [p_start, v_start, initial_accel.unwrap_or(a_start)])];
     let (mut u, mut lambda, mut lambda_dot) = (t0, 1.0f64, 0.0f64);
     let steps_per_knot = (KNOT_S / STEP_S).round() as usize;
     let max_steps = (MAX_BRAKE_S / STEP_S) as usize;

@@ -10,13 +10,12 @@ use trust_core::{
     TrajectoryBackend, Vec3, check_finite, check_finite_vec,
 };
 
+use crate::ManagerParams;
 use crate::brake::{brake_along, brake_straight};
 use crate::report::{
-    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, Origin,
-    StepReport,
+    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, Origin, StepReport,
 };
-use crate::safety::{SafetyVerdict, check_trajectory, window_bounds};
-use crate::ManagerParams;
+use crate::safety::{SafetyVerdict, assess_trajectory, check_trajectory, window_bounds};
 
 /// One kept trajectory branch.
 #[derive(Debug, Clone, PartialEq)]
@@ -113,6 +112,7 @@ pub struct Manager<F, B, H> {
     main: Option<BranchId>,
     committed: Option<PolyTraj>,
     next_id: BranchId,
+    cycle_count: u64,
 }
 
 impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
@@ -151,6 +151,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             main: None,
             committed: None,
             next_id: 0,
+            cycle_count: 0,
         })
     }
 
@@ -181,6 +182,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
 
     /// Forgets every branch and the plan (a new flight); the random stream continues.
     pub fn reset(&mut self) {
+        self.cycle_count = 0;
         self.branches.clear();
         self.main = None;
         self.committed = None;
@@ -251,12 +253,21 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             deadline,
             params: &self.params,
         };
+        let explore = !history
+            || self.cycle_count % self.params.explore_period_cycles as u64 == 0
+            || self.branches.len() < 2
+            || self.main.is_none();
+        self.cycle_count += 1;
         let frontend = &self.frontend;
         let rng = &mut self.rng;
         let (search, warm_out) = rayon::join(
             || {
                 let t = Instant::now();
-                let r = frontend.search(&query, scene, rng);
+                let r = if explore {
+                    Some(frontend.search(&query, scene, rng))
+                } else {
+                    None
+                };
                 (r, t.elapsed())
             },
             || {
@@ -267,7 +278,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         );
         let (search, frontend_time) = search;
         let (paths, frontend_report) = match search {
-            Ok(mut result) => {
+            None => (Vec::new(), None),
+            Some(Ok(mut result)) => {
                 let path_count = result.paths.len();
                 result.paths.truncate(self.params.max_explored_paths);
                 let report = FrontendReport {
@@ -278,7 +290,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 };
                 (result.paths, Some(report))
             }
-            Err(e) => {
+            Some(Err(e)) => {
                 events.push(Event::FrontendFailed {
                     error: e.to_string(),
                 });
@@ -287,7 +299,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         };
         let mut paths = paths;
         let mut fallback_guide = false;
-        if paths.is_empty() && self.params.straight_guide_when_empty {
+        if explore && paths.is_empty() && self.params.straight_guide_when_empty {
             // Beyond the paper: never explore empty-handed. The frontend's cones are
             // conservative (an obstacle's whole sweep over the horizon), so in crowded moments it
             // may find no path while a trajectory that passes behind an obstacle exists; the
@@ -319,26 +331,41 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let mut kept: Vec<Branch> = Vec::new();
         for ((id, origin, _), cand) in warm.into_iter().zip(warm_out) {
             timing.add(&cand);
-            match cand.result {
-                Err(e) => events.push(Event::SolveFailed {
-                    id: Some(id),
-                    error: e.to_string(),
-                }),
-                Ok((solution, verdict)) if verdict.safe => kept.push(Branch {
-                    id,
-                    j: solution.costs.ranking_cost(&weights),
-                    solution,
-                    origin,
-                    warm_started: true,
-                    verdict,
-                }),
+            let failed = match cand.result {
+                Err(e) => {
+                    events.push(Event::SolveFailed {
+                        id: Some(id),
+                        error: e.to_string(),
+                    });
+                    true
+                }
+                Ok((solution, verdict)) if verdict.safe => {
+                    kept.push(Branch {
+                        id,
+                        j: solution.costs.ranking_cost(&weights),
+                        solution,
+                        origin,
+                        warm_started: true,
+                        verdict,
+                    });
+                    false
+                }
                 Ok((solution, verdict)) => {
                     events.push(Event::DroppedCollision {
                         id: Some(id),
                         violation: verdict.violation,
                     });
                     rejected.push(("branch", solution.traj));
+                    true
                 }
+            };
+            if failed && origin == Origin::Marched && !reanchored {
+                let t = Instant::now();
+                if let Some(b) = self.keep_committed(id, &start, scene, &weights) {
+                    events.push(Event::KeptCommitted { id });
+                    kept.push(b);
+                }
+                timing.checker_ms += ms(t.elapsed());
             }
         }
         sort_by_j(&mut kept);
@@ -447,10 +474,48 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         (start, self.committed.is_some())
     }
 
+    /// The main branch with its previous (committed) trajectory, if that still passes the safety
+    /// check from the replan start under the current forecasts: a re-solve that fails (pushed into
+    /// a squeeze, or out of budget) must not throw away a plan that is still good.
+    fn keep_committed(
+        &self,
+        id: BranchId,
+        start: &State,
+        scene: &Scene<'_>,
+        weights: &RankingWeights,
+    ) -> Option<Branch> {
+        let plan = self.committed.as_ref()?;
+        let previous = self.branches.iter().find(|b| b.id == id)?;
+        if previous.solution.traj != *plan || plan.t_end() <= start.t {
+            return None;
+        }
+        let verdict = check_trajectory(
+            plan,
+            scene,
+            start.t,
+            plan.t_end(),
+            &self.limits,
+            &self.params.safety,
+        );
+        verdict.safe.then(|| Branch {
+            id,
+            j: previous.solution.costs.ranking_cost(weights),
+            solution: previous.solution.clone(),
+            origin: Origin::Kept,
+            warm_started: false,
+            verdict,
+        })
+    }
+
     /// Keeps the re-solved branches homotopy-distinct: a warm re-solve can slide into another
     /// branch's class, and the queue must hold one branch per class. Walking in `J` order, a
     /// branch equivalent to an already kept one is dropped (`MergedEquivalent`).
-    fn dedupe(&self, sorted: Vec<Branch>, scene: &Scene<'_>, events: &mut Vec<Event>) -> Vec<Branch> {
+    fn dedupe(
+        &self,
+        sorted: Vec<Branch>,
+        scene: &Scene<'_>,
+        events: &mut Vec<Event>,
+    ) -> Vec<Branch> {
         let mut out: Vec<Branch> = Vec::with_capacity(sorted.len());
         'branches: for b in sorted {
             for k in &out {
@@ -556,8 +621,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         weights: &RankingWeights,
         events: &mut Vec<Event>,
     ) -> Option<BranchId> {
-        let ideal = weights.lambda_s.min(weights.lambda_t / self.limits.v_max)
-            * (start.p - goal).norm();
+        let ideal =
+            weights.lambda_s.min(weights.lambda_t / self.limits.v_max) * (start.p - goal).norm();
         let ranked: Vec<(BranchId, f64)> = kept.iter().map(|b| (b.id, b.j)).collect();
         let incumbent = self.main.filter(|_| self.params.history);
         let decision = choose_main(&ranked, incumbent, ideal, self.params.hysteresis)?;
@@ -601,9 +666,12 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         if let Ok(b) = brake_straight(start, a_max, hold_s) {
             options.push(("straight", b));
         }
+        // The first collision-free option; else the one that collides latest, then least deeply.
         let mut best: Option<(usize, SafetyVerdict)> = None;
+        let rank =
+            |v: &SafetyVerdict| (v.violation.map_or(f64::INFINITY, |x| x.t), v.min_margin_m());
         for (i, (_, traj)) in options.iter().enumerate() {
-            let v = check_trajectory(
+            let v = assess_trajectory(
                 traj,
                 scene,
                 start.t,
@@ -615,7 +683,9 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 best = Some((i, v));
                 break;
             }
-            if best.as_ref().is_none_or(|(_, b)| v.min_margin_m() > b.min_margin_m()) {
+            if best.as_ref().is_none_or(|(_, b)| {
+                rank(&v).partial_cmp(&rank(b)) == Some(std::cmp::Ordering::Greater)
+            }) {
                 best = Some((i, v));
             }
         }
@@ -659,6 +729,10 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
             initial,
             deadline: self.deadline,
             horizon_s: Some(self.horizon_s),
+            max_evaluations: match initial {
+                InitialGuess::WarmStart(_) => self.params.warm_max_evaluations,
+                InitialGuess::Guide(_) => self.params.cold_max_evaluations,
+            },
         };
         match self.backend.optimize(&req, self.scene) {
             Err(e) => Candidate {
@@ -741,12 +815,7 @@ fn sort_by_j(branches: &mut [Branch]) {
 }
 
 /// Drops the worst branches beyond `n`, never `protect`.
-fn pop_back(
-    kept: &mut Vec<Branch>,
-    n: usize,
-    protect: Option<BranchId>,
-    events: &mut Vec<Event>,
-) {
+fn pop_back(kept: &mut Vec<Branch>, n: usize, protect: Option<BranchId>, events: &mut Vec<Event>) {
     while kept.len() > n {
         let Some(i) = kept.iter().rposition(|b| Some(b.id) != protect) else {
             return;

@@ -28,6 +28,16 @@ pub struct ManagerParams {
     /// obstacle's whole sweep over the horizon — so in crowded moments it can find no path while a
     /// trajectory passing behind an obstacle exists in space-time. Default `true`.
     pub straight_guide_when_empty: bool,
+    /// Evaluation budget of a warm-started re-solve (FwdMarch, BwdReplan); `None`: the backend's
+    /// own. The branch is refined again next cycle, so a re-solve need not converge fully.
+    pub warm_max_evaluations: Option<usize>,
+    /// Evaluation budget of a cold solve from a frontend path (FwdExplore); `None`: the backend's
+    /// own.
+    pub cold_max_evaluations: Option<usize>,
+    /// Run FwdExplore (the frontend and the cold solves) every this many cycles, and in every cycle
+    /// that starts with fewer than two kept branches or without a main branch. 1: every cycle (the
+    /// paper).
+    pub explore_period_cycles: usize,
     /// Weights of the ranking cost `J = λ_t·H_t + λ_s·H_s + λ_e·I_e`; `None` uses the paper's rule
     /// (Table Sim-B-1: `λ_t = 1`, `λ_s = 1/v_max`, `λ_e = 1e-4`) with the vehicle's `v_max`.
     pub ranking: Option<RankingWeights>,
@@ -75,6 +85,9 @@ impl ManagerParams {
             history: true,
             max_explored_paths: 5,
             straight_guide_when_empty: true,
+            warm_max_evaluations: None,
+            cold_max_evaluations: None,
+            explore_period_cycles: 1,
             ranking: None,
             horizon_s: 4.0,
             cycle_budget_ms: 50.0,
@@ -132,6 +145,25 @@ impl ManagerParams {
             return Err(PlanError::invalid(
                 "manager.max_explored_paths",
                 self.max_explored_paths,
+                "an integer >= 1",
+            ));
+        }
+        for (field, v) in [
+            ("manager.warm_max_evaluations", self.warm_max_evaluations),
+            ("manager.cold_max_evaluations", self.cold_max_evaluations),
+        ] {
+            if v == Some(0) {
+                return Err(PlanError::invalid(
+                    field,
+                    0,
+                    "at least 1 evaluation, or none",
+                ));
+            }
+        }
+        if self.explore_period_cycles == 0 {
+            return Err(PlanError::invalid(
+                "manager.explore_period_cycles",
+                0,
                 "an integer >= 1",
             ));
         }
@@ -208,6 +240,11 @@ pub struct SafetyParams {
     /// A branch is infeasible if its speed or acceleration exceeds the limits by more than this
     /// fraction. Default 0.1 (the backends' soft penalties overshoot by well under 1 %).
     pub limit_tolerance: f64,
+    /// Also check the straight braking manoeuvre (at `a_max`) that follows a trajectory ending in
+    /// motion: the vehicle must be able to stop safely after the plan ends. Default `true`
+    /// (beyond the paper: UTF-MINCO's free terminal velocity otherwise lets a branch end at full
+    /// speed in front of an obstacle).
+    pub braking_tail: bool,
 }
 
 impl Default for SafetyParams {
@@ -218,6 +255,7 @@ impl Default for SafetyParams {
             static_clearance_m: 0.0,
             dynamic_clearance_m: 0.0,
             limit_tolerance: 0.1,
+            braking_tail: true,
         }
     }
 }
@@ -234,10 +272,7 @@ impl SafetyParams {
                 format!("at most max_step_s ({})", self.max_step_s),
             ));
         }
-        check_non_negative(
-            "manager.safety.static_clearance_m",
-            self.static_clearance_m,
-        )?;
+        check_non_negative("manager.safety.static_clearance_m", self.static_clearance_m)?;
         check_non_negative(
             "manager.safety.dynamic_clearance_m",
             self.dynamic_clearance_m,

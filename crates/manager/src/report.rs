@@ -19,6 +19,9 @@ pub enum Origin {
     Replanned,
     /// `FwdExplore`: a new trajectory from a frontend path (cold start).
     Explored,
+    /// The main branch's previous trajectory, kept because its re-solve failed while it still
+    /// passed the safety check (beyond the paper).
+    Kept,
 }
 
 /// One kept branch after the cycle.
@@ -58,6 +61,12 @@ pub enum Event {
         position_drift_m: f64,
         /// Velocity drift (m/s).
         velocity_drift_mps: f64,
+    },
+    /// The main branch's re-solve failed; its previous trajectory (the committed plan) still passed
+    /// the safety check and was kept.
+    KeptCommitted {
+        /// The main branch.
+        id: BranchId,
     },
     /// A new homotopy class joined the branch set.
     Added {
@@ -140,6 +149,7 @@ impl Event {
     pub fn tag(&self) -> &'static str {
         match self {
             Event::Reanchored { .. } => "reanchored",
+            Event::KeptCommitted { .. } => "kept_committed",
             Event::Added { .. } => "added",
             Event::Replaced { .. } => "replaced",
             Event::DiscardedEquivalent { .. } => "discarded_equivalent",
@@ -227,7 +237,7 @@ pub struct StepReport {
     pub branches: Vec<BranchReport>,
     /// What happened, in order.
     pub events: Vec<Event>,
-    /// The frontend's part (`None` if it failed).
+    /// The frontend's part (`None` if it failed or did not run this cycle).
     pub frontend: Option<FrontendReport>,
     /// Whether the straight guide toward the goal was explored because the frontend found no path
     /// ([`crate::ManagerParams::straight_guide_when_empty`]).

@@ -8,11 +8,17 @@
 //! √3 for the trilinear ESDF), or the vehicle's speed plus an obstacle's forecast speed and radius
 //! growth. A trajectory that passes is therefore collision-free at *every* instant of the window,
 //! not only at the samples (up to the `min_step_s` floor near contact, where it samples densely).
+//!
+//! A trajectory that ends moving is also checked for what comes after it: braking straight along
+//! its final velocity at `a_max` must stay clear ([`SafetyParams::braking_tail`]). A free-terminal
+//! trajectory can otherwise end at full speed just in front of an obstacle, and a vehicle whose
+//! replanning then fails has nowhere to go.
 
 use serde::{Deserialize, Serialize};
 use trust_core::{Aabb, Limits, Piece, PolyTraj, Scene, Vec3};
 
 use crate::SafetyParams;
+use crate::brake::brake_straight;
 
 /// What the clearance was violated against.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -58,6 +64,9 @@ pub struct SafetyVerdict {
     pub max_accel: f64,
     /// Speed or acceleration above the limits by more than the tolerance.
     pub over_limits: bool,
+    /// The trajectory itself was clear but stopping after its end (straight braking at `a_max`)
+    /// would not be ([`SafetyParams::braking_tail`]).
+    pub braking_tail_violated: bool,
     /// Instants checked.
     pub sample_count: usize,
 }
@@ -189,6 +198,74 @@ pub fn check_trajectory(
     limits: &Limits,
     params: &SafetyParams,
 ) -> SafetyVerdict {
+    check(traj, scene, from, until, limits, params, false)
+}
+
+/// [`check_trajectory`] that does not stop at the first violation: the margins are the minima over
+/// the whole window (with the same proven steps where the trajectory is clear and `min_step_s`
+/// where it is not), so that colliding trajectories can be compared by how deep they go. The
+/// braking fallback uses it to choose among imperfect options.
+pub fn assess_trajectory(
+    traj: &PolyTraj,
+    scene: &Scene<'_>,
+    from: f64,
+    until: f64,
+    limits: &Limits,
+    params: &SafetyParams,
+) -> SafetyVerdict {
+    check(traj, scene, from, until, limits, params, true)
+}
+
+fn check(
+    traj: &PolyTraj,
+    scene: &Scene<'_>,
+    from: f64,
+    until: f64,
+    limits: &Limits,
+    params: &SafetyParams,
+    full: bool,
+) -> SafetyVerdict {
+    let mut verdict = check_window(traj, scene, from, until, limits, params, full);
+    // The braking tail: a trajectory that ends moving must leave room to stop after its end.
+    let end = traj.state(traj.t_end());
+    if params.braking_tail
+        && until >= traj.t_end()
+        && end.v.norm() > 1e-6
+        && (verdict.violation.is_none() || full)
+        && let Ok(tail) = brake_straight(&end, limits.a_max, params.min_step_s)
+    {
+        let mut tail_params = params.clone();
+        tail_params.limit_tolerance = f64::INFINITY;
+        let t = check_window(
+            &tail,
+            scene,
+            tail.t_start(),
+            tail.t_end(),
+            limits,
+            &tail_params,
+            full,
+        );
+        verdict.sample_count += t.sample_count;
+        verdict.min_static_margin_m = verdict.min_static_margin_m.min(t.min_static_margin_m);
+        verdict.min_dynamic_margin_m = verdict.min_dynamic_margin_m.min(t.min_dynamic_margin_m);
+        if verdict.violation.is_none() && t.violation.is_some() {
+            verdict.violation = t.violation;
+            verdict.safe = false;
+            verdict.braking_tail_violated = true;
+        }
+    }
+    verdict
+}
+
+fn check_window(
+    traj: &PolyTraj,
+    scene: &Scene<'_>,
+    from: f64,
+    until: f64,
+    limits: &Limits,
+    params: &SafetyParams,
+    full: bool,
+) -> SafetyVerdict {
     let from = if from.is_finite() {
         from
     } else {
@@ -238,6 +315,7 @@ pub fn check_trajectory(
         max_speed,
         max_accel,
         over_limits,
+        braking_tail_violated: false,
         sample_count: 0,
     };
     let max_samples = ((until - from) / params.min_step_s).ceil().min(1e7) as usize + 2;
@@ -277,14 +355,20 @@ pub fn check_trajectory(
                 let escaping = inside && with != Hit::Bounds && m >= previous - 1e-9;
                 if !escaping {
                     verdict.safe = false;
-                    verdict.violation = Some(Violation {
-                        t,
-                        with,
-                        margin_m: if m.is_nan() { f64::NEG_INFINITY } else { m },
-                    });
-                    break;
+                    if verdict.violation.is_none() {
+                        verdict.violation = Some(Violation {
+                            t,
+                            with,
+                            margin_m: if m.is_nan() { f64::NEG_INFINITY } else { m },
+                        });
+                    }
+                    if !full {
+                        break;
+                    }
+                    inside = false;
+                } else {
+                    verdict.escaping = true;
                 }
-                verdict.escaping = true;
                 previous = m;
             }
             None => inside = false,
@@ -292,7 +376,8 @@ pub fn check_trajectory(
         if t >= until {
             break;
         }
-        let proven = if inside {
+        let violating = static_margin.min(dynamic_margin) < 0.0;
+        let proven = if inside || violating {
             params.min_step_s.max(0.01f64.min(params.max_step_s))
         } else {
             let s = static_margin / static_rate.max(1e-12);
@@ -355,16 +440,49 @@ mod tests {
         let m = map(vec![]);
         let scene = Scene::new(&m, &[], 0.0).unwrap();
         let traj = line(0.0, Vec3::zeros(), Vec3::new(5.0, 0.0, 0.0), 4.0);
+        let no_tail = SafetyParams {
+            braking_tail: false,
+            ..SafetyParams::default()
+        };
+        let v = check_trajectory(&traj, &scene, 0.0, 4.0, &Limits::default(), &no_tail);
+        assert!(v.safe && v.violation.is_none());
+        assert!(v.sample_count <= 4.0f64.div_euclid(0.05) as usize + 2);
+    }
+
+    #[test]
+    fn a_trajectory_that_cannot_stop_after_its_end_is_unsafe() {
+        // Ends at 5 m/s, 0.5 m in front of a sphere: braking needs 5²/(2·15) = 0.83 m.
+        let sphere = Shape::Sphere(Sphere::new(Vec3::new(11.5, 0.0, 0.0), 1.0).unwrap());
+        let m = map(vec![sphere]);
+        let scene = Scene::new(&m, &[], 0.0).unwrap();
+        let traj = line(0.0, Vec3::zeros(), Vec3::new(5.0, 0.0, 0.0), 2.0);
         let v = check_trajectory(
             &traj,
             &scene,
             0.0,
-            4.0,
+            2.0,
             &Limits::default(),
             &SafetyParams::default(),
         );
-        assert!(v.safe && v.violation.is_none());
-        assert!(v.sample_count <= 4.0f64.div_euclid(0.05) as usize + 2);
+        assert!(!v.safe && v.braking_tail_violated, "{v:?}");
+        assert!(v.violation.unwrap().t > 2.0);
+        let no_tail = SafetyParams {
+            braking_tail: false,
+            ..SafetyParams::default()
+        };
+        let v = check_trajectory(&traj, &scene, 0.0, 2.0, &Limits::default(), &no_tail);
+        assert!(v.safe, "{v:?}");
+        // 2 m in front it can stop.
+        let traj = line(0.0, Vec3::zeros(), Vec3::new(5.0, 0.0, 0.0), 1.7);
+        let v = check_trajectory(
+            &traj,
+            &scene,
+            0.0,
+            1.7,
+            &Limits::default(),
+            &SafetyParams::default(),
+        );
+        assert!(v.safe, "{v:?}");
     }
 
     #[test]
@@ -496,7 +614,12 @@ mod tests {
             &SafetyParams::default(),
         );
         assert!(!v.safe && v.over_limits && v.violation.is_none());
-        let out = line(0.0, Vec3::new(45.0, 0.0, 0.0), Vec3::new(9.0, 0.0, 0.0), 2.0);
+        let out = line(
+            0.0,
+            Vec3::new(45.0, 0.0, 0.0),
+            Vec3::new(9.0, 0.0, 0.0),
+            2.0,
+        );
         let v = check_trajectory(
             &out,
             &scene,
@@ -519,7 +642,14 @@ mod tests {
             (1.0, 0.0),
             (0.5, 0.5),
         ] {
-            let v = check_trajectory(&traj, &scene, a, b, &Limits::default(), &SafetyParams::default());
+            let v = check_trajectory(
+                &traj,
+                &scene,
+                a,
+                b,
+                &Limits::default(),
+                &SafetyParams::default(),
+            );
             assert!(v.sample_count <= 1002, "{v:?}");
         }
     }

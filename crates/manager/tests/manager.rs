@@ -55,8 +55,11 @@ fn two_gap_corridor() -> StaticMap {
     let wall = |y0: f64, y1: f64| {
         Shape::AaBox(AaBox::new(Vec3::new(14.0, y0, 0.0), Vec3::new(15.0, y1, 6.0)).unwrap())
     };
-    StaticMap::from_shapes(bounds, vec![wall(-6.0, -4.0), wall(-1.0, 1.0), wall(4.0, 6.0)])
-        .unwrap()
+    StaticMap::from_shapes(
+        bounds,
+        vec![wall(-6.0, -4.0), wall(-1.0, 1.0), wall(4.0, 6.0)],
+    )
+    .unwrap()
 }
 
 const START: Vec3 = Vec3::new(2.0, 0.0, 3.0);
@@ -233,7 +236,9 @@ fn never_more_than_n_branches() {
         max_branches: 1,
         ..ManagerParams::trust()
     });
-    let reports = fly(&mut m, &map, GOAL, State::at_rest(0.0, START), 6, |_| Vec::new());
+    let reports = fly(&mut m, &map, GOAL, State::at_rest(0.0, START), 6, |_| {
+        Vec::new()
+    });
     assert!(reports.iter().all(|r| r.branches.len() <= 1));
     assert!(reports.iter().all(|r| r.main.is_some()));
     assert!(
@@ -247,7 +252,9 @@ fn never_more_than_n_branches() {
         max_branches: 2,
         ..ManagerParams::trust()
     });
-    let reports = fly(&mut m, &map, GOAL, State::at_rest(0.0, START), 6, |_| Vec::new());
+    let reports = fly(&mut m, &map, GOAL, State::at_rest(0.0, START), 6, |_| {
+        Vec::new()
+    });
     assert!(reports.iter().all(|r| r.branches.len() <= 2));
     assert_eq!(reports.last().unwrap().branches.len(), 2);
 }
@@ -380,7 +387,9 @@ fn an_empty_frontend_result_holds_still_safely() {
     )
     .unwrap();
     let scene = Scene::new(&map, &[], 0.0).unwrap();
-    let r = m.step(0.0, &State::at_rest(0.0, START), &GOAL, &scene).unwrap();
+    let r = m
+        .step(0.0, &State::at_rest(0.0, START), &GOAL, &scene)
+        .unwrap();
     assert!(r.main.is_none() && r.branches.is_empty());
     let f = r.fallback.expect("fallback");
     assert!(f.collision_free);
@@ -402,9 +411,14 @@ fn an_empty_frontend_result_falls_back_on_the_straight_guide() {
     )
     .unwrap();
     let goal = Vec3::new(38.0, 10.0, 5.0);
-    let reports = fly(&mut m, &map, goal, State::at_rest(0.0, Vec3::new(2.0, 10.0, 5.0)), 5, |_| {
-        Vec::new()
-    });
+    let reports = fly(
+        &mut m,
+        &map,
+        goal,
+        State::at_rest(0.0, Vec3::new(2.0, 10.0, 5.0)),
+        5,
+        |_| Vec::new(),
+    );
     assert!(reports.iter().all(|r| r.straight_guide && r.main.is_some()));
     assert!(m.plan().unwrap().position(2.0).x > 2.5);
 }
@@ -414,7 +428,9 @@ fn start_on_the_goal_hovers() {
     let map = two_gap_corridor();
     let mut m = planner(ManagerParams::trust());
     let scene = Scene::new(&map, &[], 0.0).unwrap();
-    let r = m.step(0.0, &State::at_rest(0.0, GOAL), &GOAL, &scene).unwrap();
+    let r = m
+        .step(0.0, &State::at_rest(0.0, GOAL), &GOAL, &scene)
+        .unwrap();
     let plan = m.plan().expect("a plan");
     for k in 0..=20 {
         let t = plan.t_start() + plan.duration() * k as f64 / 20.0;
@@ -451,9 +467,17 @@ fn bad_input_is_an_error_naming_the_field() {
     let e = m
         .step(0.0, &State::at_rest(0.0, START), &inside_wall, &scene)
         .unwrap_err();
-    assert!(matches!(e, PlanError::InCollision { ref field, .. } if field == "goal"), "{e}");
+    assert!(
+        matches!(e, PlanError::InCollision { ref field, .. } if field == "goal"),
+        "{e}"
+    );
     let e = m
-        .step(0.0, &State::at_rest(0.0, START), &Vec3::new(50.0, 0.0, 3.0), &scene)
+        .step(
+            0.0,
+            &State::at_rest(0.0, START),
+            &Vec3::new(50.0, 0.0, 3.0),
+            &scene,
+        )
         .unwrap_err();
     assert!(matches!(e, PlanError::OutOfBounds { .. }), "{e}");
     let mut nan = State::at_rest(0.0, START);
@@ -490,7 +514,12 @@ fn a_start_inside_a_static_obstacle_is_survived_not_fatal() {
     let mut m = planner(ManagerParams::trust());
     let scene = Scene::new(&map, &[], 0.0).unwrap();
     let r = m
-        .step(0.0, &State::at_rest(0.0, Vec3::new(14.5, 0.0, 3.0)), &GOAL, &scene)
+        .step(
+            0.0,
+            &State::at_rest(0.0, Vec3::new(14.5, 0.0, 3.0)),
+            &GOAL,
+            &scene,
+        )
         .expect("not an input error");
     assert!(
         r.events
@@ -500,4 +529,3 @@ fn a_start_inside_a_static_obstacle_is_survived_not_fatal() {
     assert!(m.plan().is_some());
     let _ = GuidePath::new(vec![START]).unwrap();
 }
-

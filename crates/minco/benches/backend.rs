@@ -119,6 +119,7 @@ fn solve(case: &E2Case, backend: &dyn TrajectoryBackend) -> PolyTraj {
         initial: InitialGuess::Guide(&guide),
         deadline: None,
         horizon_s: None,
+        max_evaluations: None,
     };
     backend
         .optimize(&req, &case.scene())
@@ -136,6 +137,7 @@ fn warm_resolve(case: &E2Case, backend: &dyn TrajectoryBackend, previous: &PolyT
         initial: InitialGuess::WarmStart(previous),
         deadline: None,
         horizon_s: None,
+        max_evaluations: None,
     };
     let scene = Scene {
         t0: t,

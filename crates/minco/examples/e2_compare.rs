@@ -70,6 +70,7 @@ fn warm_resolve(
         initial: InitialGuess::WarmStart(previous),
         deadline: None,
         horizon_s: None,
+        max_evaluations: None,
     };
     let scene = Scene {
         t0: t,
@@ -103,6 +104,7 @@ fn run(case: &E2Case, backend: &dyn TrajectoryBackend, repeats: usize) -> Result
         initial: InitialGuess::Guide(&guide),
         deadline: None,
         horizon_s: None,
+        max_evaluations: None,
     };
     let scene = case.scene();
     let mut times = Vec::with_capacity(repeats);
@@ -195,6 +197,7 @@ fn random_stats(
             initial: InitialGuess::Guide(&guide),
             deadline: None,
             horizon_s: None,
+            max_evaluations: None,
         };
         let scene = case.scene();
         let mut times = Vec::with_capacity(repeats);

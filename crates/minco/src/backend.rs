@@ -28,6 +28,7 @@
 //!     initial: InitialGuess::Guide(&guide),
 //!     deadline: None,
 //!     horizon_s: None,
+//!     max_evaluations: None,
 //! };
 //! let solution = UtfMinco::default().optimize(&req, &case.scene())?;
 //! assert!(solution.traj.duration() > 0.0);

@@ -141,6 +141,7 @@
 //!     initial: InitialGuess::Guide(&guide),
 //!     deadline: None,
 //!     horizon_s: None,
+//!     max_evaluations: None,
 //! };
 //! let scene = case.scene();
 //! let solution = UtfMinco::default().optimize(&req, &scene)?;

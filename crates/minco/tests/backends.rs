@@ -20,6 +20,7 @@ fn request<'a>(case: &E2Case, guide: &'a GuidePath) -> TrajRequest<'a> {
         initial: InitialGuess::Guide(guide),
         deadline: None,
         horizon_s: None,
+        max_evaluations: None,
     }
 }
 
@@ -168,6 +169,7 @@ fn start_on_the_goal_hovers() {
             initial: InitialGuess::Guide(&guide),
             deadline: None,
             horizon_s: None,
+            max_evaluations: None,
         };
         let solution = backend.optimize(&req, &scene).expect("valid");
         assert_valid(&solution, &start, &req.limits, &scene, backend.name());
@@ -202,6 +204,7 @@ fn single_point_guide_with_a_moving_start() {
             initial: InitialGuess::Guide(&guide),
             deadline: None,
             horizon_s: None,
+            max_evaluations: None,
         };
         let solution = backend.optimize(&req, &scene).expect("valid");
         assert_valid(&solution, &start, &req.limits, &scene, backend.name());
@@ -213,6 +216,7 @@ fn single_point_guide_with_a_moving_start() {
         initial: InitialGuess::Guide(&guide),
         deadline: None,
         horizon_s: None,
+        max_evaluations: None,
     };
     let utf = UtfMinco::default().optimize(&req, &scene).expect("valid");
     let end = utf.traj.position(utf.traj.t_end());
@@ -236,6 +240,7 @@ fn no_obstacles_straight_flight() {
         initial: InitialGuess::Guide(&guide),
         deadline: None,
         horizon_s: None,
+        max_evaluations: None,
     };
     for backend in backends() {
         let solution = backend.optimize(&req, &scene).expect("valid");
@@ -427,6 +432,7 @@ fn evaluation_budget_and_deadline_are_respected() {
         let req = TrajRequest {
             deadline: Some(Instant::now()),
             horizon_s: None,
+            max_evaluations: None,
             ..request(&case, &guide)
         };
         let solution = backend.optimize(&req, &case.scene()).expect("valid");
@@ -459,6 +465,7 @@ fn warm_start_from_a_previous_solution() {
         initial: InitialGuess::WarmStart(&first.traj),
         deadline: None,
         horizon_s: None,
+        max_evaluations: None,
     };
     let second = backend.optimize(&req, &case.scene()).expect("valid");
     assert_valid(&second, &start, &case.limits, &case.scene(), "warm start");
@@ -509,6 +516,7 @@ fn forecasts_matter_only_when_near() {
         initial: InitialGuess::Guide(&guide),
         deadline: None,
         horizon_s: None,
+        max_evaluations: None,
     };
     let a = UtfMinco::default()
         .optimize(&req, &Scene::new(&map, &[], 0.0).expect("scene"))

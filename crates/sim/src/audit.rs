@@ -96,11 +96,7 @@ fn aligned_box(p: &[f64; 3], min: &[f64; 3], max: &[f64; 3]) -> f64 {
         outside += q.max(0.0).powi(2);
         inside = inside.max(q);
     }
-    if inside > 0.0 {
-        outside.sqrt()
-    } else {
-        inside
-    }
+    if inside > 0.0 { outside.sqrt() } else { inside }
 }
 
 fn static_distance(p: &[f64; 3], shape: &StaticShape) -> f64 {
@@ -163,7 +159,11 @@ impl PointGrid {
                 }
             }
         }
-        if best <= max_reach { best } else { f64::INFINITY }
+        if best <= max_reach {
+            best
+        } else {
+            f64::INFINITY
+        }
     }
 }
 
@@ -318,7 +318,11 @@ pub fn audit(log: &RunLog, log_dir: &Path) -> Result<Audit, String> {
     );
     check(
         "path_length_m",
-        close(o.path_length_m, r.path_length_m, 1e-3 * r.path_length_m.max(1.0)),
+        close(
+            o.path_length_m,
+            r.path_length_m,
+            1e-3 * r.path_length_m.max(1.0),
+        ),
         o.path_length_m.to_string(),
         r.path_length_m.to_string(),
     );
@@ -348,7 +352,11 @@ pub fn audit(log: &RunLog, log_dir: &Path) -> Result<Audit, String> {
     ] {
         check(
             field,
-            close(logged, recomputed, MAXIMA_TOLERANCE * recomputed.abs().max(1e-9)),
+            close(
+                logged,
+                recomputed,
+                MAXIMA_TOLERANCE * recomputed.abs().max(1e-9),
+            ),
             logged.to_string(),
             recomputed.to_string(),
         );
@@ -379,7 +387,10 @@ mod tests {
 
     #[test]
     fn point_grid_finds_the_nearest_point() {
-        let g = PointGrid::new(vec![[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [10.0, 0.0, 0.0]], 1.0);
+        let g = PointGrid::new(
+            vec![[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [10.0, 0.0, 0.0]],
+            1.0,
+        );
         assert!((g.nearest(&[2.5, 0.0, 0.0], 5.0) - 0.5).abs() < 1e-12);
         assert!((g.nearest(&[6.4, 0.3, 0.0], 50.0) - 0.3f64.hypot(3.4)).abs() < 1e-12);
         assert_eq!(g.nearest(&[6.5, 0.0, 40.0], 2.0), f64::INFINITY);

@@ -474,10 +474,7 @@ impl RunLog {
                         return Err(parse("the header must be the first line, once".into()));
                     }
                     if h.schema != SCHEMA {
-                        return Err(parse(format!(
-                            "schema `{}`, expected `{SCHEMA}`",
-                            h.schema
-                        )));
+                        return Err(parse(format!("schema `{}`, expected `{SCHEMA}`", h.schema)));
                     }
                     header = Some(h);
                 }

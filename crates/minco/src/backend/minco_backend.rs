@@ -62,7 +62,7 @@ impl TrajectoryBackend for Minco {
             self.name(),
             &mut f,
             &mut x,
-            &p.solver,
+            &p.solver.capped(req.max_evaluations),
             req.deadline,
             started,
         )

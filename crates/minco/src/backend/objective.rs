@@ -271,6 +271,15 @@ impl<'a> UtfMincoObjective<'a> {
         self.terminal = self.terminal.clone().with_guidance_surface(radius);
     }
 
+    /// Overrides the terminal-velocity weight `α` of `H_s` (clamped to `[0, 1]`; non-finite
+    /// values are ignored). [`crate::UtfMinco`] sets `α = 1` when the goal lies within the
+    /// request's horizon, so that a trajectory that reaches the goal stops there.
+    pub fn set_terminal_velocity_weight(&mut self, alpha: f64) {
+        if alpha.is_finite() {
+            self.terminal.alpha = alpha.clamp(0.0, 1.0);
+        }
+    }
+
     /// Writes the decision vector for the given waypoints, terminal state and total duration
     /// (clamped to just above the minimum `n·T_min`).
     ///

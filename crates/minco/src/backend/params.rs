@@ -138,6 +138,19 @@ impl SolverParams {
         })
     }
 
+    /// These settings with the evaluation budget lowered to `cap` if that is smaller (a request's
+    /// own budget, [`trust_core::TrajRequest::max_evaluations`]).
+    pub fn capped(&self, cap: Option<usize>) -> SolverParams {
+        let mut s = self.clone();
+        if let Some(c) = cap {
+            s.max_evaluations = match s.max_evaluations {
+                0 => c,
+                m => m.min(c),
+            };
+        }
+        s
+    }
+
     /// The L-BFGS parameters with the effective evaluation budget.
     pub fn effective_lbfgs(&self) -> LbfgsParams {
         let mut p = self.lbfgs.clone();
@@ -219,6 +232,19 @@ mod tests {
         assert_eq!(s.effective_lbfgs().max_evaluations, 50);
         s.max_evaluations = 0;
         assert_eq!(s.effective_lbfgs().max_evaluations, 50);
+    }
+
+    #[test]
+    fn a_request_cap_only_lowers_the_budget() {
+        let s = SolverParams::default();
+        assert_eq!(s.capped(None).max_evaluations, 1000);
+        assert_eq!(s.capped(Some(50)).max_evaluations, 50);
+        assert_eq!(s.capped(Some(5000)).max_evaluations, 1000);
+        let unlimited = SolverParams {
+            max_evaluations: 0,
+            ..SolverParams::default()
+        };
+        assert_eq!(unlimited.capped(Some(70)).max_evaluations, 70);
     }
 
     #[test]

@@ -27,7 +27,10 @@ pub fn guidance_radius(start: &Vec3, goal: &Vec3, horizon_s: f64, limits: &Limit
 ///   iteration); the status says which stopped the solve.
 /// - Receding horizon: with [`TrajRequest::horizon_s`] the terminal is pulled to the goal
 ///   guidance surface ([`guidance_radius`], [`crate::costs::TerminalCost::eval_objective`]) so the
-///   trajectory spans about one horizon; the reported `H_s` is the paper's, toward the goal.
+///   trajectory spans about one horizon; the reported `H_s` is the paper's, toward the goal. Once
+///   the goal is within the horizon (`r_des = 0`) the terminal-velocity weight is `α = 1`, so the
+///   trajectory ends at rest on the goal (the paper ramps `α` only within `d_ε` of the goal, too
+///   late to stop from full speed).
 /// - The returned trajectory starts at `req.start` (position, velocity, acceleration, time) and
 ///   is finite; the cost breakdown is evaluated at it.
 #[derive(Debug, Clone, Default)]
@@ -64,12 +67,14 @@ impl TrajectoryBackend for UtfMinco {
         let mut f =
             UtfMincoObjective::new(scene, &req.start, req.goal, req.limits, p, init.pieces())?;
         if let Some(horizon) = req.horizon_s {
-            f.set_guidance_surface(guidance_radius(
-                &req.start.p,
-                &req.goal,
-                horizon,
-                &req.limits,
-            ));
+            let radius = guidance_radius(&req.start.p, &req.goal, horizon, &req.limits);
+            if radius > 0.0 {
+                f.set_guidance_surface(radius);
+            } else {
+                // The goal is within reach: end there at rest (full terminal-velocity weight)
+                // rather than ramp `α` only over the last `d_ε` metres.
+                f.set_terminal_velocity_weight(1.0);
+            }
         }
         let mut x = vec![0.0; f.dimension()];
         f.encode(
@@ -83,7 +88,7 @@ impl TrajectoryBackend for UtfMinco {
             self.name(),
             &mut f,
             &mut x,
-            &p.solver,
+            &p.solver.capped(req.max_evaluations),
             req.deadline,
             started,
         )
