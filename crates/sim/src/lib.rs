@@ -6,5 +6,11 @@
 //! nothing pretends to work.
 #![warn(missing_docs)]
 
+pub mod error;
+pub mod planner;
 pub mod plot;
+pub mod scenario;
+pub mod sensing;
+pub mod traffic;
 pub mod vehicle;
+pub mod world;
