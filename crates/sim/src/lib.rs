@@ -7,6 +7,12 @@
 #![warn(missing_docs)]
 
 pub mod audit;
+pub mod error;
+pub mod planner;
 pub mod plot;
 pub mod runlog;
+pub mod scenario;
+pub mod sensing;
+pub mod traffic;
 pub mod vehicle;
+pub mod world;
