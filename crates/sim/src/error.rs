@@ -71,6 +71,17 @@ pub enum SimError {
     /// A figure could not be written.
     #[error(transparent)]
     Plot(#[from] PlotError),
+    /// A run log could not be written or read.
+    #[error(transparent)]
+    Log(#[from] crate::runlog::LogError),
+    /// A file could not be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
 }
 
 impl SimError {

@@ -8,8 +8,10 @@
 
 pub mod audit;
 pub mod error;
+pub mod flight_plots;
 pub mod planner;
 pub mod plot;
+pub mod run;
 pub mod runlog;
 pub mod scenario;
 pub mod sensing;
