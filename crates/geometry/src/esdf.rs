@@ -193,7 +193,15 @@ pub struct Esdf {
     dims: [usize; 3],
     distances: Vec<f64>,
     occupied_count: usize,
+    /// Minimum of the voxel values over each block of [`COARSE_BLOCK`]³ voxels plus the next
+    /// voxel on the high side of every axis: a lower bound of the interpolant anywhere in the
+    /// block ([`Esdf::lower_bound`]).
+    coarse: Vec<f64>,
+    coarse_dims: [usize; 3],
 }
+
+/// Voxels per axis of one block of the ESDF's coarse lower-bound grid.
+pub const COARSE_BLOCK: usize = 8;
 
 impl Esdf {
     /// Builds the field from an occupancy grid (`occupied[voxel_index(dims, i, j, k)]`).
@@ -233,13 +241,70 @@ impl Esdf {
                 *d = resolution * (d.sqrt() - i.sqrt());
             }
         }
+        let (coarse, coarse_dims) = coarse_minima(&distances, dims);
         Ok(Self {
             origin,
             resolution,
             dims,
             distances,
             occupied_count,
+            coarse,
+            coarse_dims,
         })
+    }
+
+    /// A lower bound of [`Esdf::signed_distance`] at `p`, from the coarse grid of block minima:
+    /// one memory access instead of eight, for rejecting points that are surely clear (the
+    /// interpolant is a convex combination of its cell's corners, which all lie in `p`'s block
+    /// or on its high faces; outside the grid the extrapolation only adds to the clamped value).
+    /// `-inf` for a non-finite `p`.
+    pub fn lower_bound(&self, p: &Vec3) -> f64 {
+        if !p.iter().all(|c| c.is_finite()) {
+            return f64::NEG_INFINITY;
+        }
+        let mut c = [0usize; 3];
+        for i in 0..3 {
+            c[i] = self.coarse_coord(i, p[i]);
+        }
+        self.coarse[voxel_index(self.coarse_dims, c[0], c[1], c[2])]
+    }
+
+    /// A lower bound of [`Esdf::signed_distance`] over the box `region` (the minimum over the
+    /// coarse blocks it overlaps). `-inf` for a non-finite box.
+    pub fn lower_bound_in(&self, region: &Aabb) -> f64 {
+        if !region
+            .min
+            .iter()
+            .chain(region.max.iter())
+            .all(|c| c.is_finite())
+        {
+            return f64::NEG_INFINITY;
+        }
+        let mut lo = [0usize; 3];
+        let mut hi = [0usize; 3];
+        for i in 0..3 {
+            lo[i] = self.coarse_coord(i, region.min[i]);
+            hi[i] = self.coarse_coord(i, region.max[i]).max(lo[i]);
+        }
+        let mut m = f64::INFINITY;
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    m = m.min(self.coarse[voxel_index(self.coarse_dims, x, y, z)]);
+                }
+            }
+        }
+        m
+    }
+
+    /// The coarse block along axis `i` of world coordinate `x` (clamped into the grid).
+    #[inline]
+    fn coarse_coord(&self, i: usize, x: f64) -> usize {
+        let n = self.dims[i];
+        let g = ((x - self.origin[i]) / self.resolution).clamp(0.0, (n - 1) as f64);
+        // The voxel whose cell holds `g` (the last cell's base is `n − 2`), then its block.
+        let base = (g as usize).min(n.saturating_sub(2));
+        (base / COARSE_BLOCK).min(self.coarse_dims[i] - 1)
     }
 
     /// Builds the field over `bounds` from occupied `points`.
@@ -441,6 +506,46 @@ impl Esdf {
     }
 }
 
+/// Minima of `distances` over blocks of [`COARSE_BLOCK`]³ voxels extended by one voxel on the
+/// high side of each axis, and the block counts per axis.
+fn coarse_minima(distances: &[f64], dims: [usize; 3]) -> (Vec<f64>, [usize; 3]) {
+    let cd = [
+        dims[0].div_ceil(COARSE_BLOCK).max(1),
+        dims[1].div_ceil(COARSE_BLOCK).max(1),
+        dims[2].div_ceil(COARSE_BLOCK).max(1),
+    ];
+    let mut coarse = vec![f64::INFINITY; cd[0] * cd[1] * cd[2]];
+    // Each voxel contributes to its own block and, on a block's low face, to the block below.
+    let blocks = |v: usize, n_blocks: usize| {
+        let b = v / COARSE_BLOCK;
+        let own = b.min(n_blocks - 1);
+        let below = (v % COARSE_BLOCK == 0 && b > 0).then(|| b - 1);
+        (own, below)
+    };
+    for z in 0..dims[2] {
+        let (bz, bz2) = blocks(z, cd[2]);
+        for y in 0..dims[1] {
+            let (by, by2) = blocks(y, cd[1]);
+            let row = voxel_index(dims, 0, y, z);
+            for x in 0..dims[0] {
+                let d = distances[row + x];
+                let (bx, bx2) = blocks(x, cd[0]);
+                for &cz in [Some(bz), bz2].iter().flatten() {
+                    for &cy in [Some(by), by2].iter().flatten() {
+                        for &cx in [Some(bx), bx2].iter().flatten() {
+                            let k = voxel_index(cd, cx, cy, cz);
+                            if d < coarse[k] {
+                                coarse[k] = d;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    (coarse, cd)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -539,6 +644,37 @@ mod tests {
                 prop_assert!((esdf.distances()[i] - expect).abs() < 1e-12);
                 prop_assert_eq!(esdf.distances()[i] < 0.0, occ[i]);
             }
+        }
+
+        /// The coarse grid bounds the interpolant from below, at points and over boxes, inside
+        /// and outside the grid, and is tight somewhere in every block (it is a voxel value).
+        #[test]
+        fn coarse_lower_bounds_hold(
+            dims in (1usize..21, 1usize..21, 1usize..13).prop_map(|(a, b, c)| [a, b, c]),
+            density in 0.0f64..0.2,
+            seed in any::<u64>(),
+        ) {
+            let occ = random_occupancy(dims, density, seed);
+            let res = 0.3;
+            let origin = Vec3::new(-1.0, 2.0, 0.0);
+            let esdf = Esdf::from_occupancy(origin, res, dims, &occ).unwrap();
+            let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5eed);
+            let span = Vec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64) * res;
+            for _ in 0..200 {
+                let u = Vec3::new(rng.random_range(-0.3..1.3), rng.random_range(-0.3..1.3), rng.random_range(-0.3..1.3));
+                let p = origin + span.component_mul(&u);
+                let d = esdf.signed_distance(&p);
+                prop_assert!(esdf.lower_bound(&p) <= d, "{} > {d} at {p:?}", esdf.lower_bound(&p));
+                let half = Vec3::new(rng.random_range(0.0..2.0), rng.random_range(0.0..2.0), rng.random_range(0.0..2.0));
+                let region = Aabb { min: p - half, max: p + half };
+                let lb = esdf.lower_bound_in(&region);
+                for _ in 0..10 {
+                    let q = p + half.component_mul(&Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)));
+                    prop_assert!(lb <= esdf.signed_distance(&q));
+                }
+                prop_assert!(lb <= esdf.lower_bound(&p));
+            }
+            prop_assert_eq!(esdf.lower_bound(&Vec3::new(f64::NAN, 0.0, 0.0)), f64::NEG_INFINITY);
         }
 
         /// Gradient of the trilinear interpolant against central differences, away from cell faces.

@@ -254,7 +254,9 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             params: &self.params,
         };
         let explore = !history
-            || self.cycle_count.is_multiple_of(self.params.explore_period_cycles as u64)
+            || self
+                .cycle_count
+                .is_multiple_of(self.params.explore_period_cycles as u64)
             || self.branches.len() < 2
             || self.main.is_none();
         self.cycle_count += 1;

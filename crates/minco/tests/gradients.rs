@@ -28,18 +28,27 @@ fn check_gradient(
 ) -> Result<(), TestCaseError> {
     let mut xp = x.to_vec();
     for i in 0..x.len() {
-        let h = 1e-6 * (1.0 + x[i].abs());
-        xp[i] = x[i] + h;
-        let fp = f(&xp);
-        xp[i] = x[i] - h;
-        let fm = f(&xp);
-        xp[i] = x[i];
-        let fd = (fp - fm) / (2.0 * h);
         let an = grad[i];
-        prop_assert!(
-            (fd - an).abs() <= rtol * (fd.abs() + an.abs()) + atol,
-            "entry {i}: finite difference {fd} vs analytic {an}"
-        );
+        // Penetration distances are only piecewise smooth (the medial axis of a shape), so a
+        // difference step that straddles a kink disagrees with the one-sided analytic value.
+        // Shrinking the step resolves every kink the point does not sit exactly on; a wrong
+        // gradient disagrees at every step.
+        let mut last = f64::NAN;
+        let mut agrees = false;
+        for rel in [1e-6, 1e-7, 1e-8] {
+            let h = rel * (1.0 + x[i].abs());
+            xp[i] = x[i] + h;
+            let fp = f(&xp);
+            xp[i] = x[i] - h;
+            let fm = f(&xp);
+            xp[i] = x[i];
+            last = (fp - fm) / (2.0 * h);
+            if (last - an).abs() <= rtol * (last.abs() + an.abs()) + atol {
+                agrees = true;
+                break;
+            }
+        }
+        prop_assert!(agrees, "entry {i}: finite difference {last} vs analytic {an}");
     }
     Ok(())
 }
@@ -734,4 +743,27 @@ fn broad_phase_is_exact() {
     )));
     assert!(with.0 > 0.0);
     assert_eq!(with, without);
+}
+
+/// Regression: a case whose 1e-6 difference step straddled the medial axis of a penetrated
+/// obstacle (finite difference 0.311 vs analytic 0.296 on entry 18) — the analytic gradient was
+/// right; the check now shrinks the step before it blames the gradient.
+#[test]
+fn dynamic_obstacle_gradient_across_a_kink() {
+    let (seed, n, kappa) = (7_531_018_759_760_040_945_u64, 2, 2);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let flat = random_pieces(&mut rng, n);
+    let durations: Vec<f64> = (0..n).map(|_| rng.random_range(0.4..1.2)).collect();
+    let t_start = 1.0;
+    let nodes = random_grid_nodes(&mut rng, &to_coeffs(&flat), &durations, t_start, kappa, 4);
+    let forecasts = penetrating_forecasts(&mut rng, &nodes, t_start - 0.5);
+    let value = check_integrand(
+        &mut || Box::new(DynamicObstacleTerm::new(&forecasts, 0.1, 1e-2)),
+        kappa,
+        t_start,
+        &flat,
+        &durations,
+    )
+    .expect("the analytic gradient agrees with a small enough difference step");
+    assert!(value > 0.0);
 }

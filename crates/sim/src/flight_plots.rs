@@ -141,11 +141,27 @@ pub fn write_flight_plots(
     record: &FlightRecord,
     cloud: Option<&[trust_core::Vec3]>,
 ) -> Result<Vec<Written>, PlotError> {
-    let title = format!("{} — {} (seed {})", header.scenario, header.planner, header.seed);
+    let title = format!(
+        "{} — {} (seed {})",
+        header.scenario, header.planner, header.seed
+    );
     let mut written = vec![
-        view(header, record, cloud, Plane::Xy, &format!("{title}: top view")).write(dir, "top")?,
-        view(header, record, cloud, Plane::Xz, &format!("{title}: side view"))
-            .write(dir, "side")?,
+        view(
+            header,
+            record,
+            cloud,
+            Plane::Xy,
+            &format!("{title}: top view"),
+        )
+        .write(dir, "top")?,
+        view(
+            header,
+            record,
+            cloud,
+            Plane::Xz,
+            &format!("{title}: side view"),
+        )
+        .write(dir, "side")?,
     ];
     let series = |f: &dyn Fn(&crate::runlog::StateRecord) -> f64| -> Vec<(f64, f64)> {
         record.states.iter().map(|s| (s.t, f(s))).collect()

@@ -223,7 +223,10 @@ fn run(s: &Scenario, out: &Path, zero_timing: bool, plots: bool) -> Result<ExitC
          max speed {:.2} m/s, max accel {:.2} m/s²",
         planner.label,
         o.status.as_str(),
-        o.with.as_ref().map(|w| format!(" with {w}")).unwrap_or_default(),
+        o.with
+            .as_ref()
+            .map(|w| format!(" with {w}"))
+            .unwrap_or_default(),
         o.t,
         o.path_length_m,
         o.min_clearance_static_m,

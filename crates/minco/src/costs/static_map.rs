@@ -51,7 +51,11 @@ impl<'a> StaticObstacleTerm<'a> {
         }
         self.map
             .shapes_near(&samples_box.inflated(self.clearance), &mut self.near);
-        self.use_esdf = self.map.esdf().is_some_and(|e| e.occupied_count() > 0);
+        // The ESDF matters only where its coarse lower bound over the samples' box is below
+        // the clearance (exact: elsewhere every sample's penalty is 0).
+        self.use_esdf = self.map.esdf().is_some_and(|e| {
+            e.occupied_count() > 0 && e.lower_bound_in(samples_box) < self.clearance
+        });
         self.use_esdf || !self.near.is_empty()
     }
 
@@ -74,6 +78,7 @@ impl<'a> StaticObstacleTerm<'a> {
         }
         if self.use_esdf
             && let Some(esdf) = self.map.esdf()
+            && esdf.lower_bound(p) < self.clearance
         {
             add(esdf.distance_and_gradient(p));
         }
@@ -83,20 +88,24 @@ impl<'a> StaticObstacleTerm<'a> {
     /// Sets `flags[k]` for every node `k` (position `(x[k], y[k], z[k])`) that is not provably
     /// farther than the clearance plus
     /// [`FILTER_MARGIN_M`](crate::costs::integrate::FILTER_MARGIN_M) from a shape kept by the
-    /// piece's broad phase (the rejection of [`beyond_clearance`], column by column); every node
-    /// if the map has a voxel ESDF in use.
+    /// piece's broad phase (the rejection of [`beyond_clearance`], column by column) or whose
+    /// ESDF lower bound ([`trust_geometry::Esdf::lower_bound`]) is below that distance.
     #[expect(
         clippy::neg_cmp_op_on_partial_ord,
         reason = "a NaN must count as possibly active"
     )]
     pub(crate) fn flag_nodes(&self, x: &[f64], y: &[f64], z: &[f64], flags: &mut [bool]) {
-        if self.use_esdf {
-            flags.fill(true);
-            return;
-        }
         let m = flags.len();
         let (x, y, z) = (&x[..m], &y[..m], &z[..m]);
         let grow = self.clearance + crate::costs::integrate::FILTER_MARGIN_M;
+        if self.use_esdf
+            && let Some(esdf) = self.map.esdf()
+        {
+            // The coarse lower bound of the ESDF rejects most nodes with one memory access.
+            for (k, flag) in flags.iter_mut().enumerate() {
+                *flag |= !(esdf.lower_bound(&Vec3::new(x[k], y[k], z[k])) >= grow);
+            }
+        }
         let shapes = self.map.shapes();
         for &i in &self.near {
             match &shapes[i] {
