@@ -54,12 +54,16 @@ fn bench(c: &mut Criterion) {
         c.bench_function(&format!("pdc_signed_distance/{name}"), |bch| {
             bch.iter(|| black_box(&pdc).signed_distance(black_box(&p)))
         });
-        let mut out = Vec::with_capacity(64);
+        let region = trust_predict::Aabb {
+            min: Vec3::repeat(-10.0),
+            max: Vec3::repeat(10.0),
+        };
+        let mut out = Vec::with_capacity(66);
         c.bench_function(&format!("pdc_surface_samples_8x8/{name}"), |bch| {
             bch.iter(|| {
                 out.clear();
                 black_box(&pdc)
-                    .surface_samples_into(8, 8, 0.1, &mut out)
+                    .surface_samples_into(8, 8, 0.1, &region, &mut out)
                     .unwrap();
                 black_box(out.len())
             })

@@ -9,16 +9,19 @@
 //!   distance field (DDF) of paper Sec. III-D (eq. design-of-Io; `∂d/∂t` is term (b) of eq.
 //!   gradients-of-Io). Spheres and vertical cylinders ([`ObstacleShape`]).
 //! * [`Pdc`] — the predictive directional cone of paper Sec. III-B (eq. PDC): the union of the
-//!   growing obstacle over a horizon, with exact point and segment tests for spheres (provably
-//!   conservative for cylinders with a positive clearance), a signed distance, a bounding box and
-//!   the obstacle-aware surface samples on slices along `v0` used by DEV-PRM. The PDC is the convex
-//!   hull of its two end shapes (see the [`pdc`] module).
+//!   growing obstacle over a horizon (or at one instant, [`Pdc::at_time`]), with exact point and
+//!   segment tests for spheres (provably conservative for cylinders with a positive clearance), a
+//!   signed distance with its gradient, a bounding box, a support mapping and the obstacle-aware
+//!   surface samples on slices along `v0` used by DEV-PRM. The PDC is the convex hull of its two
+//!   end shapes (see the [`pdc`] module); its queries are closed forms tuned for the roadmap's hot
+//!   path, and every user of the cone (DEV-PRM, UVD, TVD, safety checks) shares them.
 //! * [`CvEkf`] — the dynamic-obstacle estimator of paper Sec. IV ("EKF"): constant-velocity model,
 //!   position measurements with dropouts, and `mu` derived from the velocity covariance.
-//! * [`convex`] — the closed-form minimizers behind the PDC queries, reusable on their own.
+//! * [`convex`] — the minimizers behind the PDC queries (closed forms over intervals and polygons,
+//!   cutting planes along a segment, segment–segment distance), reusable on their own.
 //!
 //! ```
-//! use trust_predict::{Forecast, ObstacleShape, Vec3};
+//! use trust_predict::{Aabb, Forecast, ObstacleShape, Vec3};
 //!
 //! // A 0.5 m ball at the origin moving along +x at 2 m/s, 0.2 m margin, 0.3 m/s uncertainty growth.
 //! let f = Forecast::new(ObstacleShape::Sphere, Vec3::zeros(), Vec3::new(2.0, 0.0, 0.0), 0.0, 0.5, 0.2, 0.3)?;
@@ -31,9 +34,11 @@
 //! assert!(!pdc.segment_clear(&Vec3::new(2.0, -5.0, 0.0), &Vec3::new(2.0, 5.0, 0.0), 0.1));
 //! // …but not one behind it.
 //! assert!(pdc.segment_clear(&Vec3::new(-2.0, -5.0, 0.0), &Vec3::new(-2.0, 5.0, 0.0), 0.1));
-//! // Obstacle-aware samples: 4 slices along v0, 8 points each, 0.1 m outside the surface.
-//! let samples = pdc.surface_samples(4, 8, 0.1)?;
-//! assert_eq!(samples.len(), 32);
+//! // Obstacle-aware samples in a region: 4 slices along v0, 8 points each, and one beyond each
+//! // end of the sweep, 0.1 m outside the surface.
+//! let region = Aabb { min: Vec3::repeat(-10.0), max: Vec3::repeat(10.0) };
+//! let samples = pdc.surface_samples(4, 8, 0.1, &region)?;
+//! assert_eq!(samples.len(), 34);
 //! assert!(samples.iter().all(|p| (pdc.signed_distance(p) - 0.1).abs() < 1e-9));
 //! # Ok::<(), trust_predict::PredictError>(())
 //! ```
@@ -51,5 +56,5 @@ pub mod pdc;
 pub use ekf::{CvEkf, EkfParams};
 pub use error::PredictError;
 pub use forecast::{Forecast, ObstacleShape};
-pub use pdc::{CLEAR_TOLERANCE, Pdc, perpendicular_frame};
-pub use trust_geometry::Vec3;
+pub use pdc::{CLEAR_TOLERANCE, Pdc, frame_along, round_cone_sdf};
+pub use trust_geometry::{Aabb, Vec3};

@@ -1,74 +1,92 @@
-//! The predictive directional cone (PDC, paper Sec. III-B, eq. PDC).
+//! The predictive directional cone (PDC, paper Sec. III-B, eq. PDC): the one implementation every
+//! user of the cone shares (DEV-PRM's roadmap, the UVD and TVD checkers, safety checks, plots).
 //!
 //! # Geometry
 //!
-//! Over a window `[t_s, t_e]` (length `T`), with `τ = t − t_s`, the obstacle is the base shape at
-//! `c(τ) = c_s + v·τ` inflated to size `r(τ) = r_s + mu·τ` (cylinders: radius and half-height both
-//! grow by `mu·τ`, see [`ObstacleShape`]). The PDC is the union of these shapes over `τ ∈ [0, T]`.
+//! Over a window `[t_s, t_e]` the obstacle is the base shape at `c(t)` inflated to `r(t)` (cylinders:
+//! radius and half-height both grow, see [`ObstacleShape`]). With `λ = (t − t_s)/(t_e − t_s)` the
+//! centre, radius and half-height are affine in `λ`, and the shapes are homothetic, so the shape at
+//! `λ` is the Minkowski combination `(1 − λ)·K(0) + λ·K(1)`: **the PDC is the convex hull of its two
+//! end shapes** — a round cone (tapered capsule) for a sphere, the hull of two vertical cylinders for
+//! a cylinder. (A window that starts before the forecast's `t0`, where the inflation is clamped, is
+//! the hull of its end shapes too; it contains the union of the slices and equals it when `mu = 0`.)
 //!
-//! Because the centre and the size are affine in `τ` and the shapes are homothetic, the shape at
-//! `τ = λT` is the Minkowski combination `(1 − λ)·K(0) + λ·K(T)`, so **the PDC is the convex hull of
-//! its two end shapes** — a tapered capsule ("cone-frustum capsule") for a sphere, the hull of two
-//! cylinders for a cylinder. Two consequences used below:
+//! Consequences used below: `(x, λ) ↦ sd(x, K(λ))` is jointly convex (the signed distance to a
+//! convex set is `sup_n (n·x − σ_K(n))` and the support function `σ_{K(λ)}(n)` is affine in `λ`), so
+//! the PDC's signed distance `min_λ sd(x, K(λ))` is convex in `x` and along any segment.
 //!
-//! * `(x, τ) ↦ sd(x, K(τ))` is jointly convex (the signed distance to a convex set is
-//!   `sup_n (n·x − σ_K(n))`, and the support function `σ_{K(τ)}(n)` is affine in `τ`), so along a
-//!   segment `x(s)` the function `(s, τ) ↦ sd(x(s), K(τ))` is convex on `[0,1] × [0,T]`.
-//! * Sphere: `‖x − c(τ)‖ − r(τ)` is a norm of an affine map minus an affine function, minimized in
-//!   closed form over an interval or a polygon ([`crate::convex`]).
+//! # How the queries are answered
+//!
+//! * **Sphere**: the signed distance of the round cone in closed form ([`round_cone_sdf`]: cap,
+//!   lateral surface, cap), which equals `min_λ (‖x − c(λ)‖ − r(λ))` everywhere. Segment tests
+//!   reject by bounding box, then accept or reject by the distance between the segment and the
+//!   cone's axis, and otherwise minimize the convex distance along the segment by cutting planes
+//!   ([`convex_segment_clear`]).
+//! * **Cylinder, at heights every slice covers** (the *core*: between the higher of the two bottoms
+//!   and the lower of the two tops — every height of interest for an obstacle taller than the
+//!   region, like the full-height pillars of experiment E1): the PDC's cross-section there is the
+//!   2-D round cone of the end discs, so the sphere machinery applies to the horizontal projection.
+//! * **Cylinder, elsewhere**: the *square-rim* distance `min_λ max(ρ(λ), ζ(λ))` (`ρ` the horizontal
+//!   and `ζ` the vertical signed distance to `K(λ)`; a convex function of `x`) is minimized over
+//!   `λ` in closed form — the minimum of the maximum of a norm-minus-affine function and two affine
+//!   ones lies at an end of the window, at the norm's own minimizer, or where two of them cross —
+//!   and a segment test minimizes the horizontal distance over the convex polygon of `(s, λ)` where
+//!   the vertical extents overlap ([`min_over_convex_polygon`]).
 //!
 //! # Exactness
 //!
 //! | query | sphere | cylinder |
 //! |---|---|---|
-//! | [`Pdc::signed_distance`] | exact outside; inside negative, magnitude ≤ true depth | same, by golden-section search on the convex `τ ↦ sd`, to within `(‖v‖ + √2·mu)·1e-13·T` |
+//! | [`Pdc::signed_distance`], [`Pdc::distance_and_gradient`] | exact outside; inside negative, magnitude ≤ true depth | the square-rim distance: exact in the core and wherever the nearest point is not on a rim; near a rim at least `1/√2` of the Euclidean distance; inside negative, magnitude ≤ true depth |
 //! | [`Pdc::point_clear`], [`Pdc::contains`] | exact | exact for `clearance ≤ 0`; conservative for `clearance > 0` |
 //! | [`Pdc::segment_clear`] | exact | exact for `clearance ≤ 0`; conservative for `clearance > 0` |
 //!
-//! "Conservative" for cylinders: a positive clearance is applied by inflating the cylinder's radius
-//! and half-height by `clearance` (a square rim instead of the rounded offset surface), so a point
-//! or segment may be reported blocked although its distance is up to `√2·clearance` — never the
-//! other way round. "Exact" means up to floating-point rounding; all clearance tests additionally
-//! use [`CLEAR_TOLERANCE`] so that rounding can only make them stricter.
+//! "Conservative" for cylinders: a positive clearance inflates the cylinder's radius and half-height
+//! by `clearance` (a square rim instead of the rounded offset surface), so a point or segment may be
+//! reported blocked although its distance is up to `√2·clearance` — never the other way round; in
+//! the core the two agree. "Exact" means up to floating-point rounding; all clearance tests
+//! additionally use [`CLEAR_TOLERANCE`] so that rounding can only make them stricter.
 
-use std::f64::consts::PI;
-
-use trust_geometry::{Aabb, Vec3, cylinder_sdf};
+use trust_geometry::{Aabb, Vec3};
 
 use crate::convex::{
-    NormMinusAffine2d, Vec2, clip_half_plane, min_norm_minus_affine, min_over_convex_polygon,
+    NormMinusAffine2d, Vec2, clip_half_plane, convex_segment_clear, min_norm_minus_affine,
+    min_over_convex_polygon, segment_segment_distance,
 };
-use crate::error::{check_finite, check_non_negative, check_vec};
+use crate::error::{check_finite, check_non_negative};
 use crate::{Forecast, ObstacleShape, PredictError};
+
+mod samples;
 
 /// A point or segment counts as clear of a PDC only if its distance exceeds the requested clearance
 /// by more than this (m); absorbs floating-point rounding in the exact tests.
 pub const CLEAR_TOLERANCE: f64 = 1e-9;
 
-/// Iterations of the golden-section search used for cylinder signed distances
-/// (`0.618^70 ≈ 2.5e-15` of the window).
-const GOLDEN_ITERATIONS: usize = 70;
-
-/// The predictive directional cone of one [`Forecast`] over a time window (paper eq. PDC).
+/// The predictive directional cone of one [`Forecast`] over a time window (paper eq. PDC), with the
+/// data its queries need precomputed (end shapes, bounding box, the core of a cylinder).
 ///
-/// Build with [`Pdc::new`] (the paper's `[t0, t0 + T_h]`) or [`Pdc::over_window`]. See the module
-/// documentation for the geometry and the exactness of every query.
+/// Build with [`Pdc::new`] (the paper's `[t0, t0 + T_h]`), [`Pdc::over_window`] or [`Pdc::at_time`]
+/// (the obstacle at one instant, for temporal checks such as TVD). See the module documentation for
+/// the geometry and the exactness of every query.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pdc {
     forecast: Forecast,
     t_start: f64,
     /// Window length `T` (s).
     duration: f64,
-    /// Centre at `t_start`.
-    c_start: Vec3,
-    /// Radius at `t_start` (sphere or cylinder radius).
-    r_start: f64,
-    /// Vertical half-extent at `t_start` (cylinder half-height; the radius for a sphere).
-    h_start: f64,
-    /// Centre of a ball containing the PDC (the midpoint of the centre path).
-    ball_center: Vec3,
-    /// Radius of that ball: half the path length plus the final shape's circumradius.
-    ball_radius: f64,
+    cylinder: bool,
+    /// Centre at the start and at the end of the window.
+    a: Vec3,
+    b: Vec3,
+    /// Radius at the start and at the end.
+    ra: f64,
+    rb: f64,
+    /// Vertical half-extent at the start and at the end (the radius for a sphere).
+    ha: f64,
+    hb: f64,
+    /// Heights every slice of a cylinder covers: `(higher bottom, lower top)`; empty if `lo > hi`.
+    core: (f64, f64),
+    aabb: Aabb,
 }
 
 impl Pdc {
@@ -81,12 +99,12 @@ impl Pdc {
         Self::over_window(forecast, forecast.t0, forecast.t0 + horizon)
     }
 
-    /// The PDC over an arbitrary window `[t_start, t_end]` with `t0 ≤ t_start ≤ t_end` (e.g. from
-    /// the planning time, later than the observation, to the end of the horizon).
+    /// The PDC over an arbitrary window `[t_start, t_end]` (e.g. from the planning time, later than
+    /// the observation, to the end of the horizon). A window starting before `forecast.t0` gives
+    /// the hull of its end shapes (see the module documentation).
     ///
     /// # Errors
-    /// [`PredictError`] if the forecast is invalid, a time is non-finite, `t_start < forecast.t0`
-    /// or `t_end < t_start`.
+    /// [`PredictError`] if the forecast is invalid, a time is non-finite or `t_end < t_start`.
     pub fn over_window(
         forecast: &Forecast,
         t_start: f64,
@@ -95,29 +113,52 @@ impl Pdc {
         forecast.validate()?;
         check_finite("t_start", t_start)?;
         check_finite("t_end", t_end)?;
-        if t_end < t_start || t_start < forecast.t0 {
+        if t_end < t_start {
             return Err(PredictError::InvalidWindow {
                 t_start,
                 t_end,
-                hint: format!(" and t_start >= forecast.t0 = {}", forecast.t0),
+                hint: String::new(),
             });
         }
-        let (c0, c1) = (forecast.center(t_start), forecast.center(t_end));
-        let (r1, h1) = (forecast.radius(t_end), forecast.vertical_half_extent(t_end));
-        let circumradius = match forecast.shape {
-            ObstacleShape::Sphere => r1,
-            ObstacleShape::Cylinder { .. } => r1.hypot(h1),
-        };
-        Ok(Pdc {
+        Ok(Self::between(forecast, t_start, t_end))
+    }
+
+    /// The obstacle as forecast at time `t` (a window of length zero): the chord test of temporal
+    /// visibility deformation and dense safety checks against forecasts.
+    ///
+    /// # Errors
+    /// [`PredictError`] if the forecast is invalid or `t` is non-finite.
+    pub fn at_time(forecast: &Forecast, t: f64) -> Result<Self, PredictError> {
+        Self::over_window(forecast, t, t)
+    }
+
+    /// Builds the cone of a valid forecast over `[t_a, t_b]`, `t_a <= t_b` finite.
+    #[inline]
+    pub(crate) fn between(forecast: &Forecast, t_a: f64, t_b: f64) -> Self {
+        let (a, b) = (forecast.center(t_a), forecast.center(t_b));
+        let (ra, rb) = (forecast.radius(t_a), forecast.radius(t_b));
+        let (ha, hb) = (
+            forecast.vertical_half_extent(t_a),
+            forecast.vertical_half_extent(t_b),
+        );
+        let (ext_a, ext_b) = (Vec3::new(ra, ra, ha), Vec3::new(rb, rb, hb));
+        Pdc {
             forecast: *forecast,
-            t_start,
-            duration: t_end - t_start,
-            c_start: c0,
-            r_start: forecast.radius(t_start),
-            h_start: forecast.vertical_half_extent(t_start),
-            ball_center: 0.5 * (c0 + c1),
-            ball_radius: 0.5 * (c1 - c0).norm() + circumradius,
-        })
+            t_start: t_a,
+            duration: t_b - t_a,
+            cylinder: matches!(forecast.shape, ObstacleShape::Cylinder { .. }),
+            a,
+            b,
+            ra,
+            rb,
+            ha,
+            hb,
+            core: ((a.z - ha).max(b.z - hb), (a.z + ha).min(b.z + hb)),
+            aabb: Aabb {
+                min: (a - ext_a).inf(&(b - ext_b)),
+                max: (a + ext_a).sup(&(b + ext_b)),
+            },
+        }
     }
 
     /// The forecast this cone was built from.
@@ -140,86 +181,46 @@ impl Pdc {
         self.duration
     }
 
-    /// Radius of a ball around `ball_center` containing every point the clearance tests with
-    /// inflation `c` (clearance plus tolerance) could block: a cylinder grown by `c > 0` in radius
-    /// and half-height has a circumradius at most `√2·c` larger.
-    fn blocking_radius(&self, c: f64) -> f64 {
-        let k = match self.forecast.shape {
-            ObstacleShape::Sphere => 1.0,
-            ObstacleShape::Cylinder { .. } => std::f64::consts::SQRT_2,
-        };
-        self.ball_radius + k * c.max(0.0)
-    }
-
-    fn v(&self) -> Vec3 {
-        self.forecast.v0
-    }
-
-    fn mu(&self) -> f64 {
-        self.forecast.mu
-    }
-
-    fn center_at(&self, tau: f64) -> Vec3 {
-        self.c_start + self.forecast.v0 * tau
-    }
-
-    fn radius_at(&self, tau: f64) -> f64 {
-        self.r_start + self.forecast.mu * tau
-    }
-
-    fn half_height_at(&self, tau: f64) -> f64 {
-        self.h_start + self.forecast.mu * tau
+    /// The two end shapes whose convex hull the PDC is, at the start and at the end of the window:
+    /// `(centre, radius, vertical half-extent)` each (the half-extent equals the radius for a
+    /// sphere).
+    pub fn ends(&self) -> [(Vec3, f64, f64); 2] {
+        [(self.a, self.ra, self.ha), (self.b, self.rb, self.hb)]
     }
 
     /// Axis-aligned bounding box of the PDC (exact: the box of the two end shapes).
+    #[inline]
     pub fn aabb(&self) -> Aabb {
-        let t = self.duration;
-        let (c0, c1) = (self.c_start, self.center_at(t));
-        let h0 = Vec3::new(self.r_start, self.r_start, self.h_start);
-        let h1 = Vec3::new(self.radius_at(t), self.radius_at(t), self.half_height_at(t));
-        Aabb {
-            min: (c0 - h0).inf(&(c1 - h1)),
-            max: (c0 + h0).sup(&(c1 + h1)),
-        }
+        self.aabb
     }
 
-    /// `min_τ sd(p, K(τ))`: the signed distance from `p` to the PDC — exact outside and on the
-    /// boundary; inside it is negative with magnitude at most the true depth.
-    ///
-    /// Sphere: closed form ([`min_norm_minus_affine`]). Cylinder: golden-section search on the
-    /// convex function `τ ↦ sd(p, K(τ))`; the value returned is attained at some `τ` (never below
-    /// the true minimum) and exceeds it by at most `(‖v‖ + √2·mu)·1e-13·T`.
-    /// `p` is assumed finite.
+    /// The signed distance from `p` to the PDC (negative inside); see [`Pdc::distance_and_gradient`].
+    #[inline]
     pub fn signed_distance(&self, p: &Vec3) -> f64 {
-        match self.forecast.shape {
-            ObstacleShape::Sphere => {
-                min_norm_minus_affine(
-                    &(p - self.c_start),
-                    &(-self.v()),
-                    self.r_start,
-                    self.mu(),
-                    0.0,
-                    self.duration,
-                )
-                .value
-            }
-            ObstacleShape::Cylinder { .. } => {
-                let f = |tau: f64| {
-                    cylinder_sdf(
-                        &self.center_at(tau),
-                        self.radius_at(tau),
-                        self.half_height_at(tau),
-                        p,
-                    )
-                    .0
-                };
-                golden_section_min(f, 0.0, self.duration)
-            }
+        self.distance_and_gradient(p).0
+    }
+
+    /// The signed distance from `p` to the PDC and its gradient in `p` (a unit vector except at
+    /// kinks, where it is a subgradient of norm at most 1; never NaN for finite `p`).
+    ///
+    /// Spheres: exact outside; inside negative with magnitude at most the true depth. Cylinders:
+    /// the square-rim distance of the module documentation (exact in the core and away from the
+    /// rims). `p` is assumed finite.
+    #[inline]
+    pub fn distance_and_gradient(&self, p: &Vec3) -> (f64, Vec3) {
+        if !self.cylinder {
+            return round_cone_sdf(&self.a, &self.b, self.ra, self.rb, p);
         }
+        let (d, g) = self.horizontal_distance(p);
+        if d >= 0.0 && self.in_core(p.z) {
+            return (d, g);
+        }
+        self.square_rim_distance(p)
     }
 
     /// Whether `p` lies in the PDC (within [`CLEAR_TOLERANCE`]). Exact for both shapes.
     /// Non-finite `p` counts as contained.
+    #[inline]
     pub fn contains(&self, p: &Vec3) -> bool {
         !self.point_clear(p, 0.0)
     }
@@ -227,675 +228,340 @@ impl Pdc {
     /// Whether `p` is farther than `clearance` (m, may be negative) from the PDC: exact for spheres
     /// and for `clearance ≤ 0`; conservative (may say "not clear" up to `√2·clearance`) for
     /// cylinders with `clearance > 0`. Non-finite input counts as not clear.
+    #[inline]
     pub fn point_clear(&self, p: &Vec3, clearance: f64) -> bool {
-        if check_vec("p", p).is_err() || !clearance.is_finite() {
+        if !p.iter().all(|x| x.is_finite()) || !clearance.is_finite() {
             return false;
         }
         let c = clearance + CLEAR_TOLERANCE;
-        if (p - self.ball_center).norm() > self.blocking_radius(c) {
-            return true; // broad phase: outside a ball containing the (inflated) cone
+        if (0..3).any(|i| p[i] < self.aabb.min[i] - c || p[i] > self.aabb.max[i] + c) {
+            return true; // outside the box grown by the clearance
         }
-        let w = p - self.c_start;
-        let v = self.v();
-        let mu = self.mu();
-        match self.forecast.shape {
-            ObstacleShape::Sphere => {
-                min_norm_minus_affine(&w, &(-v), self.r_start + c, mu, 0.0, self.duration).value
-                    > 0.0
-            }
-            ObstacleShape::Cylinder { .. } => {
-                // Vertical overlap |w_z − v_z τ| ≤ h + c + mu τ is an interval of τ.
-                let h = self.h_start + c;
-                let mut lo = 0.0_f64;
-                let mut hi = self.duration;
-                for (a, b) in [(-v.z - mu, h - w.z), (v.z - mu, h + w.z)] {
-                    if !restrict_interval(a, b, &mut lo, &mut hi) {
-                        return true;
-                    }
-                }
-                let wh = Vec3::new(w.x, w.y, 0.0);
-                let vh = Vec3::new(-v.x, -v.y, 0.0);
-                min_norm_minus_affine(&wh, &vh, self.r_start + c, mu, lo, hi).value > 0.0
-            }
+        if self.cylinder && c >= 0.0 && self.in_core(p.z) {
+            // Inside the 2-D round cone means inside the PDC; outside, the distance is horizontal.
+            return self.horizontal_distance(p).0 > c;
         }
+        self.distance_and_gradient(p).0 > c
     }
 
     /// Whether the segment `a → b` stays farther than `clearance` (m, may be negative) from the
-    /// obstacle at **every** time of the window — the roadmap visibility test of DEV-PRM.
-    ///
-    /// Sphere: exact; minimizes `‖x(s) − c(τ)‖ − r(τ)` over `(s, τ) ∈ [0,1] × [0,T]` in closed form
-    /// (a convex function: norm of an affine map minus an affine function). Cylinder: exact for
-    /// `clearance ≤ 0`, conservative for `clearance > 0` (the cylinder is inflated by `clearance` in
-    /// radius and half-height): the `(s, τ)` where the vertical extents overlap form a convex
-    /// polygon, over which the horizontal distance is minimized in closed form. Non-finite input
-    /// counts as not clear.
+    /// obstacle at **every** time of the window — the roadmap visibility test of DEV-PRM. Exact for
+    /// spheres; for cylinders exact for `clearance ≤ 0` and conservative for `clearance > 0`.
+    /// Non-finite input counts as not clear.
+    #[inline]
     pub fn segment_clear(&self, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
-        if check_vec("a", a).is_err() || check_vec("b", b).is_err() || !clearance.is_finite() {
+        if !a.iter().chain(b.iter()).all(|x| x.is_finite()) || !clearance.is_finite() {
             return false;
         }
+        self.segment_clear_in_box(a, b, clearance, &Aabb::from_segment(a, b))
+    }
+
+    /// [`Pdc::segment_clear`] without the input checks, for a caller that tests one segment against
+    /// many cones: `a`, `b` and `clearance` must be finite and `seg_box` must be
+    /// `Aabb::from_segment(a, b)` (computed once by the caller).
+    #[inline]
+    pub fn segment_clear_in_box(&self, a: &Vec3, b: &Vec3, clearance: f64, seg_box: &Aabb) -> bool {
         let c = clearance + CLEAR_TOLERANCE;
-        if point_segment_distance(&self.ball_center, a, b) > self.blocking_radius(c) {
-            return true; // broad phase: the segment misses a ball containing the (inflated) cone
+        for i in 0..3 {
+            if seg_box.min[i] > self.aabb.max[i] + c || seg_box.max[i] < self.aabb.min[i] - c {
+                return true;
+            }
         }
-        let t = self.duration;
-        let rect = [
+        let (r_min, r_max) = (self.ra.min(self.rb), self.ra.max(self.rb));
+        if !self.cylinder {
+            // The cone lies within `r_max` of its axis and contains the balls of radius `r_min`
+            // around it.
+            let d = segment_segment_distance(a, b, &self.a, &self.b);
+            if d >= r_max + c {
+                return true;
+            }
+            if d < r_min + c {
+                return false;
+            }
+            return convex_segment_clear(a, b, c, |x| {
+                round_cone_sdf(&self.a, &self.b, self.ra, self.rb, x)
+            });
+        }
+        let (fa, fb, ca, cb) = (flat(a), flat(b), flat(&self.a), flat(&self.b));
+        let d = segment_segment_distance(&fa, &fb, &ca, &cb);
+        if d >= r_max + c {
+            return true;
+        }
+        if c >= 0.0 && self.in_core(seg_box.min.z) && self.in_core(seg_box.max.z) {
+            // Within the core the question is 2-D: the projected segment against the round cone
+            // of the end discs.
+            if d < r_min + c {
+                return false;
+            }
+            return convex_segment_clear(&fa, &fb, c, |x| {
+                round_cone_sdf(&ca, &cb, self.ra, self.rb, x)
+            });
+        }
+        self.cylinder_segment_clear(a, b, c)
+    }
+
+    /// A point of the PDC that maximizes `x·d` (its support mapping, for GJK-type separation
+    /// tests); the start centre for `d = 0` or a non-finite `d`.
+    #[inline]
+    pub fn support(&self, d: &Vec3) -> Vec3 {
+        if !self.cylinder {
+            let n = d.norm();
+            if n.is_nan() || n <= 0.0 {
+                return self.a;
+            }
+            let u = d / n;
+            let (pa, pb) = (self.a + u * self.ra, self.b + u * self.rb);
+            return if pa.dot(d) >= pb.dot(d) { pa } else { pb };
+        }
+        let n = (d.x * d.x + d.y * d.y).sqrt();
+        let end = |c: &Vec3, r: f64, h: f64| {
+            let (x, y) = if n > 0.0 {
+                (c.x + d.x / n * r, c.y + d.y / n * r)
+            } else {
+                (c.x, c.y)
+            };
+            Vec3::new(x, y, if d.z >= 0.0 { c.z + h } else { c.z - h })
+        };
+        let (pa, pb) = (
+            end(&self.a, self.ra, self.ha),
+            end(&self.b, self.rb, self.hb),
+        );
+        if pa.dot(d) >= pb.dot(d) { pa } else { pb }
+    }
+
+    #[inline]
+    fn in_core(&self, z: f64) -> bool {
+        z >= self.core.0 && z <= self.core.1
+    }
+
+    /// Signed distance of the horizontal projection of `p` to the 2-D round cone of the end discs
+    /// of a cylinder PDC, with its (horizontal) gradient.
+    #[inline]
+    fn horizontal_distance(&self, p: &Vec3) -> (f64, Vec3) {
+        let (d, g) = round_cone_sdf(&flat(&self.a), &flat(&self.b), self.ra, self.rb, &flat(p));
+        (d, flat(&g))
+    }
+
+    /// Cylinder segment test outside the core: the horizontal distance minimized over the convex
+    /// polygon of `(s, λ) ∈ [0, 1]²` where the vertical extents (inflated by `c`) overlap.
+    fn cylinder_segment_clear(&self, a: &Vec3, b: &Vec3, c: f64) -> bool {
+        let m = a - self.a;
+        let d = b - a;
+        let sweep = self.b - self.a;
+        let (dr, dh) = (self.rb - self.ra, self.hb - self.ha);
+        let square = [
             Vec2::new(0.0, 0.0),
             Vec2::new(1.0, 0.0),
-            Vec2::new(1.0, t),
-            Vec2::new(0.0, t),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(0.0, 1.0),
         ];
-        let m = a - self.c_start;
-        let d = b - a;
-        let v = self.v();
-        let mu = self.mu();
-        match self.forecast.shape {
-            ObstacleShape::Sphere => {
-                let f = NormMinusAffine2d {
-                    m,
-                    mx: d,
-                    my: -v,
-                    k0: self.r_start + c,
-                    k: Vec2::new(0.0, mu),
-                };
-                min_over_convex_polygon(&f, &rect) > 0.0
-            }
-            ObstacleShape::Cylinder { .. } => {
-                // e(s, τ) = m_z + d_z s − v_z τ; need |e| ≤ h + c + mu τ.
-                let h = self.h_start + c;
-                let poly = clip_half_plane(&rect, &Vec2::new(d.z, -v.z - mu), h - m.z);
-                let poly = clip_half_plane(&poly, &Vec2::new(-d.z, v.z - mu), h + m.z);
-                let flat = |x: Vec3| Vec3::new(x.x, x.y, 0.0);
-                let f = NormMinusAffine2d {
-                    m: flat(m),
-                    mx: flat(d),
-                    my: flat(-v),
-                    k0: self.r_start + c,
-                    k: Vec2::new(0.0, mu),
-                };
-                min_over_convex_polygon(&f, &poly) > 0.0
-            }
-        }
-    }
-
-    /// Points on the surface of the PDC inflated by `margin` (paper Sec. III-B, obstacle-aware
-    /// samples), on `slices` cross-sections perpendicular to `v0` at evenly spaced times of the
-    /// window (both ends included; one slice is at the middle), `per_slice` points per ring, rings
-    /// of odd slices rotated by half a step. Deterministic.
-    ///
-    /// * Sphere with `‖v‖ > mu`: ring `k` is the circle along which the sphere at `τ_k` touches the
-    ///   cone's surface (its normal makes `asin(mu/‖v‖)` with the cross-section); each point's
-    ///   signed distance to the PDC is exactly `margin`.
-    /// * Sphere with `‖v‖ ≤ mu` (or `v = 0`): the PDC is the final sphere; rings are its latitudes
-    ///   about `v` (`z` if `v = 0`), signed distance exactly `margin`.
-    /// * Cylinder: rays from the axis point `c(τ_k)` in the cross-section plane are cut where they
-    ///   leave the PDC of the cylinder inflated by `margin` (bisection on the exact membership
-    ///   test); signed distance in `[margin, √2·margin]` (up to `1e-8`). If the final cylinder
-    ///   contains the whole PDC, horizontal rings on its side wall at evenly spaced heights
-    ///   (signed distance exactly `margin`).
-    ///
-    /// Frames perpendicular to `v` are built from the coordinate axis least aligned with `v`, so a
-    /// vertical `v` works.
-    ///
-    /// # Errors
-    /// [`PredictError`] if `margin` is non-finite or negative, or `slices·per_slice` overflows.
-    pub fn surface_samples(
-        &self,
-        slices: usize,
-        per_slice: usize,
-        margin: f64,
-    ) -> Result<Vec<Vec3>, PredictError> {
-        let mut out = Vec::new();
-        self.surface_samples_into(slices, per_slice, margin, &mut out)?;
-        Ok(out)
-    }
-
-    /// As [`Pdc::surface_samples`], appending to `out` (not cleared).
-    ///
-    /// # Errors
-    /// As [`Pdc::surface_samples`].
-    pub fn surface_samples_into(
-        &self,
-        slices: usize,
-        per_slice: usize,
-        margin: f64,
-        out: &mut Vec<Vec3>,
-    ) -> Result<(), PredictError> {
-        check_non_negative("margin", margin)?;
-        let count = slices
-            .checked_mul(per_slice)
-            .ok_or(PredictError::OutOfRange {
-                field: "slices * per_slice".into(),
-                value: slices as f64 * per_slice as f64,
-                expected: "a product that fits in usize",
-            })?;
-        out.reserve(count);
-        if count == 0 {
-            return Ok(());
-        }
-        let t = self.duration;
-        let v = self.v();
-        let mu = self.mu();
-        let speed = v.norm();
-        let ring_angle =
-            |k: usize, j: usize| 2.0 * PI * (j as f64 + 0.5 * (k % 2) as f64) / per_slice as f64;
-        let slice_tau = |k: usize| {
-            if slices == 1 {
-                0.5 * t
-            } else {
-                t * k as f64 / (slices - 1) as f64
-            }
+        // e(s, λ) = m_z + d_z s − sweep_z λ must satisfy |e| ≤ ha + c + dh λ.
+        let h = self.ha + c;
+        let poly = clip_half_plane(&square, &Vec2::new(d.z, -sweep.z - dh), h - m.z);
+        let poly = clip_half_plane(&poly, &Vec2::new(-d.z, sweep.z - dh), h + m.z);
+        let f = NormMinusAffine2d {
+            m: flat(&m),
+            mx: flat(&d),
+            my: -flat(&sweep),
+            k0: self.ra + c,
+            k: Vec2::new(0.0, dr),
         };
-        match self.forecast.shape {
-            ObstacleShape::Sphere => {
-                if speed > mu && speed * t > 0.0 {
-                    let axis = v / speed;
-                    let (e1, e2) = perpendicular_frame(&axis);
-                    let sin_a = mu / speed;
-                    let cos_a = ((1.0 - sin_a) * (1.0 + sin_a)).sqrt();
-                    for k in 0..slices {
-                        let tau = slice_tau(k);
-                        let (c, r) = (self.center_at(tau), self.radius_at(tau) + margin);
-                        for j in 0..per_slice {
-                            let th = ring_angle(k, j);
-                            let n = axis * (-sin_a) + (e1 * th.cos() + e2 * th.sin()) * cos_a;
-                            out.push(c + n * r);
-                        }
-                    }
-                } else {
-                    let axis = if speed > 0.0 { v / speed } else { Vec3::z() };
-                    let (e1, e2) = perpendicular_frame(&axis);
-                    let (c, r) = (self.center_at(t), self.radius_at(t) + margin);
-                    for k in 0..slices {
-                        let phi = PI * (k as f64 + 0.5) / slices as f64;
-                        for j in 0..per_slice {
-                            let th = ring_angle(k, j);
-                            let n = axis * phi.cos() + (e1 * th.cos() + e2 * th.sin()) * phi.sin();
-                            out.push(c + n * r);
-                        }
-                    }
+        min_over_convex_polygon(&f, &poly) > 0.0
+    }
+
+    /// The square-rim distance `min_λ max(ρ(λ), top(λ), bottom(λ))` of a cylinder PDC and a
+    /// subgradient. `ρ(λ) = ‖w − λ·sweep‖_xy − r(λ)` is a norm minus an affine function, the two
+    /// vertical terms are affine, so the minimum lies at `λ ∈ {0, 1}`, at `ρ`'s minimizer, where
+    /// top and bottom cross, or where `ρ` crosses one of them; every candidate is evaluated.
+    fn square_rim_distance(&self, p: &Vec3) -> (f64, Vec3) {
+        let w = p - self.a;
+        let sweep = self.b - self.a;
+        let (wh, sh) = (flat(&w), flat(&sweep));
+        let (dr, dh) = (self.rb - self.ra, self.hb - self.ha);
+        // top(λ) = (w_z − λ sweep_z) − h(λ), bottom(λ) = −(w_z − λ sweep_z) − h(λ): `α + β λ`.
+        let caps = [
+            (w.z - self.ha, -sweep.z - dh),
+            (-w.z - self.ha, sweep.z - dh),
+        ];
+        let radial = |l: f64| (wh - sh * l).norm() - (self.ra + dr * l);
+        let value = |l: f64| {
+            radial(l)
+                .max(caps[0].0 + caps[0].1 * l)
+                .max(caps[1].0 + caps[1].1 * l)
+        };
+        let mut best = (value(0.0), 0.0);
+        let mut consider = |l: f64| {
+            if l.is_finite() {
+                let l = l.clamp(0.0, 1.0);
+                let v = value(l);
+                if v < best.0 {
+                    best = (v, l);
                 }
             }
-            ObstacleShape::Cylinder { .. } => {
-                let vh = v.xy().norm();
-                if vh <= mu && v.z.abs() <= mu {
-                    // The final cylinder contains every earlier one.
-                    let (c, r, h) = (
-                        self.center_at(t),
-                        self.radius_at(t) + margin,
-                        self.half_height_at(t) + margin,
-                    );
-                    for k in 0..slices {
-                        let z = h * (2.0 * (k as f64 + 0.5) / slices as f64 - 1.0);
-                        for j in 0..per_slice {
-                            let th = ring_angle(k, j);
-                            out.push(c + Vec3::new(r * th.cos(), r * th.sin(), z));
-                        }
-                    }
-                } else {
-                    let axis = v / speed;
-                    let (e1, e2) = perpendicular_frame(&axis);
-                    for k in 0..slices {
-                        let tau = slice_tau(k);
-                        for j in 0..per_slice {
-                            let th = ring_angle(k, j);
-                            let dir = e1 * th.cos() + e2 * th.sin();
-                            out.push(self.ray_exit(tau, &dir, margin));
-                        }
-                    }
+        };
+        consider(1.0);
+        consider(min_norm_minus_affine(&wh, &(-sh), self.ra, dr, 0.0, 1.0).arg);
+        if sweep.z != 0.0 {
+            consider(w.z / sweep.z);
+        }
+        for (alpha, beta) in caps {
+            for root in norm_affine_crossings(&wh, &sh, self.ra + alpha, dr + beta) {
+                consider(root);
+            }
+        }
+        let (q, l) = best;
+        // The gradient: an active term whose λ-derivative satisfies the optimality condition at
+        // `l`, or the combination of two active terms whose λ-derivatives cancel (Danskin).
+        let rv = wh - sh * l;
+        let rn = rv.norm();
+        let radial_dir = if rn > 0.0 { rv / rn } else { Vec3::x() };
+        let terms = [
+            (radial(l), radial_dir, -radial_dir.dot(&sh) - dr),
+            (caps[0].0 + caps[0].1 * l, Vec3::z(), caps[0].1),
+            (caps[1].0 + caps[1].1 * l, -Vec3::z(), caps[1].1),
+        ];
+        let scale = 1.0 + w.norm() + sweep.norm() + self.rb + self.hb;
+        let tol_value = 1e-12 * scale;
+        let tol_slope = 1e-9 * (1.0 + sweep.norm() + dr.abs() + dh.abs());
+        let optimal = |eta: f64| (l >= 1.0 || eta >= -tol_slope) && (l <= 0.0 || eta <= tol_slope);
+        let active = |i: usize| terms[i].0 >= q - tol_value;
+        if let Some(t) = (0..3).find(|&i| active(i) && optimal(terms[i].2)) {
+            return (q, terms[t].1);
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                let (ei, ej) = (terms[i].2, terms[j].2);
+                if active(i) && active(j) && ei < 0.0 && ej > 0.0 {
+                    let weight = ej / (ej - ei);
+                    return (q, terms[i].1 * weight + terms[j].1 * (1.0 - weight));
                 }
             }
         }
-        Ok(())
-    }
-
-    /// The first point outside the `margin`-inflated PDC along the ray `c(τ) + λ·dir` (`dir` a unit
-    /// vector), by bisection on the exact membership test (the inflated PDC is convex and contains
-    /// `c(τ)`). The bracket starts at the ray's exit from the shape at `τ` (inside the PDC) and its
-    /// exit from the bounding ball (outside).
-    fn ray_exit(&self, tau: f64, dir: &Vec3, margin: f64) -> Vec3 {
-        let origin = self.center_at(tau);
-        let exit_along = |extent: f64, component: f64| {
-            if component == 0.0 {
-                f64::INFINITY
-            } else {
-                extent / component.abs()
-            }
-        };
-        let radial = exit_along(self.radius_at(tau) + margin, dir.xy().norm());
-        let vertical = exit_along(self.half_height_at(tau) + margin, dir.z);
-        let mut lo = radial.min(vertical);
-        let w = origin - self.ball_center;
-        let rho = self.blocking_radius(margin + CLEAR_TOLERANCE) + 1e-9;
-        let along = dir.dot(&w);
-        let mut hi = -along
-            + (along * along - (w.norm_squared() - rho * rho))
-                .max(0.0)
-                .sqrt();
-        if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) {
-            lo = 0.0;
-        }
-        while hi - lo > 1e-10 * (1.0 + hi) {
-            let mid = 0.5 * (lo + hi);
-            if self.point_clear(&(origin + dir * mid), margin) {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        origin + dir * hi
+        let first = (0..3).find(|&i| active(i)).unwrap_or(0);
+        (q, terms[first].1)
     }
 }
 
-/// Distance from `p` to the segment `a → b`.
-fn point_segment_distance(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
-    let d = b - a;
-    let len2 = d.norm_squared();
-    let s = if len2 > 0.0 {
-        ((p - a).dot(&d) / len2).clamp(0.0, 1.0)
+/// The horizontal part of a vector.
+#[inline]
+fn flat(v: &Vec3) -> Vec3 {
+    Vec3::new(v.x, v.y, 0.0)
+}
+
+/// The `λ` where `‖w − λ·u‖ = α + β·λ` (roots of the squared equation, refined by two Newton steps
+/// on the unsquared one; spurious roots of the squaring may be included — the caller evaluates every
+/// candidate).
+fn norm_affine_crossings(w: &Vec3, u: &Vec3, alpha: f64, beta: f64) -> impl Iterator<Item = f64> {
+    // (u·u − β²) λ² − 2 (w·u + αβ) λ + (w·w − α²) = 0
+    let qa = u.dot(u) - beta * beta;
+    let qb = -2.0 * (w.dot(u) + alpha * beta);
+    let qc = w.dot(w) - alpha * alpha;
+    let mut roots = [f64::NAN; 2];
+    if qa.abs() <= 1e-14 * (u.dot(u) + beta * beta) {
+        if qb != 0.0 {
+            roots[0] = -qc / qb;
+        }
     } else {
-        0.0
-    };
-    (a + d * s - p).norm()
-}
-
-/// Restricts `[lo, hi]` to `{τ : a·τ ≤ b}`; returns `false` if the result is empty.
-fn restrict_interval(a: f64, b: f64, lo: &mut f64, hi: &mut f64) -> bool {
-    if a > 0.0 {
-        *hi = hi.min(b / a);
-    } else if a < 0.0 {
-        *lo = lo.max(b / a);
-    } else if b < 0.0 {
-        return false;
-    }
-    *lo <= *hi
-}
-
-/// Minimum of a convex (unimodal) function on `[lo, hi]` by golden-section search; returns the
-/// smallest value evaluated (so never below the true minimum).
-fn golden_section_min(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
-    const INV_PHI: f64 = 0.618_033_988_749_894_9;
-    let (mut a, mut b) = (lo, hi);
-    let mut best = f(a).min(f(b));
-    if b <= a {
-        return best;
-    }
-    let mut x1 = b - INV_PHI * (b - a);
-    let mut x2 = a + INV_PHI * (b - a);
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..GOLDEN_ITERATIONS {
-        if f1 <= f2 {
-            b = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = b - INV_PHI * (b - a);
-            f1 = f(x1);
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc < 0.0 {
+            roots[0] = -qb / (2.0 * qa); // tangency up to rounding
         } else {
-            a = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = a + INV_PHI * (b - a);
-            f2 = f(x2);
+            let q = -0.5 * (qb + disc.sqrt().copysign(qb));
+            roots[0] = q / qa;
+            if q != 0.0 {
+                roots[1] = qc / q;
+            }
         }
-        best = best.min(f1).min(f2);
     }
-    best
+    roots.into_iter().map(move |mut l| {
+        for _ in 0..2 {
+            let r = w - u * l;
+            let n = r.norm();
+            let slope = -r.dot(u) / n - beta;
+            let step = (n - alpha - beta * l) / slope;
+            if !(n > 0.0 && step.is_finite()) {
+                break;
+            }
+            l -= step;
+        }
+        l
+    })
 }
 
-/// Two unit vectors completing the unit vector `axis` to a right-handed orthonormal frame
-/// `(e1, e2, axis)`. The helper axis is the coordinate axis least aligned with `axis`, so every
-/// direction (including vertical ones) gets a well-conditioned frame.
-pub fn perpendicular_frame(axis: &Vec3) -> (Vec3, Vec3) {
-    let a = axis.abs();
-    let helper = if a.x <= a.y && a.x <= a.z {
-        Vec3::x()
-    } else if a.y <= a.z {
-        Vec3::y()
+/// Signed distance from `p` to the convex hull of the balls `B(a, ra)` and `B(b, rb)` (a round cone,
+/// the PDC of a sphere), with its gradient (a unit vector). It equals
+/// `min_λ (‖p − c(λ)‖ − r(λ))` over the linear interpolation of centre and radius: exact outside and
+/// on the surface; inside, the (negative) distance to the face of the nearest region (cap `a`,
+/// lateral surface, cap `b`).
+#[inline]
+pub fn round_cone_sdf(a: &Vec3, b: &Vec3, ra: f64, rb: f64, p: &Vec3) -> (f64, Vec3) {
+    let ab = b - a;
+    let len = ab.norm();
+    // One ball contains the other (or the sweep is a point): a single sphere.
+    if len <= (ra - rb).abs() || len <= 1e-12 {
+        return if ra >= rb {
+            trust_geometry::sphere_sdf(a, ra, p)
+        } else {
+            trust_geometry::sphere_sdf(b, rb, p)
+        };
+    }
+    let u = ab / len;
+    let ap = p - a;
+    // 2-D coordinates in the half-plane through the axis: x along the axis, y >= 0 radial.
+    let x = ap.dot(&u);
+    let radial = ap - u * x;
+    let y = radial.norm();
+    let radial_dir = if y > 1e-12 {
+        radial / y
     } else {
-        Vec3::z()
+        any_perpendicular(&u)
     };
-    let e1 = (helper - axis * helper.dot(axis)).normalize();
-    let e2 = axis.cross(&e1);
-    (e1, e2)
+    // The lateral line is tangent to both circles; its outward normal is (sin α, cos α).
+    let sin_a = (ra - rb) / len;
+    let cos_a = (1.0 - sin_a * sin_a).max(0.0).sqrt();
+    // Tangent direction from a toward b along the lateral line: (cos α, −sin α).
+    let along = x * cos_a - y * sin_a;
+    if along < 0.0 {
+        trust_geometry::sphere_sdf(a, ra, p)
+    } else if along > len * cos_a {
+        trust_geometry::sphere_sdf(b, rb, p)
+    } else {
+        let d = x * sin_a + y * cos_a - ra;
+        (d, (u * sin_a + radial_dir * cos_a).normalize())
+    }
+}
+
+/// A unit vector perpendicular to `u` (unit).
+#[inline]
+fn any_perpendicular(u: &Vec3) -> Vec3 {
+    let pick = if u.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
+    (pick - u * u.dot(&pick)).normalize()
+}
+
+/// An orthonormal right-handed frame `[x, y, z]` whose first axis points along `axis` (any length)
+/// and whose second axis is horizontal. A vertical `axis` gets world `x` as second axis; a zero or
+/// non-finite `axis` gets the world axes.
+pub fn frame_along(axis: &Vec3) -> [Vec3; 3] {
+    let n = axis.norm();
+    if !n.is_finite() || n <= 0.0 {
+        return [Vec3::x(), Vec3::y(), Vec3::z()];
+    }
+    let x = axis / n;
+    let horizontal_sq = x.x * x.x + x.y * x.y;
+    let y = if horizontal_sq.is_nan() || horizontal_sq <= 0.0 {
+        // Vertical: any horizontal axis is perpendicular to x.
+        Vec3::x()
+    } else {
+        // z × x is horizontal and perpendicular to x.
+        Vec3::new(-x.y, x.x, 0.0) / horizontal_sq.sqrt()
+    };
+    let z = x.cross(&y);
+    [x, y, z]
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use approx::assert_relative_eq;
-    use proptest::prelude::*;
-
-    fn v3(r: f64) -> impl Strategy<Value = Vec3> {
-        (-r..r, -r..r, -r..r).prop_map(|(x, y, z)| Vec3::new(x, y, z))
-    }
-
-    fn shape() -> impl Strategy<Value = ObstacleShape> {
-        prop_oneof![
-            Just(ObstacleShape::Sphere),
-            (0.2..1.5f64).prop_map(|half_height| ObstacleShape::Cylinder { half_height }),
-        ]
-    }
-
-    /// A forecast made at t0 = 0.5 and a PDC over `[t0 + lag, t0 + lag + horizon]`.
-    fn pdc_strategy() -> impl Strategy<Value = Pdc> {
-        (
-            shape(),
-            v3(1.0),
-            v3(2.0),
-            0.2..1.0f64,
-            0.0..0.3f64,
-            0.0..0.6f64,
-            0.0..0.5f64,
-            0.0..3.0f64,
-        )
-            .prop_map(|(shape, p0, v0, r_o, r_safe, mu, lag, horizon)| {
-                let f = Forecast::new(shape, p0, v0, 0.5, r_o, r_safe, mu).unwrap();
-                Pdc::over_window(&f, 0.5 + lag, 0.5 + lag + horizon).unwrap()
-            })
-    }
-
-    /// The "square-rim" distance `max(q_r, q_z)` that the cylinder clearance tests use; equals the
-    /// signed distance except outside near the rim, where it is smaller.
-    fn square_rim(pdc: &Pdc, x: &Vec3, t: f64) -> f64 {
-        let f = pdc.forecast();
-        let q = x - f.center(t);
-        (q.x.hypot(q.y) - f.radius(t)).max(q.z.abs() - f.vertical_half_extent(t))
-    }
-
-    /// Dense minimum over (s, t) of a function, with the grid's Lipschitz slack.
-    fn dense_min(
-        pdc: &Pdc,
-        a: &Vec3,
-        b: &Vec3,
-        n: usize,
-        g: impl Fn(&Vec3, f64) -> f64,
-    ) -> (f64, f64) {
-        let mut best = f64::INFINITY;
-        for i in 0..=n {
-            let x = a + (b - a) * (i as f64 / n as f64);
-            for j in 0..=n {
-                let t = pdc.t_start() + pdc.horizon() * j as f64 / n as f64;
-                best = best.min(g(&x, t));
-            }
-        }
-        let f = pdc.forecast();
-        let lip_s = (b - a).norm();
-        let lip_t = f.v0.norm() + std::f64::consts::SQRT_2 * f.mu;
-        (best, (lip_s + lip_t * pdc.horizon()) / n as f64)
-    }
-
-    #[test]
-    fn window_validation() {
-        let f = Forecast::sphere(Vec3::zeros(), Vec3::x(), 1.0, 0.5, 0.0, 0.1).unwrap();
-        assert!(
-            matches!(Pdc::new(&f, -1.0), Err(PredictError::OutOfRange { ref field, .. }) if field == "horizon")
-        );
-        assert!(Pdc::new(&f, f64::NAN).is_err());
-        assert!(matches!(
-            Pdc::over_window(&f, 0.5, 2.0),
-            Err(PredictError::InvalidWindow { .. })
-        ));
-        assert!(Pdc::over_window(&f, 2.0, 1.5).is_err());
-        let mut bad = f;
-        bad.r_o = -1.0;
-        assert!(Pdc::new(&bad, 1.0).is_err());
-        let p = Pdc::over_window(&f, 1.5, 3.0).unwrap();
-        assert_relative_eq!(p.t_end(), 3.0);
-        assert_relative_eq!(p.horizon(), 1.5);
-        assert_eq!(p.forecast(), &f);
-    }
-
-    #[test]
-    fn sphere_cone_closed_form_on_axis_and_side() {
-        // r(τ) = 1 + 0.5τ, c(τ) = (2τ, 0, 0), T = 2: end ball at x = 4 with r = 2.
-        let f =
-            Forecast::sphere(Vec3::zeros(), Vec3::new(2.0, 0.0, 0.0), 0.0, 1.0, 0.0, 0.5).unwrap();
-        let pdc = f.pdc(2.0).unwrap();
-        assert_relative_eq!(
-            pdc.signed_distance(&Vec3::new(7.0, 0.0, 0.0)),
-            1.0,
-            epsilon = 1e-12
-        );
-        assert_relative_eq!(
-            pdc.signed_distance(&Vec3::new(-3.0, 0.0, 0.0)),
-            2.0,
-            epsilon = 1e-12
-        );
-        // Beside the cone: the tangent line has slope sin α = 0.25.
-        let p = Vec3::new(2.0, 5.0, 0.0);
-        let brute = (0..=20000)
-            .map(|i| f.signed_distance(&p, 2.0 * i as f64 / 20000.0))
-            .fold(f64::INFINITY, f64::min);
-        assert_relative_eq!(pdc.signed_distance(&p), brute, epsilon = 1e-6);
-        assert!(pdc.contains(&Vec3::new(3.9, 1.9, 0.0)));
-        assert!(!pdc.contains(&Vec3::new(0.0, 1.1, 0.0)));
-    }
-
-    #[test]
-    fn slow_sphere_cone_is_the_final_ball() {
-        let f =
-            Forecast::sphere(Vec3::zeros(), Vec3::new(0.0, 0.0, 0.3), 0.0, 1.0, 0.0, 0.5).unwrap();
-        let pdc = f.pdc(2.0).unwrap();
-        for p in [
-            Vec3::new(0.0, 0.0, -3.0),
-            Vec3::new(2.5, 0.0, 0.6),
-            Vec3::new(0.1, 0.2, 0.3),
-        ] {
-            assert_relative_eq!(
-                pdc.signed_distance(&p),
-                f.signed_distance(&p, 2.0),
-                epsilon = 1e-12
-            );
-        }
-        let samples = pdc.surface_samples(5, 7, 0.2).unwrap();
-        assert_eq!(samples.len(), 35);
-        for s in &samples {
-            assert_relative_eq!(pdc.signed_distance(s), 0.2, epsilon = 1e-9);
-        }
-    }
-
-    #[test]
-    fn zero_velocity_and_zero_horizon_are_fine() {
-        for shape in [
-            ObstacleShape::Sphere,
-            ObstacleShape::Cylinder { half_height: 1.0 },
-        ] {
-            let f = Forecast::new(
-                shape,
-                Vec3::new(1.0, 1.0, 1.0),
-                Vec3::zeros(),
-                0.0,
-                0.5,
-                0.1,
-                0.0,
-            )
-            .unwrap();
-            for horizon in [0.0, 2.0] {
-                let pdc = f.pdc(horizon).unwrap();
-                let samples = pdc.surface_samples(3, 6, 0.1).unwrap();
-                assert_eq!(samples.len(), 18);
-                for s in &samples {
-                    let d = pdc.signed_distance(s);
-                    assert!(
-                        d > 0.1 - 1e-9 && d < 0.1 * std::f64::consts::SQRT_2 + 1e-9,
-                        "{shape:?}: {d}"
-                    );
-                }
-                assert!(pdc.contains(&f.p0));
-                assert!(!pdc.segment_clear(
-                    &Vec3::new(-5.0, 1.0, 1.0),
-                    &Vec3::new(5.0, 1.0, 1.0),
-                    0.0
-                ));
-                assert!(pdc.segment_clear(
-                    &Vec3::new(-5.0, 3.0, 1.0),
-                    &Vec3::new(5.0, 3.0, 1.0),
-                    0.5
-                ));
-                // A degenerate segment behaves like a point.
-                let p = Vec3::new(1.0, 1.75, 1.0);
-                assert_eq!(pdc.segment_clear(&p, &p, 0.1), pdc.point_clear(&p, 0.1));
-            }
-        }
-    }
-
-    #[test]
-    fn vertical_velocity_frames_work() {
-        for shape in [
-            ObstacleShape::Sphere,
-            ObstacleShape::Cylinder { half_height: 0.5 },
-        ] {
-            let f = Forecast::new(
-                shape,
-                Vec3::zeros(),
-                Vec3::new(0.0, 0.0, -2.0),
-                0.0,
-                0.5,
-                0.0,
-                0.2,
-            )
-            .unwrap();
-            let pdc = f.pdc(1.5).unwrap();
-            let samples = pdc.surface_samples(4, 6, 0.05).unwrap();
-            assert_eq!(samples.len(), 24);
-            for s in &samples {
-                assert!(s.iter().all(|x| x.is_finite()));
-                let d = pdc.signed_distance(s);
-                assert!(
-                    d > 0.05 - 1e-9 && d < 0.05 * std::f64::consts::SQRT_2 + 1e-9,
-                    "{shape:?}: {d}"
-                );
-            }
-        }
-        let (e1, e2) = perpendicular_frame(&Vec3::z());
-        assert_relative_eq!(e1.dot(&e2), 0.0);
-        assert_relative_eq!(e1.cross(&e2), Vec3::z());
-    }
-
-    #[test]
-    fn non_finite_queries_are_blocked_and_bad_margin_is_an_error() {
-        let f = Forecast::sphere(Vec3::zeros(), Vec3::x(), 0.0, 0.5, 0.0, 0.1).unwrap();
-        let pdc = f.pdc(1.0).unwrap();
-        let nan = Vec3::new(f64::NAN, 0.0, 0.0);
-        assert!(pdc.contains(&nan));
-        assert!(!pdc.point_clear(&Vec3::new(9.0, 9.0, 9.0), f64::NAN));
-        assert!(!pdc.segment_clear(&nan, &Vec3::zeros(), 0.1));
-        assert!(!pdc.segment_clear(
-            &Vec3::new(9.0, 9.0, 9.0),
-            &Vec3::new(9.0, 9.0, 8.0),
-            f64::INFINITY
-        ));
-        assert!(pdc.surface_samples(2, 2, -0.1).is_err());
-        assert!(pdc.surface_samples(2, 2, f64::NAN).is_err());
-        assert!(pdc.surface_samples(usize::MAX, 2, 0.1).is_err());
-        assert!(pdc.surface_samples(0, 5, 0.1).unwrap().is_empty());
-    }
-
-    #[test]
-    fn tall_cylinder_crossing_a_horizontal_segment() {
-        // A pillar (r = 0.3, h = 2) walking along +y at 1 m/s crosses the segment x ∈ [-3, 3], y = 2.
-        let f = Forecast::new(
-            ObstacleShape::Cylinder { half_height: 2.0 },
-            Vec3::new(0.0, 0.0, 1.0),
-            Vec3::new(0.0, 1.0, 0.0),
-            0.0,
-            0.3,
-            0.0,
-            0.0,
-        )
-        .unwrap();
-        let (a, b) = (Vec3::new(-3.0, 2.0, 1.0), Vec3::new(3.0, 2.0, 1.0));
-        assert!(!f.pdc(3.0).unwrap().segment_clear(&a, &b, 0.1));
-        assert!(f.pdc(1.5).unwrap().segment_clear(&a, &b, 0.1)); // it has not arrived yet
-        // Flying above it is clear; a clearance reaching down to the top is not.
-        let (a, b) = (Vec3::new(-3.0, 2.0, 3.5), Vec3::new(3.0, 2.0, 3.5));
-        assert!(f.pdc(3.0).unwrap().segment_clear(&a, &b, 0.4));
-        assert!(!f.pdc(3.0).unwrap().segment_clear(&a, &b, 0.6));
-    }
-
-    proptest! {
-        #[test]
-        fn signed_distance_matches_dense_time_sampling(pdc in pdc_strategy(), p in v3(4.0)) {
-            let n = 4000;
-            let f = pdc.forecast();
-            let dense = (0..=n)
-                .map(|j| f.signed_distance(&p, pdc.t_start() + pdc.horizon() * j as f64 / n as f64))
-                .fold(f64::INFINITY, f64::min);
-            let slack = (f.v0.norm() + 1.5 * f.mu) * pdc.horizon() / n as f64 + 1e-9;
-            let d = pdc.signed_distance(&p);
-            prop_assert!(d <= dense + 1e-9, "{d} above dense {dense}");
-            prop_assert!(d >= dense - slack, "{d} below dense {dense}");
-        }
-
-        #[test]
-        fn point_clear_agrees_with_signed_distance(pdc in pdc_strategy(), p in v3(4.0), clearance in -0.2..0.5f64) {
-            let d = pdc.signed_distance(&p);
-            let clear = pdc.point_clear(&p, clearance);
-            if d < clearance - 1e-7 {
-                prop_assert!(!clear, "d = {d} < clearance {clearance} but clear");
-            }
-            if !clear {
-                let bound = match pdc.forecast().shape {
-                    ObstacleShape::Sphere => clearance,
-                    ObstacleShape::Cylinder { .. } => clearance.max(std::f64::consts::SQRT_2 * clearance),
-                };
-                prop_assert!(d <= bound + 1e-7, "blocked but d = {d} > {bound}");
-            }
-            prop_assert_eq!(pdc.contains(&p), !pdc.point_clear(&p, 0.0));
-        }
-
-        #[test]
-        fn segment_clear_agrees_with_dense_sampling(
-            pdc in pdc_strategy(), a in v3(4.0), b in v3(4.0), clearance in -0.2..0.5f64,
-        ) {
-            let f = *pdc.forecast();
-            let clear = pdc.segment_clear(&a, &b, clearance);
-            let (dense_sd, slack) = dense_min(&pdc, &a, &b, 120, |x, t| f.signed_distance(x, t));
-            // A sampled hit must be reported.
-            if dense_sd < clearance - 1e-9 {
-                prop_assert!(!clear, "dense min {dense_sd} < clearance {clearance} but reported clear");
-            }
-            // A reported block must be (nearly) real: exact for spheres, the square-rim superset for
-            // cylinders.
-            if !clear {
-                let dense_exact = match f.shape {
-                    ObstacleShape::Sphere => dense_sd,
-                    ObstacleShape::Cylinder { .. } => dense_min(&pdc, &a, &b, 120, |x, t| square_rim(&pdc, x, t)).0,
-                };
-                prop_assert!(dense_exact <= clearance + slack + 1e-9,
-                    "blocked but dense min {dense_exact} > clearance {clearance} + slack {slack}");
-            }
-        }
-
-        #[test]
-        fn surface_samples_lie_on_the_inflated_surface(
-            pdc in pdc_strategy(), slices in 1usize..6, per_slice in 1usize..9, margin in 0.0..0.3f64,
-        ) {
-            let samples = pdc.surface_samples(slices, per_slice, margin).unwrap();
-            prop_assert_eq!(samples.len(), slices * per_slice);
-            for s in &samples {
-                let d = pdc.signed_distance(s);
-                match pdc.forecast().shape {
-                    ObstacleShape::Sphere => prop_assert!((d - margin).abs() < 1e-9, "d = {d}, margin {margin}"),
-                    ObstacleShape::Cylinder { .. } => prop_assert!(
-                        d > margin - 1e-8 && d < std::f64::consts::SQRT_2 * margin + 1e-8,
-                        "d = {d}, margin {margin}"
-                    ),
-                }
-            }
-        }
-
-        #[test]
-        fn aabb_contains_the_cone(pdc in pdc_strategy(), dirs in proptest::collection::vec(v3(1.0), 8)) {
-            let b = pdc.aabb();
-            let f = pdc.forecast();
-            for (j, dir) in dirs.iter().enumerate() {
-                prop_assume!(dir.norm() > 1e-3);
-                let t = pdc.t_start() + pdc.horizon() * j as f64 / 7.0;
-                let c = f.center(t);
-                let ext = Vec3::new(f.radius(t), f.radius(t), f.vertical_half_extent(t));
-                let corner = c + ext.component_mul(&dir.map(f64::signum));
-                prop_assert!(b.inflated(1e-9).contains(&corner));
-            }
-        }
-    }
-}
+mod tests;

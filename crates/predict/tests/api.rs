@@ -9,7 +9,7 @@ use trust_predict::convex::{
     NormMinusAffine2d, Vec2, min_norm_minus_affine, min_over_convex_polygon,
 };
 use trust_predict::{
-    CLEAR_TOLERANCE, CvEkf, EkfParams, Forecast, ObstacleShape, Pdc, PredictError, Vec3,
+    Aabb, CLEAR_TOLERANCE, CvEkf, EkfParams, Forecast, ObstacleShape, Pdc, PredictError, Vec3,
 };
 
 /// Tracks a pedestrian-like cylinder walking at constant velocity and checks that its forecast
@@ -80,9 +80,14 @@ fn cone_blocks_what_the_obstacle_will_sweep() {
     assert!(short.segment_clear(&Vec3::new(-4.0, 0.0, 1.0), &Vec3::new(4.0, 0.0, 1.0), 0.2));
     assert!(pdc.aabb().contains(&Vec3::new(0.0, 1.0, 1.0)));
     // Samples around the cone are obstacle-aware roadmap seeds: on the surface, 0.1 m out.
+    let region = Aabb {
+        min: Vec3::repeat(-10.0),
+        max: Vec3::repeat(10.0),
+    };
     let mut out = Vec::new();
-    pdc.surface_samples_into(3, 6, 0.1, &mut out).unwrap();
-    assert_eq!(out.len(), 18);
+    pdc.surface_samples_into(3, 6, 0.1, &region, &mut out)
+        .unwrap();
+    assert_eq!(out.len(), 20); // 3 rings of 6 and one point beyond each end
     for s in &out {
         assert_relative_eq!(pdc.signed_distance(s), 0.1, epsilon = 1e-9);
         assert!(pdc.point_clear(s, 0.05) && !pdc.point_clear(s, 0.15));
@@ -106,9 +111,12 @@ fn errors_name_the_field_and_value() {
         "forecast.mu = -1 is out of range: expected a finite number >= 0"
     );
     let f = Forecast::sphere(Vec3::zeros(), Vec3::zeros(), 2.0, 0.5, 0.1, 0.0).unwrap();
-    let e = Pdc::over_window(&f, 1.0, 3.0).unwrap_err();
+    let e = Pdc::over_window(&f, 3.0, 1.0).unwrap_err();
     assert!(matches!(e, PredictError::InvalidWindow { .. }));
-    assert!(e.to_string().contains("t_start >= forecast.t0 = 2"), "{e}");
+    assert_eq!(
+        e.to_string(),
+        "invalid time window [3, 1]: expected finite t_start <= t_end"
+    );
     let mut ekf = CvEkf::new(0.0, Vec3::zeros(), EkfParams::default()).unwrap();
     let e = ekf
         .step(1.0, Some(Vec3::new(0.0, f64::NAN, 0.0)))

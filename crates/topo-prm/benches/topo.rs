@@ -1,7 +1,7 @@
 //! Criterion benches: one DEV-PRM search and one V-PRM search on an E1 scene (K = 10), the UVD test
 //! the roadmap runs for every connector candidate (two connectors of the same guards, on the same and
 //! on opposite sides of a moving obstacle's PDC), one TVD check between two trajectories among the E1
-//! obstacles, and the roadmap's cone segment test against `trust_predict::Pdc`'s.
+//! obstacles, and the segment test of one predictive directional cone (`trust_predict::Pdc`).
 //!
 //! `cargo bench -p trust-topo-prm` for medians; `cargo bench -p trust-topo-prm -- --test` runs each
 //! once (CI smoke mode).
@@ -74,7 +74,7 @@ fn bench_uvd_connectors(c: &mut Criterion) {
         0.2,
     )
     .expect("valid forecast");
-    let obstacles = Obstacles::with_forecast_cones(&map, &[f], 0.0, 2.0);
+    let obstacles = Obstacles::with_forecast_cones(&map, &[f], 0.0, 2.0).expect("valid forecast");
     let (s, g) = (Vec3::new(1.0, 10.0, 5.0), Vec3::new(19.0, 10.0, 5.0));
     let above = [s, Vec3::new(9.0, 13.5, 5.0), g];
     let above2 = [s, Vec3::new(11.0, 14.5, 5.3), g];
@@ -126,8 +126,7 @@ fn bench_tvd(c: &mut Criterion) {
     });
 }
 
-/// 1000 random segments against one moving-sphere PDC: our `cone::Cone` versus `trust_predict::Pdc`
-/// (the reason the roadmap keeps its own copy of the geometry).
+/// 1000 random segments against one moving-sphere PDC (`trust_predict::Pdc::segment_clear`).
 fn bench_cone_tests(c: &mut Criterion) {
     use rand::Rng as _;
     let f = trust_core::Forecast::sphere(
@@ -139,8 +138,7 @@ fn bench_cone_tests(c: &mut Criterion) {
         0.2,
     )
     .expect("valid forecast");
-    let cone = trust_topo_prm::cone::Cone::from_forecast(&f, 0.0, 2.0);
-    let pdc = trust_predict::Pdc::over_window(&f, 0.0, 2.0).expect("valid window");
+    let cone = trust_predict::Pdc::over_window(&f, 0.0, 2.0).expect("valid window");
     let mut rng = Rng::seed_from_u64(3);
     let mut point = || {
         Vec3::new(
@@ -155,14 +153,6 @@ fn bench_cone_tests(c: &mut Criterion) {
             segments
                 .iter()
                 .filter(|(p, q)| cone.segment_clear(p, q, 0.1))
-                .count()
-        });
-    });
-    c.bench_function("predict_pdc_segment_clear_x1000", |b| {
-        b.iter(|| {
-            segments
-                .iter()
-                .filter(|(p, q)| pdc.segment_clear(p, q, 0.1))
                 .count()
         });
     });

@@ -271,17 +271,16 @@ fn run(args: &Args) -> Result<serde_json::Value, PlanError> {
         for (planner, total) in planners.iter().zip(&mut totals) {
             let mut rng = Rng::seed_from_u64(planner_seed);
             let result = planner.search(&world.query, &scene, &mut rng)?;
-            let valid: Vec<GuidePath> = result
-                .paths
-                .iter()
-                .filter(|p| {
-                    let obstacles = checker.obstacles(*p, *p, &scene);
-                    p.points
-                        .windows(2)
-                        .all(|w| obstacles.segment_clear(&w[0], &w[1], 0.0))
-                })
-                .cloned()
-                .collect();
+            let mut valid: Vec<GuidePath> = Vec::with_capacity(result.paths.len());
+            for p in &result.paths {
+                let obstacles = checker.obstacles(p, p, &scene)?;
+                if p.points
+                    .windows(2)
+                    .all(|w| obstacles.segment_clear(&w[0], &w[1], 0.0))
+                {
+                    valid.push(p.clone());
+                }
+            }
             let timed: Vec<ConstantSpeedPath<'_>> = result
                 .paths
                 .iter()

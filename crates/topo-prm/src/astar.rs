@@ -19,7 +19,6 @@ use trust_core::{
     check_non_negative, check_positive,
 };
 
-use crate::cone::Cone;
 use crate::ggs::Terminal;
 use crate::prm::{COINCIDENT_M, check_query, coincident_result};
 use crate::shortcut::shortcut;
@@ -259,17 +258,13 @@ impl PathFrontend for SparseAStar {
             Terminal::Point(query.goal)
         };
         let cones = if p.pdc {
-            scene
-                .forecasts
-                .iter()
-                .map(|f| Cone::from_forecast(f, query.start.t, query.horizon_s))
-                .collect()
+            crate::visibility::forecast_cones(scene.forecasts, query.start.t, query.horizon_s)?
         } else {
             Vec::new()
         };
         let mut obstacles = Obstacles::with_cones(scene.map, cones);
         obstacles.drop_cones(|c| {
-            c.contains(&start, 0.0) || matches!(terminal, Terminal::Point(g) if c.contains(&g, 0.0))
+            c.contains(&start) || matches!(terminal, Terminal::Point(g) if c.contains(&g))
         });
         let start_clearance = obstacles.clearance(&start);
         let start_threshold = if start_clearance.is_finite() {

@@ -23,7 +23,7 @@
 //!   ([`DevPrmParams::stall_samples`]): the coverage rule of the original visibility PRM (Siméon et
 //!   al. 2000), which Fast-Planner replaced by a fixed budget;
 //! * obstacle-aware samples lie on slices of each PDC and, for a moving obstacle, on its axis beyond
-//!   the first and last slice ([`crate::cone::Cone::surface_samples`]); they are inserted first, when
+//!   the first and last slice ([`trust_predict::Pdc::surface_samples`]); they are inserted first, when
 //!   only the start and the terminal are guards, so one that sees a single guard is kept and retried
 //!   against the guards added later ([`crate::roadmap::RoadmapBuilder::add_persistent_sample`])
 //!   instead of being discarded;
@@ -35,7 +35,6 @@ use serde::{Deserialize, Serialize};
 use trust_core::{PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult, Vec3};
 
 use crate::prm::{ConeMode, GraphSearch, PrmSetup, SurfaceSampling, run};
-use crate::vprm::check_common;
 
 /// Parameters of [`DevPrm`]. The V-PRM part defaults to Fast-Planner's values (see
 /// [`crate::VprmParams`]); the paper gives no values for the rest, so they are ours, as stated.
@@ -113,6 +112,8 @@ impl Default for DevPrmParams {
     }
 }
 
+crate::prm::impl_shared_setup!(DevPrmParams);
+
 impl DevPrmParams {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
@@ -120,18 +121,8 @@ impl DevPrmParams {
     }
 
     fn setup(&self) -> Result<PrmSetup, PlanError> {
-        let budget = check_common(
-            "devprm",
-            &self.inflate,
-            self.clearance,
-            self.resolution,
-            self.budget_ms,
-            self.max_raw_paths,
-            self.keep_raw_paths,
-            self.max_paths,
-            self.length_ratio,
-            self.max_expansions,
-        )?;
+        let shared = self.shared_setup();
+        shared.check_shared("devprm")?;
         if self.beam_width == 0 {
             return Err(PlanError::invalid("devprm.beam_width", 0, ">= 1"));
         }
@@ -151,20 +142,10 @@ impl DevPrmParams {
             }
         }
         Ok(PrmSetup {
-            inflate: self.inflate,
-            clearance: self.clearance,
-            resolution: self.resolution,
-            budget,
-            max_samples: self.max_samples,
             stall_samples: self.stall_samples,
             search: GraphSearch::Beam {
                 width: self.beam_width,
             },
-            max_raw_paths: self.max_raw_paths,
-            keep_raw_paths: self.keep_raw_paths,
-            max_paths: self.max_paths,
-            length_ratio: self.length_ratio,
-            max_expansions: self.max_expansions,
             cones: if self.pdc {
                 ConeMode::Predictive
             } else {
@@ -178,6 +159,7 @@ impl DevPrmParams {
                 },
             ),
             goal_surface: self.goal_guidance_surface,
+            ..shared
         })
     }
 }

@@ -8,6 +8,7 @@
 //! with degenerate input; the iteration only makes the bound tight quickly.
 
 use trust_core::Vec3;
+use trust_predict::Pdc;
 
 /// Iteration cap of [`separated`]: GJK on a polytope of a few vertices and a smooth convex set
 /// converges in a handful of steps; undecided cases after this many are reported as not separated.
@@ -21,6 +22,12 @@ const SEPARATION_TOL: f64 = 1e-9;
 pub trait SupportMap {
     /// A point of the set that maximizes `x·d` (any point of the set for `d = 0`).
     fn support(&self, d: &Vec3) -> Vec3;
+}
+
+impl SupportMap for Pdc {
+    fn support(&self, d: &Vec3) -> Vec3 {
+        Pdc::support(self, d)
+    }
 }
 
 /// The convex hull of a non-empty set of points.

@@ -16,8 +16,9 @@
 //! | [`gjk::separated`] | GJK separation test of convex sets (clears whole ranges of UVD chords) | — |
 //!
 //! Use a frontend through [`trust_core::PathFrontend`] and a checker through
-//! [`trust_core::HomotopyChecker`]; the building blocks (roadmap, searches, shortcut, selection, cone
-//! geometry, sampling frame) are public modules so that a variant can be assembled from them.
+//! [`trust_core::HomotopyChecker`]; the building blocks (roadmap, searches, shortcut, selection,
+//! visibility, sampling frame) are public modules so that a variant can be assembled from them. The
+//! predictive directional cones themselves are `trust_predict::Pdc`, shared with every other user.
 //!
 //! Experiment E1 (paper Fig. Sim-A-1-1(c)) is the example `prm_efficiency`
 //! (`cargo run --release -p trust-topo-prm --example prm_efficiency -- --obstacles 10 --trials 50`);
@@ -65,7 +66,6 @@
 #![warn(missing_docs)]
 
 pub mod astar;
-pub mod cone;
 pub mod devprm;
 pub mod ggs;
 pub mod gjk;

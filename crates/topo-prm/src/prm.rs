@@ -6,10 +6,9 @@ use std::time::{Duration, Instant};
 
 use trust_core::{
     Aabb, GuidePath, PathQuery, PlanError, Rng, Scene, SearchResult, SearchStats, Vec3,
-    check_finite, check_finite_vec, check_non_negative,
+    check_finite, check_finite_vec, check_non_negative, check_positive,
 };
 
-use crate::cone::Cone;
 use crate::ggs::Terminal;
 use crate::roadmap::{RoadmapBuilder, RoadmapParams, SampleOutcome};
 use crate::sampling::SamplingBox;
@@ -19,7 +18,7 @@ use crate::search::{
 use crate::select::{prune_equivalent, select_short_paths};
 use crate::shortcut::shortcut;
 use crate::uvd::{UvdScratch, polylines_equivalent_among};
-use crate::visibility::Obstacles;
+use crate::visibility::{Obstacles, forecast_cones};
 
 /// Start and goal closer than this (m) are treated as the same point: the answer is the path
 /// `[start, goal]` without any sampling.
@@ -103,7 +102,8 @@ pub(crate) struct PrmSetup {
     pub inflate: Vec3,
     pub clearance: f64,
     pub resolution: f64,
-    pub budget: Duration,
+    /// Time budget of the roadmap construction (ms; checked by [`PrmSetup::check_shared`]).
+    pub budget_ms: f64,
     pub max_samples: usize,
     pub stall_samples: usize,
     pub search: GraphSearch,
@@ -116,6 +116,91 @@ pub(crate) struct PrmSetup {
     pub surface_sampling: Option<SurfaceSampling>,
     pub goal_surface: bool,
 }
+
+impl PrmSetup {
+    /// The roadmap's time budget.
+    fn budget(&self, prefix: &str) -> Result<Duration, PlanError> {
+        Duration::try_from_secs_f64(self.budget_ms / 1000.0).map_err(|_| {
+            PlanError::invalid(
+                format!("{prefix}.budget_ms"),
+                self.budget_ms,
+                "a duration representable in std::time::Duration",
+            )
+        })
+    }
+
+    /// Checks the fields V-PRM and DEV-PRM share (errors name `prefix.field`); the planners check
+    /// their own fields.
+    pub(crate) fn check_shared(&self, prefix: &str) -> Result<(), PlanError> {
+        let inflate = &self.inflate;
+        check_finite_vec(&format!("{prefix}.inflate"), inflate)?;
+        if inflate.iter().any(|x| *x < 0.0) {
+            return Err(PlanError::invalid(
+                format!("{prefix}.inflate"),
+                [inflate.x, inflate.y, inflate.z],
+                "non-negative components",
+            ));
+        }
+        check_non_negative(&format!("{prefix}.clearance"), self.clearance)?;
+        check_positive(&format!("{prefix}.resolution"), self.resolution)?;
+        check_positive(&format!("{prefix}.budget_ms"), self.budget_ms)?;
+        self.budget(prefix)?;
+        for (name, value) in [
+            ("max_raw_paths", self.max_raw_paths),
+            ("keep_raw_paths", self.keep_raw_paths),
+            ("max_paths", self.max_paths),
+            ("max_expansions", self.max_expansions),
+        ] {
+            if value == 0 {
+                return Err(PlanError::invalid(
+                    format!("{prefix}.{name}"),
+                    value,
+                    ">= 1",
+                ));
+            }
+        }
+        if !(self.length_ratio.is_finite() && self.length_ratio >= 1.0) {
+            return Err(PlanError::invalid(
+                format!("{prefix}.length_ratio"),
+                self.length_ratio,
+                "a finite number >= 1",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Implements `fn shared_setup(&self) -> PrmSetup` for a params struct that has the fields V-PRM
+/// and DEV-PRM share under the same names ([`crate::VprmParams`], [`crate::DevPrmParams`]): those
+/// fields, and V-PRM's choices for the rest — depth-first search, no stall stop, moving obstacles
+/// ignored, no surface samples, paths ending at the goal — for the planner to override. Unchecked:
+/// see [`PrmSetup::check_shared`].
+macro_rules! impl_shared_setup {
+    ($params:ty) => {
+        impl $params {
+            fn shared_setup(&self) -> $crate::prm::PrmSetup {
+                $crate::prm::PrmSetup {
+                    inflate: self.inflate,
+                    clearance: self.clearance,
+                    resolution: self.resolution,
+                    budget_ms: self.budget_ms,
+                    max_samples: self.max_samples,
+                    stall_samples: 0,
+                    search: $crate::prm::GraphSearch::DepthFirst,
+                    max_raw_paths: self.max_raw_paths,
+                    keep_raw_paths: self.keep_raw_paths,
+                    max_paths: self.max_paths,
+                    length_ratio: self.length_ratio,
+                    max_expansions: self.max_expansions,
+                    cones: $crate::prm::ConeMode::Ignore,
+                    surface_sampling: None,
+                    goal_surface: false,
+                }
+            }
+        }
+    };
+}
+pub(crate) use impl_shared_setup;
 
 /// Intersection of two boxes, or `None` if they do not meet.
 fn intersection(a: &Aabb, b: &Aabb) -> Option<Aabb> {
@@ -185,7 +270,7 @@ pub(crate) fn run(
     if (query.goal - start).norm() <= COINCIDENT_M {
         return coincident_result(query, since);
     }
-    let deadline = since + setup.budget;
+    let deadline = since + setup.budget("prm")?;
 
     let terminal = if setup.goal_surface {
         Terminal::goal_guidance_surface(&start, &query.goal, query.horizon_s, query.limits.v_max)
@@ -206,18 +291,10 @@ pub(crate) fn run(
     // Obstacles: static map plus the cones that can touch the region; cones that swallow the start
     // (or a goal point) cannot be avoided in space and are left to the trajectory backend.
     let t_query = query.start.t;
-    let cones: Vec<Cone> = match setup.cones {
+    let cones = match setup.cones {
         ConeMode::Ignore => Vec::new(),
-        ConeMode::Frozen => scene
-            .forecasts
-            .iter()
-            .map(|f| Cone::at_time(f, t_query))
-            .collect(),
-        ConeMode::Predictive => scene
-            .forecasts
-            .iter()
-            .map(|f| Cone::from_forecast(f, t_query, query.horizon_s))
-            .collect(),
+        ConeMode::Frozen => forecast_cones(scene.forecasts, t_query, 0.0)?,
+        ConeMode::Predictive => forecast_cones(scene.forecasts, t_query, query.horizon_s)?,
     };
     let mut obstacles =
         Obstacles::with_cones(scene.map, cones).restricted_to(&region.inflated(REGION_MARGIN_M));
@@ -225,8 +302,7 @@ pub(crate) fn run(
         Terminal::Point(g) => Some(g),
         Terminal::Surface { .. } => None,
     };
-    obstacles
-        .drop_cones(|c| c.contains(&start, 0.0) || goal_point.is_some_and(|g| c.contains(&g, 0.0)));
+    obstacles.drop_cones(|c| c.contains(&start) || goal_point.is_some_and(|g| c.contains(&g)));
 
     let params = RoadmapParams {
         sample_clearance: setup.clearance,
@@ -241,8 +317,15 @@ pub(crate) fn run(
     // one that sees a single guard now is retried against the guards random sampling adds.
     if let Some(s) = setup.surface_sampling {
         let mut samples = Vec::new();
-        for cone in obstacles.cones() {
-            cone.surface_samples(s.slices, s.per_slice, s.offset, &region, &mut samples);
+        for (i, cone) in obstacles.cones().iter().enumerate() {
+            cone.surface_samples_into(s.slices, s.per_slice, s.offset, &region, &mut samples)
+                .map_err(|e| {
+                    PlanError::invalid(
+                        format!("devprm surface samples of scene.forecasts[{i}]"),
+                        s,
+                        e.to_string(),
+                    )
+                })?;
         }
         for p in samples {
             if Instant::now() >= deadline {

@@ -59,24 +59,10 @@ impl SamplingBox {
 }
 
 /// An orthonormal right-handed frame whose first axis points from `start` to `goal` and whose second
-/// axis is horizontal. Vertical start→goal: the second axis is world `x`. Coincident points: world axes.
+/// axis is horizontal ([`trust_predict::frame_along`]). Vertical start→goal: the second axis is world
+/// `x`. Coincident points: world axes.
 pub fn frame(start: &Vec3, goal: &Vec3) -> [Vec3; 3] {
-    let d = goal - start;
-    let n = d.norm();
-    if !n.is_finite() || n <= 0.0 {
-        return [Vec3::x(), Vec3::y(), Vec3::z()];
-    }
-    let x = d / n;
-    let horizontal_sq = x.x * x.x + x.y * x.y;
-    let y = if horizontal_sq.is_nan() || horizontal_sq <= 0.0 {
-        // Vertical: any horizontal axis is perpendicular to x.
-        Vec3::x()
-    } else {
-        // z × x is horizontal and perpendicular to x.
-        Vec3::new(-x.y, x.x, 0.0) / horizontal_sq.sqrt()
-    };
-    let z = x.cross(&y);
-    [x, y, z]
+    trust_predict::frame_along(&(goal - start))
 }
 
 #[cfg(test)]

@@ -13,18 +13,17 @@ use trust_core::{
     Curve, HomotopyChecker, PlanError, Scene, Vec3, check_non_negative, check_positive,
 };
 
-use crate::cone::Cone;
-
 /// Upper bound on the number of sampled times of one comparison.
 pub const MAX_SAMPLES: usize = 1_000_000;
 
 /// The chord test of TVD at one time: `[p, q]` keeps `clearance` from every forecast obstacle as it is
-/// at time `t` and from the static map.
+/// at time `t` ([`trust_core::Forecast::segment_clear`], the predictive directional cone of a window
+/// of length zero) and from the static map. A non-finite time counts as blocking.
 pub fn chord_clear(scene: &Scene<'_>, p: &Vec3, q: &Vec3, t: f64, clearance: f64) -> bool {
     scene
         .forecasts
         .iter()
-        .all(|f| Cone::at_time(f, t).segment_clear(p, q, clearance))
+        .all(|f| f.segment_clear(p, q, t, clearance))
         && scene.map.segment_clear(p, q, clearance)
 }
 

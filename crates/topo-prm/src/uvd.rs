@@ -20,9 +20,8 @@ use trust_core::{
     Aabb, Curve, HomotopyChecker, PlanError, Scene, Vec3, check_non_negative, check_positive,
 };
 
-use crate::cone::Cone;
 use crate::gjk::{Hull, separated_along};
-use crate::visibility::Obstacles;
+use crate::visibility::{Obstacles, forecast_cones};
 
 /// Upper bound on the resampled point count (guards against a tiny resolution on a huge curve).
 pub const MAX_POINTS: usize = 1 << 20;
@@ -730,19 +729,19 @@ impl Uvd {
 
     /// The obstacles this checker tests chords against for curves `a`, `b` in `scene`: the static map,
     /// plus the frozen obstacles or their cones minus those containing an end of either curve.
-    pub fn obstacles<'s>(&self, a: &dyn Curve, b: &dyn Curve, scene: &Scene<'s>) -> Obstacles<'s> {
-        let cones: Vec<Cone> = match (self.params.pdc_horizon_s, self.params.freeze_forecasts) {
-            (Some(h), _) => scene
-                .forecasts
-                .iter()
-                .map(|f| Cone::from_forecast(f, scene.t0, h))
-                .collect(),
-            (None, true) => scene
-                .forecasts
-                .iter()
-                .map(|f| Cone::at_time(f, scene.t0))
-                .collect(),
-            (None, false) => return Obstacles::new(scene.map),
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] naming the forecast if one is invalid.
+    pub fn obstacles<'s>(
+        &self,
+        a: &dyn Curve,
+        b: &dyn Curve,
+        scene: &Scene<'s>,
+    ) -> Result<Obstacles<'s>, PlanError> {
+        let cones = match (self.params.pdc_horizon_s, self.params.freeze_forecasts) {
+            (Some(h), _) => forecast_cones(scene.forecasts, scene.t0, h)?,
+            (None, true) => forecast_cones(scene.forecasts, scene.t0, 0.0)?,
+            (None, false) => return Ok(Obstacles::new(scene.map)),
         };
         let mut obs = Obstacles::with_cones(scene.map, cones);
         let mut ends = Vec::with_capacity(4);
@@ -752,8 +751,8 @@ impl Uvd {
             ends.extend_from_slice(&pts);
         }
         let clearance = self.params.clearance;
-        obs.drop_cones(|cone| ends.iter().any(|p| cone.contains(p, clearance)));
-        obs
+        obs.drop_cones(|cone| ends.iter().any(|p| !cone.point_clear(p, clearance)));
+        Ok(obs)
     }
 }
 
@@ -773,7 +772,7 @@ impl HomotopyChecker for Uvd {
         scene: &Scene<'_>,
     ) -> Result<bool, PlanError> {
         self.params.validate()?;
-        let obs = self.obstacles(a, b, scene);
+        let obs = self.obstacles(a, b, scene)?;
         Ok(equivalent_among(
             &obs,
             a,
@@ -789,7 +788,7 @@ impl HomotopyChecker for Uvd {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
-    use trust_core::{GuidePath, StaticMap};
+    use trust_core::{Forecast, GuidePath, ObstacleShape, StaticMap};
     use trust_geometry::{Shape, Sphere};
 
     fn pillar_map() -> StaticMap {
@@ -896,17 +895,18 @@ mod tests {
             let (start, goal) = (Vec3::new(-6.0, 0.0, 0.0), Vec3::new(6.0, 0.0, 0.0));
             let a: Vec<Vec3> = std::iter::once(start).chain(mid_a).chain([goal]).collect();
             let b: Vec<Vec3> = std::iter::once(start).chain(mid_b).chain([goal]).collect();
-            let cones: Vec<Cone> = cones
+            let forecasts: Vec<Forecast> = cones
                 .into_iter()
                 .map(|(c, v, r, grow, cyl)| {
-                    if cyl {
-                        Cone::cylinder(c, c + v, r, r + grow, 1.0, 1.0 + grow)
+                    let shape = if cyl {
+                        ObstacleShape::Cylinder { half_height: 1.0 }
                     } else {
-                        Cone::sphere(c, c + v, r, r + grow)
-                    }
+                        ObstacleShape::Sphere
+                    };
+                    Forecast::new(shape, c, v, 0.0, r, 0.0, grow).unwrap()
                 })
                 .collect();
-            let obs = Obstacles::with_cones(&map, cones);
+            let obs = Obstacles::with_forecast_cones(&map, &forecasts, 0.0, 1.0).unwrap();
             let fast = polylines_equivalent_among(
                 &obs, &a, &b, 0.1, threshold, &mut UvdScratch::default(),
             );

@@ -1,19 +1,41 @@
-//! What the roadmap "sees": the static map plus an optional set of swept obstacles ([`Cone`]s).
+//! What the roadmap "sees": the static map plus an optional set of swept obstacles, each a
+//! predictive directional cone ([`Pdc`], the one implementation in `trust_predict`).
 //!
-//! V-PRM uses the static map (and, optionally, the moving obstacles frozen where they are now);
-//! DEV-PRM adds the predictive directional cones of all forecasts (paper Sec. III-B). Segment tests
-//! reject cones by bounding box before any exact test, and [`Obstacles::restricted_to`] keeps only
-//! the cones near a region so that a whole search pays for the relevant obstacles only.
+//! V-PRM uses the static map (and, optionally, the moving obstacles frozen where they are now: cones
+//! over a window of length zero); DEV-PRM adds the predictive directional cones of all forecasts
+//! (paper Sec. III-B). Segment tests reject cones by bounding box before any exact test, and
+//! [`Obstacles::restricted_to`] keeps only the cones near a region so that a whole search pays for
+//! the relevant obstacles only.
 
-use trust_core::{Aabb, Forecast, StaticMap, Vec3};
+use trust_core::{Aabb, Forecast, PlanError, StaticMap, Vec3};
+use trust_predict::Pdc;
 
-use crate::cone::Cone;
+/// The predictive directional cones of `forecasts` over `[t_start, t_start + horizon_s]` (a negative
+/// horizon counts as zero: the obstacles as they are at `t_start`).
+///
+/// # Errors
+/// [`PlanError::InvalidInput`] naming the forecast if one is invalid or `t_start` is not finite.
+pub fn forecast_cones(
+    forecasts: &[Forecast],
+    t_start: f64,
+    horizon_s: f64,
+) -> Result<Vec<Pdc>, PlanError> {
+    let t_end = t_start + horizon_s.max(0.0);
+    forecasts
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            Pdc::over_window(f, t_start, t_end)
+                .map_err(|e| PlanError::invalid(format!("scene.forecasts[{i}]"), f, e.to_string()))
+        })
+        .collect()
+}
 
 /// The obstacle set of one search: static map ∪ cones.
 #[derive(Debug, Clone)]
 pub struct Obstacles<'a> {
     map: &'a StaticMap,
-    cones: Vec<Cone>,
+    cones: Vec<Pdc>,
 }
 
 impl<'a> Obstacles<'a> {
@@ -26,23 +48,25 @@ impl<'a> Obstacles<'a> {
     }
 
     /// The static map and the given cones.
-    pub fn with_cones(map: &'a StaticMap, cones: Vec<Cone>) -> Self {
+    pub fn with_cones(map: &'a StaticMap, cones: Vec<Pdc>) -> Self {
         Obstacles { map, cones }
     }
 
     /// The static map and the predictive directional cones of `forecasts` over
-    /// `[t_start, t_start + horizon_s]`.
+    /// `[t_start, t_start + horizon_s]` ([`forecast_cones`]).
+    ///
+    /// # Errors
+    /// As [`forecast_cones`].
     pub fn with_forecast_cones(
         map: &'a StaticMap,
         forecasts: &[Forecast],
         t_start: f64,
         horizon_s: f64,
-    ) -> Self {
-        let cones = forecasts
-            .iter()
-            .map(|f| Cone::from_forecast(f, t_start, horizon_s))
-            .collect();
-        Obstacles { map, cones }
+    ) -> Result<Self, PlanError> {
+        Ok(Obstacles {
+            map,
+            cones: forecast_cones(forecasts, t_start, horizon_s)?,
+        })
     }
 
     /// The static map.
@@ -51,13 +75,13 @@ impl<'a> Obstacles<'a> {
     }
 
     /// The cones.
-    pub fn cones(&self) -> &[Cone] {
+    pub fn cones(&self) -> &[Pdc] {
         &self.cones
     }
 
     /// Drops every cone for which `drop` returns true (e.g. cones that contain the start); returns how
     /// many were dropped.
-    pub fn drop_cones(&mut self, mut drop: impl FnMut(&Cone) -> bool) -> usize {
+    pub fn drop_cones(&mut self, mut drop: impl FnMut(&Pdc) -> bool) -> usize {
         let before = self.cones.len();
         self.cones.retain(|c| !drop(c));
         before - self.cones.len()
@@ -104,7 +128,7 @@ impl<'a> Obstacles<'a> {
 
     /// True if `p` keeps at least `clearance` from every obstacle.
     pub fn is_free(&self, p: &Vec3, clearance: f64) -> bool {
-        self.cones.iter().all(|c| !c.contains(p, clearance)) && self.map.is_free(p, clearance)
+        self.cones.iter().all(|c| c.point_clear(p, clearance)) && self.map.is_free(p, clearance)
     }
 
     /// Signed distance to the nearest obstacle (`+∞` when there is none).
@@ -149,8 +173,8 @@ mod tests {
     #[test]
     fn sees_map_and_cones() {
         let m = map();
-        let cone = Cone::sphere(Vec3::zeros(), Vec3::x(), 1.0, 1.0);
-        let obs = Obstacles::with_cones(&m, vec![cone]);
+        let ball = Forecast::sphere(Vec3::zeros(), Vec3::x(), 0.0, 1.0, 0.0, 0.0).unwrap();
+        let obs = Obstacles::with_forecast_cones(&m, &[ball], 0.0, 1.0).unwrap();
         let (a, b) = (Vec3::new(-5.0, -3.0, 0.0), Vec3::new(5.0, -3.0, 0.0));
         assert!(obs.segment_clear(&a, &b, 0.1));
         assert!(!obs.segment_clear(&Vec3::new(-5.0, 0.0, 0.0), &Vec3::new(5.0, 0.0, 0.0), 0.0));

@@ -6,16 +6,11 @@
 //! selection with a length ratio — against the static map, with moving obstacles (optionally) frozen
 //! where they are at the query time, as an occupancy map would show them. It never uses their motion.
 
-use std::time::Duration;
-
 use serde::{Deserialize, Serialize};
 
-use trust_core::{
-    PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult, Vec3, check_finite_vec,
-    check_non_negative, check_positive,
-};
+use trust_core::{PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult, Vec3};
 
-use crate::prm::{ConeMode, GraphSearch, PrmSetup, run};
+use crate::prm::{ConeMode, PrmSetup, run};
 
 /// Parameters of [`Vprm`]. Defaults are Fast-Planner's (`topo_prm` launch parameters, see
 /// `reference/topo-prm.md`) unless stated otherwise.
@@ -72,105 +67,25 @@ impl Default for VprmParams {
     }
 }
 
-/// Checks the fields V-PRM and DEV-PRM share; `prefix` names the params struct in errors.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn check_common(
-    prefix: &str,
-    inflate: &Vec3,
-    clearance: f64,
-    resolution: f64,
-    budget_ms: f64,
-    max_raw_paths: usize,
-    keep_raw_paths: usize,
-    max_paths: usize,
-    length_ratio: f64,
-    max_expansions: usize,
-) -> Result<Duration, PlanError> {
-    check_finite_vec(&format!("{prefix}.inflate"), inflate)?;
-    if inflate.iter().any(|x| *x < 0.0) {
-        return Err(PlanError::invalid(
-            format!("{prefix}.inflate"),
-            [inflate.x, inflate.y, inflate.z],
-            "non-negative components",
-        ));
-    }
-    check_non_negative(&format!("{prefix}.clearance"), clearance)?;
-    check_positive(&format!("{prefix}.resolution"), resolution)?;
-    check_positive(&format!("{prefix}.budget_ms"), budget_ms)?;
-    let budget = Duration::try_from_secs_f64(budget_ms / 1000.0).map_err(|_| {
-        PlanError::invalid(
-            format!("{prefix}.budget_ms"),
-            budget_ms,
-            "a duration representable in std::time::Duration",
-        )
-    })?;
-    for (name, value) in [
-        ("max_raw_paths", max_raw_paths),
-        ("keep_raw_paths", keep_raw_paths),
-        ("max_paths", max_paths),
-        ("max_expansions", max_expansions),
-    ] {
-        if value == 0 {
-            return Err(PlanError::invalid(
-                format!("{prefix}.{name}"),
-                value,
-                ">= 1",
-            ));
-        }
-    }
-    if !(length_ratio.is_finite() && length_ratio >= 1.0) {
-        return Err(PlanError::invalid(
-            format!("{prefix}.length_ratio"),
-            length_ratio,
-            "a finite number >= 1",
-        ));
-    }
-    Ok(budget)
-}
+crate::prm::impl_shared_setup!(VprmParams);
 
 impl VprmParams {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
-        self.budget().map(|_| ())
-    }
-
-    fn budget(&self) -> Result<Duration, PlanError> {
-        check_common(
-            "vprm",
-            &self.inflate,
-            self.clearance,
-            self.resolution,
-            self.budget_ms,
-            self.max_raw_paths,
-            self.keep_raw_paths,
-            self.max_paths,
-            self.length_ratio,
-            self.max_expansions,
-        )
+        self.setup().map(|_| ())
     }
 
     fn setup(&self) -> Result<PrmSetup, PlanError> {
-        Ok(PrmSetup {
-            inflate: self.inflate,
-            clearance: self.clearance,
-            resolution: self.resolution,
-            budget: self.budget()?,
-            max_samples: self.max_samples,
-            stall_samples: 0,
-            search: GraphSearch::DepthFirst,
-            max_raw_paths: self.max_raw_paths,
-            keep_raw_paths: self.keep_raw_paths,
-            max_paths: self.max_paths,
-            length_ratio: self.length_ratio,
-            max_expansions: self.max_expansions,
+        let setup = PrmSetup {
             cones: if self.freeze_forecasts {
                 ConeMode::Frozen
             } else {
                 ConeMode::Ignore
             },
-            surface_sampling: None,
-            goal_surface: false,
-        })
+            ..self.shared_setup()
+        };
+        setup.check_shared("vprm")?;
+        Ok(setup)
     }
 }
 

@@ -153,8 +153,8 @@ fn start_inside_a_cone_still_plans() {
         0.2,
     )
     .unwrap();
-    let cone = trust_topo_prm::cone::Cone::from_forecast(&f, 0.0, 2.0);
-    assert!(cone.contains(&start, 0.0));
+    let cone = trust_predict::Pdc::new(&f, 2.0).unwrap();
+    assert!(cone.contains(&start));
     let q = query(start, Vec3::new(18.0, 10.0, 5.0));
     for fe in frontends() {
         let paths = run(fe.as_ref(), &map, &[f], &q).unwrap();
@@ -180,7 +180,7 @@ fn devprm_paths_avoid_the_cones() {
     let dev = &frontends()[1];
     let paths = run(dev.as_ref(), &map, &[f], &q).unwrap();
     assert!(paths.len() >= 2, "{} paths", paths.len());
-    let obs = Obstacles::with_forecast_cones(&map, &[f], 0.0, 2.0);
+    let obs = Obstacles::with_forecast_cones(&map, &[f], 0.0, 2.0).unwrap();
     for p in &paths {
         for s in p.points.windows(2) {
             assert!(obs.segment_clear(&s[0], &s[1], 0.0), "{s:?}");

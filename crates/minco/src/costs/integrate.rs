@@ -134,24 +134,24 @@ pub trait Integrand {
 /// are turned into coefficient gradients once per piece (`β_d` of `s = uT` factorizes into
 /// `u^e T^e`).
 ///
-/// The backends' objectives use a crate-private fast path for their fused penalties
-/// ([`PenaltyIntegrand`](crate::costs::PenaltyIntegrand)) that evaluates only the nodes where a
-/// penalty can be active and gives the same result bit for bit (module `fused`, tested against
-/// this generic path).
+/// The backends' objectives use a crate-private rule for their fused penalties
+/// ([`PenaltyIntegrand`](crate::costs::PenaltyIntegrand)) in the same quadrature loop: it
+/// evaluates only the nodes where a penalty can be active and gives the same result bit for bit
+/// (module `fused`, tested against this generic path).
 #[derive(Debug, Clone)]
 pub struct TrapezoidIntegrator {
     kappa: usize,
     /// `[1, u, u², u³, u⁴, u⁵]` at every node fraction `u_k = k/κ`.
     u_powers: Vec<[f64; 6]>,
-    /// `[p, v, a, j]` at every node, piece by piece.
+    /// `[p, v, a, j]` at every node, piece by piece ([`TrapezoidIntegrator::integrate`]).
     nodes: Vec<[Vec3; 4]>,
-    /// Box of each piece's node positions.
+    /// Box of the points each piece's rule evaluates (its broad phase).
     boxes: Vec<Aabb>,
     /// Per piece, `Σ_k ω_k (T_i/κ) ∂L/∂t` (the dI-c coupling it sends to earlier pieces).
     coupling: Vec<f64>,
-    /// Scaled coefficients of every piece ([`TrapezoidIntegrator::integrate_penalties`]).
+    /// Scaled coefficients of every piece.
     scaled: Vec<ScaledPiece>,
-    /// Column-wise node scratch of [`TrapezoidIntegrator::integrate_penalties`].
+    /// Column-wise node scratch of the objective's rule ([`TrapezoidIntegrator::integrate_penalties`]).
     columns: fused::NodeColumns,
 }
 
@@ -199,76 +199,88 @@ impl TrapezoidIntegrator {
         grad_c: &mut [Vec3],
         grad_t: &mut [f64],
     ) -> Result<f64, MincoError> {
+        let mut rule = EveryNode {
+            integrand,
+            nodes: std::mem::take(&mut self.nodes),
+            node_count: 0,
+        };
+        let result = self.run(traj, &mut rule, grad_c, grad_t, f64::INFINITY);
+        self.nodes = rule.nodes;
+        result.map(|(total, _)| total)
+    }
+
+    /// The quadrature both paths share: scales every piece and asks `rule` for the box of the
+    /// points it will evaluate there (pass 1), gives the rule the whole trajectory's window and
+    /// box, then adds each piece's integral, `∂I/∂c` and explicit `∂I/∂T` (pass 2), and finally the
+    /// dI-c coupling of every piece into the earlier durations.
+    ///
+    /// Stops after the first piece where the running total exceeds `limit` and returns `(total so
+    /// far, false)` (the gradients are then incomplete); otherwise `(total, true)`.
+    fn run<R: PieceRule>(
+        &mut self,
+        traj: &PiecewiseView<'_>,
+        rule: &mut R,
+        grad_c: &mut [Vec3],
+        grad_t: &mut [f64],
+        limit: f64,
+    ) -> Result<(f64, bool), MincoError> {
         let n = traj.durations.len();
         check_len("coeffs", 6 * n, traj.coeffs.len())?;
         check_len("grad_c", 6 * n, grad_c.len())?;
         check_len("grad_t", n, grad_t.len())?;
         if n == 0 {
-            return Ok(0.0);
+            return Ok((0.0, true));
         }
-        let kappa = self.kappa;
-        let nodes_per_piece = kappa + 1;
 
-        // Pass 1: node derivatives and per-piece boxes.
-        self.nodes.resize(n * nodes_per_piece, [Vec3::zeros(); 4]);
+        // Pass 1: scaled coefficients and the boxes of the points each piece is evaluated at.
+        self.scaled.clear();
         self.boxes.clear();
         let mut all = Aabb {
             min: Vec3::repeat(f64::INFINITY),
             max: Vec3::repeat(f64::NEG_INFINITY),
         };
-        for ((c, &duration), nodes) in traj
-            .coeffs
-            .chunks_exact(6)
-            .zip(traj.durations)
-            .zip(self.nodes.chunks_exact_mut(nodes_per_piece))
-        {
+        for (c, &duration) in traj.coeffs.chunks_exact(6).zip(traj.durations) {
             let scaled = ScaledPiece::new(c, duration);
-            let mut b = Aabb {
-                min: Vec3::repeat(f64::INFINITY),
-                max: Vec3::repeat(f64::NEG_INFINITY),
-            };
-            for (node, u) in nodes.iter_mut().zip(&self.u_powers) {
-                *node = scaled.at(u);
-                b.min = b.min.inf(&node[0]);
-                b.max = b.max.sup(&node[0]);
-            }
-            all = all.union(&b);
+            let b = rule.piece_box(self.scaled.len(), &scaled, &self.u_powers);
+            all = points_box(&[all.min, all.max, b.min, b.max]);
             self.boxes.push(b);
+            self.scaled.push(scaled);
         }
         let t_end = traj.t_start + traj.durations.iter().sum::<f64>();
-        integrand.begin_trajectory(traj.t_start, t_end, &all);
+        rule.begin_trajectory(traj.t_start, t_end, &all);
 
-        // Pass 2: the integrand at every node of every piece its broad phase keeps.
+        // Pass 2: every piece the rule does not skip.
         self.coupling.clear();
         self.coupling.resize(n, 0.0);
         let mut total = 0.0;
         let mut piece_start = traj.t_start;
         for i in 0..n {
             let duration = traj.durations[i];
-            let piece_end = piece_start + duration;
-            if integrand.begin_piece(i, piece_start, piece_end, &self.boxes[i]) {
-                let nodes = &self.nodes[i * nodes_per_piece..(i + 1) * nodes_per_piece];
-                let c = &traj.coeffs[6 * i..6 * i + 6];
-                let piece = integrate_piece(
-                    integrand,
-                    i,
-                    piece_start,
-                    duration,
-                    kappa,
-                    nodes,
-                    &self.u_powers,
-                    c,
-                );
-                if piece.active {
-                    total += piece.value;
-                    piece
-                        .moments
-                        .add_to(&mut grad_c[6 * i..6 * i + 6], duration);
-                    grad_t[i] += piece.grad_t;
-                    self.coupling[i] += piece.coupling;
+            let piece = rule.piece(PieceContext {
+                index: i,
+                start: piece_start,
+                duration,
+                coeffs: &traj.coeffs[6 * i..6 * i + 6],
+                scaled: &self.scaled[i],
+                bounds: &self.boxes[i],
+                kappa: self.kappa,
+                u_powers: &self.u_powers,
+                columns: &mut self.columns,
+            });
+            if let Some(piece) = piece
+                && piece.active
+            {
+                total += piece.value;
+                piece
+                    .moments
+                    .add_to(&mut grad_c[6 * i..6 * i + 6], duration);
+                grad_t[i] += piece.grad_t;
+                self.coupling[i] += piece.coupling;
+                if total > limit {
+                    return Ok((total, false));
                 }
             }
-            piece_start = piece_end;
+            piece_start += duration;
         }
         // eq. dI-c: piece j collects the explicit-time terms of every later piece.
         let mut later = 0.0;
@@ -276,12 +288,132 @@ impl TrapezoidIntegrator {
             grad_t[i] += later;
             later += self.coupling[i];
         }
-        Ok(total)
+        Ok((total, true))
+    }
+}
+
+/// What [`TrapezoidIntegrator::run`] hands a rule for one piece.
+struct PieceContext<'a> {
+    /// Piece index `i`.
+    index: usize,
+    /// Absolute start time of the piece (s).
+    start: f64,
+    /// Duration `T_i` (s).
+    duration: f64,
+    /// The piece's six coefficient rows.
+    coeffs: &'a [Vec3],
+    /// The coefficients scaled to the node fraction.
+    scaled: &'a ScaledPiece,
+    /// The box [`PieceRule::piece_box`] gave for this piece.
+    bounds: &'a Aabb,
+    /// Intervals per piece `κ`.
+    kappa: usize,
+    /// `[1, u, …, u⁵]` at every node fraction.
+    u_powers: &'a [[f64; 6]],
+    /// Column-wise node scratch (used by the objective's rule).
+    columns: &'a mut fused::NodeColumns,
+}
+
+/// Which nodes an integration evaluates and how: [`EveryNode`] (the public path, any
+/// [`Integrand`], every node of every piece its broad phase keeps) or the objective's penalties
+/// at the nodes their filters flag (module `fused`).
+trait PieceRule {
+    /// Box of the points the rule evaluates on piece `index` (the broad phase's input); called
+    /// for every piece in order before any [`PieceRule::piece`].
+    fn piece_box(&mut self, index: usize, piece: &ScaledPiece, u_powers: &[[f64; 6]]) -> Aabb;
+
+    /// The whole trajectory's time window and the union of the piece boxes.
+    fn begin_trajectory(&mut self, t_begin: f64, t_end: f64, all: &Aabb);
+
+    /// The piece's contribution, or `None` if the rule skips it (its integrand vanishes there).
+    fn piece(&mut self, ctx: PieceContext<'_>) -> Option<PieceIntegral>;
+}
+
+/// The generic rule: an [`Integrand`] at every node of every piece its broad phase keeps. The node
+/// states are computed once, for the boxes, and kept for the integrand.
+struct EveryNode<'i, I: ?Sized> {
+    integrand: &'i mut I,
+    /// `[p, v, a, j]` at every node of the pieces seen so far (the integrator's scratch).
+    nodes: Vec<[Vec3; 4]>,
+    /// Nodes per piece (`κ + 1`).
+    node_count: usize,
+}
+
+impl<I: Integrand + ?Sized> PieceRule for EveryNode<'_, I> {
+    #[inline(always)]
+    fn piece_box(&mut self, index: usize, piece: &ScaledPiece, u_powers: &[[f64; 6]]) -> Aabb {
+        self.node_count = u_powers.len();
+        if index == 0 {
+            self.nodes.clear();
+        }
+        let first = self.nodes.len();
+        self.nodes.extend(u_powers.iter().map(|u| piece.at(u)));
+        let mut b = Aabb {
+            min: Vec3::repeat(f64::INFINITY),
+            max: Vec3::repeat(f64::NEG_INFINITY),
+        };
+        for node in &self.nodes[first..] {
+            b.min = b.min.inf(&node[0]);
+            b.max = b.max.sup(&node[0]);
+        }
+        b
+    }
+
+    fn begin_trajectory(&mut self, t_begin: f64, t_end: f64, all: &Aabb) {
+        self.integrand.begin_trajectory(t_begin, t_end, all);
+    }
+
+    #[inline(always)]
+    fn piece(&mut self, ctx: PieceContext<'_>) -> Option<PieceIntegral> {
+        let integrand = &mut *self.integrand;
+        let piece_end = ctx.start + ctx.duration;
+        if !integrand.begin_piece(ctx.index, ctx.start, piece_end, ctx.bounds) {
+            return None;
+        }
+        let m = self.node_count;
+        let nodes = &self.nodes[ctx.index * m..(ctx.index + 1) * m];
+        let kappa = ctx.kappa;
+        let inv_kappa = 1.0 / kappa as f64;
+        let h = ctx.duration * inv_kappa;
+        let mut out = PieceIntegral::ZERO;
+        for (k, (node, u)) in nodes.iter().zip(ctx.u_powers).enumerate() {
+            let [p, v, a, j] = *node;
+            let omega = if k == 0 || k == kappa { 0.5 } else { 1.0 };
+            let weight = omega * h;
+            let s = u[1] * ctx.duration;
+            let state = SampleState {
+                piece: ctx.index,
+                index: k,
+                t: ctx.start + s,
+                weight,
+                p,
+                v,
+                a,
+                j,
+            };
+            let mut g = SampleGrad::ZERO;
+            let value = integrand.sample(&state, &mut g);
+            if value == 0.0 && g.is_zero() {
+                continue;
+            }
+            out.active = true;
+            out.value += weight * value;
+            let has_jerk = g.j != Vec3::zeros();
+            out.moments.add(&g, weight, u, has_jerk);
+            let mut along = g.p.dot(&v) + g.v.dot(&a) + g.a.dot(&j) + g.t;
+            if has_jerk {
+                let snap = ctx.coeffs[4] * 24.0 + ctx.coeffs[5] * (120.0 * s);
+                along += g.j.dot(&snap);
+            }
+            out.grad_t += omega * inv_kappa * value + weight * u[1] * along;
+            out.coupling += weight * g.t;
+        }
+        Some(out)
     }
 }
 
 /// What one piece contributes: `I_i`, the moments for `∂I/∂c_i`, the explicit `∂I_i/∂T_i` and the
-/// dI-c coupling.
+/// dI-c coupling; `active` if any node contributed.
 struct PieceIntegral {
     active: bool,
     value: f64,
@@ -290,61 +422,14 @@ struct PieceIntegral {
     coupling: f64,
 }
 
-/// Integrates one piece (pass 2 of [`TrapezoidIntegrator::integrate`]).
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn integrate_piece<I: Integrand + ?Sized>(
-    integrand: &mut I,
-    piece: usize,
-    piece_start: f64,
-    duration: f64,
-    kappa: usize,
-    nodes: &[[Vec3; 4]],
-    u_powers: &[[f64; 6]],
-    c: &[Vec3],
-) -> PieceIntegral {
-    let inv_kappa = 1.0 / kappa as f64;
-    let h = duration * inv_kappa;
-    let mut out = PieceIntegral {
+impl PieceIntegral {
+    const ZERO: PieceIntegral = PieceIntegral {
         active: false,
         value: 0.0,
         moments: Moments::ZERO,
         grad_t: 0.0,
         coupling: 0.0,
     };
-    for (k, (node, u)) in nodes.iter().zip(u_powers).enumerate() {
-        let [p, v, a, j] = *node;
-        let omega = if k == 0 || k == kappa { 0.5 } else { 1.0 };
-        let weight = omega * h;
-        let s = u[1] * duration;
-        let state = SampleState {
-            piece,
-            index: k,
-            t: piece_start + s,
-            weight,
-            p,
-            v,
-            a,
-            j,
-        };
-        let mut g = SampleGrad::ZERO;
-        let value = integrand.sample(&state, &mut g);
-        if value == 0.0 && g.is_zero() {
-            continue;
-        }
-        out.active = true;
-        out.value += weight * value;
-        let has_jerk = g.j != Vec3::zeros();
-        out.moments.add(&g, weight, u, has_jerk);
-        let mut along = g.p.dot(&v) + g.v.dot(&a) + g.a.dot(&j) + g.t;
-        if has_jerk {
-            let snap = c[4] * 24.0 + c[5] * (120.0 * s);
-            along += g.j.dot(&snap);
-        }
-        out.grad_t += omega * inv_kappa * value + weight * u[1] * along;
-        out.coupling += weight * g.t;
-    }
-    out
 }
 
 /// A piece's coefficients rescaled to the node fraction `u = s/T`: position, velocity,

@@ -1,6 +1,6 @@
-//! The objective's integration path: [`TrapezoidIntegrator::integrate_penalties`], the same
-//! quadrature and gradients as [`TrapezoidIntegrator::integrate`] specialised to
-//! [`PenaltyIntegrand`], doing the full work only at the nodes where a penalty can be active.
+//! The objective's integration rule: [`TrapezoidIntegrator::integrate_penalties`] runs the same
+//! quadrature loop as [`TrapezoidIntegrator::integrate`] with a rule specialised to
+//! [`PenaltyIntegrand`] that does the full work only at the nodes where a penalty can be active.
 //!
 //! Per piece, cheap conservative filters mark the nodes that may contribute; only those go
 //! through the per-node evaluation of the generic path (same formulas, same order; node values
@@ -22,7 +22,10 @@
 
 use trust_core::{Aabb, Vec3};
 
-use super::{Moments, PiecewiseView, ScaledPiece, TrapezoidIntegrator, check_len, points_box};
+use super::{
+    PieceContext, PieceIntegral, PieceRule, PiecewiseView, ScaledPiece, TrapezoidIntegrator,
+    points_box,
+};
 use crate::costs::PenaltyIntegrand;
 use crate::error::MincoError;
 
@@ -174,82 +177,54 @@ impl TrapezoidIntegrator {
         grad_t: &mut [f64],
         limit: f64,
     ) -> Result<(f64, bool), MincoError> {
-        let n = traj.durations.len();
-        check_len("coeffs", 6 * n, traj.coeffs.len())?;
-        check_len("grad_c", 6 * n, grad_c.len())?;
-        check_len("grad_t", n, grad_t.len())?;
         debug_assert!(
             traj.coeffs.iter().all(|c| c.iter().all(|x| x.is_finite()))
                 && traj.durations.iter().all(|t| t.is_finite() && *t > 0.0)
                 && traj.t_start.is_finite(),
             "integrate_penalties needs a finite trajectory"
         );
-        if n == 0 {
-            return Ok((0.0, true));
-        }
+        self.run(traj, &mut FlaggedNodes(penalties), grad_c, grad_t, limit)
+    }
+}
 
-        // Pass 1: scaled coefficients and the boxes of their Bézier control points.
-        self.scaled.clear();
-        self.boxes.clear();
-        let mut all = Aabb {
-            min: Vec3::repeat(f64::INFINITY),
-            max: Vec3::repeat(f64::NEG_INFINITY),
-        };
-        for (c, &duration) in traj.coeffs.chunks_exact(6).zip(traj.durations) {
-            let scaled = ScaledPiece::new(c, duration);
-            let b = points_box(&scaled.bernstein_positions());
-            all = points_box(&[all.min, all.max, b.min, b.max]);
-            self.boxes.push(b);
-            self.scaled.push(scaled);
-        }
-        let t_end = traj.t_start + traj.durations.iter().sum::<f64>();
-        penalties.begin_trajectory_obstacles(traj.t_start, t_end, &all);
+/// The objective's rule: the penalties at the nodes the filters flag.
+struct FlaggedNodes<'p, 'a>(&'p mut PenaltyIntegrand<'a>);
 
-        // Pass 2: the nodes the filters keep, piece by piece.
-        self.coupling.clear();
-        self.coupling.resize(n, 0.0);
-        let mut total = 0.0;
-        let mut piece_start = traj.t_start;
-        for i in 0..n {
-            let duration = traj.durations[i];
-            let piece_end = piece_start + duration;
-            let obstacles = penalties.begin_piece_obstacles(piece_start, piece_end, &self.boxes[i]);
-            let scaled = &self.scaled[i];
-            let columns = &mut self.columns;
-            if !flag_nodes(columns, penalties, obstacles, scaled, piece_start, duration) {
-                piece_start = piece_end;
-                continue;
-            }
-            let piece = penalty_piece(
-                penalties,
-                obstacles,
-                scaled,
-                piece_start,
-                duration,
-                self.kappa,
-                &self.u_powers,
-                columns,
-            );
-            if piece.active {
-                total += piece.value;
-                piece
-                    .moments
-                    .add_to(&mut grad_c[6 * i..6 * i + 6], duration);
-                grad_t[i] += piece.grad_t;
-                self.coupling[i] += piece.coupling;
-                if total > limit {
-                    return Ok((total, false));
-                }
-            }
-            piece_start = piece_end;
+impl PieceRule for FlaggedNodes<'_, '_> {
+    #[inline(always)]
+    fn piece_box(&mut self, _index: usize, piece: &ScaledPiece, _u_powers: &[[f64; 6]]) -> Aabb {
+        points_box(&piece.bernstein_positions())
+    }
+
+    fn begin_trajectory(&mut self, t_begin: f64, t_end: f64, all: &Aabb) {
+        self.0.begin_trajectory_obstacles(t_begin, t_end, all);
+    }
+
+    #[inline(always)]
+    fn piece(&mut self, ctx: PieceContext<'_>) -> Option<PieceIntegral> {
+        let penalties = &mut *self.0;
+        let piece_end = ctx.start + ctx.duration;
+        let obstacles = penalties.begin_piece_obstacles(ctx.start, piece_end, ctx.bounds);
+        if !flag_nodes(
+            ctx.columns,
+            penalties,
+            obstacles,
+            ctx.scaled,
+            ctx.start,
+            ctx.duration,
+        ) {
+            return None;
         }
-        // eq. dI-c: piece j collects the explicit-time terms of every later piece.
-        let mut later = 0.0;
-        for i in (0..n).rev() {
-            grad_t[i] += later;
-            later += self.coupling[i];
-        }
-        Ok((total, true))
+        Some(penalty_piece(
+            penalties,
+            obstacles,
+            ctx.scaled,
+            ctx.start,
+            ctx.duration,
+            ctx.kappa,
+            ctx.u_powers,
+            ctx.columns,
+        ))
     }
 }
 
@@ -350,15 +325,6 @@ fn bernstein_acceleration(a: &[Vec3; 4]) -> [Vec3; 4] {
     ]
 }
 
-/// What one piece contributes (see `PieceIntegral` of the generic path).
-struct PenaltyPiece {
-    active: bool,
-    value: f64,
-    moments: Moments,
-    grad_t: f64,
-    coupling: f64,
-}
-
 /// The flagged nodes of one piece: eqs. dI-a, dI-b and dI-c as in `integrate_piece`, for the
 /// penalties.
 #[allow(clippy::too_many_arguments)]
@@ -372,16 +338,10 @@ fn penalty_piece(
     kappa: usize,
     u_powers: &[[f64; 6]],
     columns: &NodeColumns,
-) -> PenaltyPiece {
+) -> PieceIntegral {
     let inv_kappa = 1.0 / kappa as f64;
     let h = duration * inv_kappa;
-    let mut out = PenaltyPiece {
-        active: false,
-        value: 0.0,
-        moments: Moments::ZERO,
-        grad_t: 0.0,
-        coupling: 0.0,
-    };
+    let mut out = PieceIntegral::ZERO;
     let flags = &columns.flags;
     for (k, (u, _)) in u_powers
         .iter()
