@@ -20,13 +20,13 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 use trust_core::{PolyTraj, Scene, Vec3};
-use trust_manager::StepReport;
+use trust_manager::{Event, Hit, StepReport};
 
 use crate::error::SimError;
 use crate::planner::{self, ResolvedPlanner};
 use crate::runlog::{
-    Bounds, CycleRecord, Header, LimitsInfo, LogWriter, ObstacleInfo, ObstacleKind, Outcome,
-    Record, SCHEMA, StateRecord, StaticShape, Status, VehicleInfo,
+    Bounds, CycleRecord, Dropped, Header, LimitsInfo, LogWriter, ObstacleInfo, ObstacleKind,
+    Outcome, Record, SCHEMA, StateRecord, StaticShape, Status, VehicleInfo,
 };
 use crate::scenario::{Latency, ShapeSpec, VehicleModel};
 use crate::traffic::MovingShape;
@@ -536,5 +536,22 @@ fn cycle_record(report: &StepReport, effective_t: f64, zero_timing: bool) -> Cyc
         effective_t,
         branch_j: report.branches.iter().map(|b| b.j).collect(),
         fallback_collision_free: report.fallback.as_ref().map(|f| f.collision_free),
+        dropped: dropped(report),
     }
+}
+
+/// Counts the cycle's safety drops by cause.
+fn dropped(report: &StepReport) -> Dropped {
+    let mut out = Dropped::default();
+    for event in &report.events {
+        if let Event::DroppedCollision { violation, .. } = event {
+            match violation.map(|v| v.with) {
+                Some(Hit::Static) => out.static_map += 1,
+                Some(Hit::Obstacle(_)) => out.moving += 1,
+                Some(Hit::Bounds) => out.bounds += 1,
+                None => out.limits += 1,
+            }
+        }
+    }
+    out
 }

@@ -188,6 +188,29 @@ pub struct CycleRecord {
     /// Added: whether the plan is a braking fallback, and whether it was collision-free.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback_collision_free: Option<bool>,
+    /// Added: what the safety check dropped this cycle, by the first violation's cause.
+    #[serde(default, skip_serializing_if = "Dropped::is_empty")]
+    pub dropped: Dropped,
+}
+
+/// Trajectories the safety check dropped in one cycle, by cause of the first violation.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Dropped {
+    /// Too close to the static map.
+    pub static_map: usize,
+    /// Too close to a moving obstacle's forecast.
+    pub moving: usize,
+    /// Left the map bounds.
+    pub bounds: usize,
+    /// Only the speed or acceleration limit was exceeded.
+    pub limits: usize,
+}
+
+impl Dropped {
+    /// Nothing was dropped.
+    pub fn is_empty(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 /// How a flight ended.

@@ -6,9 +6,11 @@ use trust_geometry::Shape;
 use super::integrate::{Integrand, SampleGrad, SampleState};
 use super::smooth::SmoothedL1;
 
-/// Static-map penalty `L_s = Σ_shapes f_max(c − d_shape(p)) + f_max(c − d_esdf(p))`: the smoothed
-/// violation of the clearance `c` by each analytic shape of the [`StaticMap`] and by its voxel
-/// ESDF (if any), with the closed-form signed distances of `trust-geometry`.
+/// Static-map penalty `L_s = Σ_shapes f_max(c − d_shape(p)) + f_max(c − d_esdf(p)) +
+/// Σ_faces f_max(c − d_face(p))`: the smoothed violation of the clearance `c` by each analytic
+/// shape of the [`StaticMap`], by its voxel ESDF (if any) and by the six faces of its bounds
+/// (the map ends there: a trajectory leaving it has left the known world, and the manager's
+/// safety check rejects it), with the closed-form signed distances of `trust-geometry`.
 ///
 /// Summing over shapes (instead of penalizing the map's minimum distance) keeps the cost smooth
 /// where two shapes are equally near; where only one shape violates the clearance — the usual
@@ -22,6 +24,7 @@ pub struct StaticObstacleTerm<'a> {
     smoothing: SmoothedL1,
     near: Vec<usize>,
     use_esdf: bool,
+    near_bounds: bool,
 }
 
 impl<'a> StaticObstacleTerm<'a> {
@@ -33,6 +36,7 @@ impl<'a> StaticObstacleTerm<'a> {
             smoothing: SmoothedL1::new(smoothing),
             near: Vec::new(),
             use_esdf: false,
+            near_bounds: false,
         }
     }
 
@@ -40,8 +44,13 @@ impl<'a> StaticObstacleTerm<'a> {
     pub(crate) fn begin_piece_impl(&mut self, samples_box: &Aabb) -> bool {
         self.near.clear();
         self.use_esdf = false;
+        let b = self.map.bounds();
+        self.near_bounds = (0..3).any(|k| {
+            !(samples_box.min[k] - b.min[k] >= self.clearance
+                && b.max[k] - samples_box.max[k] >= self.clearance)
+        });
         if self.map.has_no_obstacles() {
-            return false;
+            return self.near_bounds;
         }
         if !(samples_box.min.iter().chain(samples_box.max.iter())).all(|x| x.is_finite()) {
             // Non-finite samples: let the sample evaluation report a non-finite cost.
@@ -56,7 +65,7 @@ impl<'a> StaticObstacleTerm<'a> {
         self.use_esdf = self.map.esdf().is_some_and(|e| {
             e.occupied_count() > 0 && e.lower_bound_in(samples_box) < self.clearance
         });
-        self.use_esdf || !self.near.is_empty()
+        self.use_esdf || self.near_bounds || !self.near.is_empty()
     }
 
     /// Unweighted `L_s` at `p`; adds `weight · ∂L_s/∂p` into `grad_p`.
@@ -82,6 +91,19 @@ impl<'a> StaticObstacleTerm<'a> {
         {
             add(esdf.distance_and_gradient(p));
         }
+        if self.near_bounds {
+            let b = self.map.bounds();
+            for k in 0..3 {
+                let mut unit = Vec3::zeros();
+                unit[k] = 1.0;
+                if p[k] - b.min[k] < self.clearance {
+                    add((p[k] - b.min[k], unit));
+                }
+                if b.max[k] - p[k] < self.clearance {
+                    add((b.max[k] - p[k], -unit));
+                }
+            }
+        }
         total
     }
 
@@ -98,6 +120,19 @@ impl<'a> StaticObstacleTerm<'a> {
         let m = flags.len();
         let (x, y, z) = (&x[..m], &y[..m], &z[..m]);
         let grow = self.clearance + crate::costs::integrate::FILTER_MARGIN_M;
+        if self.near_bounds {
+            let b = self.map.bounds();
+            let (lo, hi) = (b.min.add_scalar(grow), b.max.add_scalar(-grow));
+            for (k, flag) in flags.iter_mut().enumerate() {
+                let inside = x[k] >= lo.x
+                    && x[k] <= hi.x
+                    && y[k] >= lo.y
+                    && y[k] <= hi.y
+                    && z[k] >= lo.z
+                    && z[k] <= hi.z;
+                *flag |= !inside;
+            }
+        }
         if self.use_esdf
             && let Some(esdf) = self.map.esdf()
         {
@@ -225,8 +260,8 @@ mod tests {
             let (mut hi, mut lo) = (p, p);
             hi[d] += h;
             lo[d] -= h;
-            let fd = (term.sample(&state(hi), &mut SampleGrad::default())
-                - term.sample(&state(lo), &mut SampleGrad::default()))
+            let fd = (term.sample(&state(hi), &mut SampleGrad::ZERO)
+                - term.sample(&state(lo), &mut SampleGrad::ZERO))
                 / (2.0 * h);
             assert_relative_eq!(g.p[d], fd, epsilon = 1e-6, max_relative = 1e-6);
         }
@@ -269,17 +304,57 @@ mod tests {
     }
 
     #[test]
-    fn empty_map_is_skipped() {
+    fn empty_map_is_skipped_away_from_its_faces() {
         let map = StaticMap::empty(Aabb {
             min: Vec3::zeros(),
-            max: Vec3::repeat(1.0),
+            max: Vec3::repeat(10.0),
         })
         .expect("bounds");
         let mut term = StaticObstacleTerm::new(&map, 0.3, 1e-2);
-        let b = Aabb {
-            min: Vec3::zeros(),
-            max: Vec3::repeat(1.0),
+        let inside = Aabb {
+            min: Vec3::repeat(1.0),
+            max: Vec3::repeat(9.0),
         };
-        assert!(!term.begin_piece(0, 0.0, 1.0, &b));
+        assert!(!term.begin_piece(0, 0.0, 1.0, &inside));
+        let touching = Aabb {
+            min: Vec3::new(1.0, 1.0, 0.1),
+            max: Vec3::repeat(9.0),
+        };
+        assert!(term.begin_piece(0, 0.0, 1.0, &touching));
+    }
+
+    /// Within the clearance of a face of the bounds the penalty pushes inward, with the analytic
+    /// gradient of the face distance; a point away from every face costs nothing.
+    #[test]
+    fn bounds_faces_are_penalized() {
+        let map = StaticMap::empty(Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::repeat(10.0),
+        })
+        .expect("bounds");
+        let mut term = StaticObstacleTerm::new(&map, 0.5, 1e-2);
+        let all = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::repeat(10.0),
+        };
+        assert!(term.begin_piece(0, 0.0, 1.0, &all));
+        let p = Vec3::new(5.0, 9.8, 0.2);
+        let mut g = SampleGrad::ZERO;
+        let value = term.sample(&state(p), &mut g);
+        assert!(value > 0.0);
+        assert!(g.p.y > 0.0 && g.p.z < 0.0 && g.p.x == 0.0, "{:?}", g.p);
+        for k in 0..3 {
+            let h = 1e-6;
+            let (mut a, mut b) = (p, p);
+            a[k] += h;
+            b[k] -= h;
+            let fd = (term.sample(&state(a), &mut SampleGrad::ZERO)
+                - term.sample(&state(b), &mut SampleGrad::ZERO))
+                / (2.0 * h);
+            assert_relative_eq!(fd, g.p[k], epsilon = 1e-5, max_relative = 1e-5);
+        }
+        let mut g = SampleGrad::ZERO;
+        assert_eq!(term.sample(&state(Vec3::repeat(5.0)), &mut g), 0.0);
+        assert_eq!(g.p, Vec3::zeros());
     }
 }
