@@ -9,6 +9,10 @@
 //!   number of dynamic obstacles; writes `out/e1/results.json` and `out/e1/report.md`.
 //! - `experiment e2`: paper Table Sim-A-2, UTF-MINCO vs MINCO on the static and dynamic 50×20×10 m
 //!   scenes; writes `out/e2/results.json` and `out/e2/report.md`.
+//! - `experiment e3`: paper Table Sim-B-1, the branches of one cold cycle on an E1-like scene.
+//! - `experiment e4` / `ablate [ARGS]`: paper Fig. baseline-test-3, baselines 1–3 vs
+//!   TRUST-Planner in closed loop (`trust-sim ablate`, see its `--help`); `ablate merge DIR...`
+//!   combines the shards of a study.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -32,6 +36,15 @@ struct Cli {
 enum Cmd {
     /// Run `.ci/run` (format, clippy, tests, rustdoc, benchmark and example smoke runs).
     Ci,
+    /// The main job: E4, baselines 1–3 vs TRUST-Planner in closed loop (release build of
+    /// `trust-sim ablate`; every argument is passed on, see `cargo xtask ablate --help`).
+    /// `cargo xtask ablate merge --out DIR SHARD_DIR...` combines a sharded study.
+    #[command(disable_help_flag = true)]
+    Ablate {
+        /// Arguments of `trust-sim ablate` (or `merge` followed by those of `ablate-merge`).
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
     /// Reproduce one of the paper's experiments (release build) and write a report under `out/`.
     Experiment {
         /// Which experiment.
@@ -54,6 +67,10 @@ enum Experiment {
     E1,
     /// UTF-MINCO vs MINCO on static and dynamic scenes (paper Table Sim-A-2).
     E2,
+    /// The branches of one cold cycle on an E1-like scene (paper Table Sim-B-1).
+    E3,
+    /// Baselines 1–3 vs TRUST-Planner in closed loop (paper Fig. baseline-test-3): `ablate`.
+    E4,
 }
 
 fn main() -> Result<()> {
@@ -78,7 +95,43 @@ fn main() -> Result<()> {
             match name {
                 Experiment::E1 => experiment_e1(&root, trials, seed, &out.join("e1")),
                 Experiment::E2 => experiment_e2(&root, trials, &out.join("e2")),
+                Experiment::E3 => trust_sim(
+                    &root,
+                    &[
+                        "e3".into(),
+                        "--seed".into(),
+                        seed.to_string(),
+                        "--out".into(),
+                        out.join("e3").display().to_string(),
+                    ],
+                ),
+                Experiment::E4 => trust_sim(
+                    &root,
+                    &[
+                        "ablate".into(),
+                        "--trials".into(),
+                        trials.to_string(),
+                        "--seed".into(),
+                        seed.to_string(),
+                        "--out".into(),
+                        out.join("e4").display().to_string(),
+                    ],
+                ),
             }
+        }
+        Cmd::Ablate { args } => {
+            let mut full = Vec::with_capacity(args.len() + 1);
+            match args.first().map(String::as_str) {
+                Some("merge") => {
+                    full.push("ablate-merge".to_string());
+                    full.extend(args[1..].iter().cloned());
+                }
+                _ => {
+                    full.push("ablate".to_string());
+                    full.extend(args);
+                }
+            }
+            trust_sim(&root, &full)
         }
     }
 }
@@ -166,6 +219,28 @@ fn experiment_e2(root: &Path, trials: usize, out: &Path) -> Result<()> {
         serde_json::to_string_pretty(&json)?
     );
     write_outputs(out, &json, &md)
+}
+
+/// Runs `cargo run --release -p trust-sim -- ARGS` in the workspace root, passing the terminal
+/// through (progress bars, the report), with the source's git sha for the report.
+fn trust_sim(root: &Path, args: &[String]) -> Result<()> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let mut cmd = Command::new(cargo);
+    cmd.current_dir(root)
+        .args(["run", "--quiet", "--release", "-p", "trust-sim", "--"])
+        .args(args);
+    if let Ok(out) = Command::new("git")
+        .current_dir(root)
+        .args(["rev-parse", "HEAD"])
+        .output()
+        && out.status.success()
+    {
+        cmd.env(
+            "TRUST_GIT_SHA",
+            String::from_utf8_lossy(&out.stdout).trim(),
+        );
+    }
+    run_status(&mut cmd)
 }
 
 fn write_outputs(out: &Path, json: &Value, md: &str) -> Result<()> {

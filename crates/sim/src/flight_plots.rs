@@ -11,7 +11,7 @@ use crate::plot::{
     TimeSeries, Written,
 };
 use crate::run::FlightRecord;
-use crate::runlog::{Header, StaticShape};
+use crate::runlog::{Header, StateRecord, StaticShape};
 
 /// Most points of the planner's cloud drawn (the view thins them further).
 const MAX_CLOUD_POINTS: usize = 200_000;
@@ -20,7 +20,8 @@ fn p3(a: &[f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
 }
 
-fn static_shape(plane: Plane, s: &StaticShape) -> Shape {
+/// A static shape of a run log projected on `plane` for a [`MapView`].
+pub fn static_shape(plane: Plane, s: &StaticShape) -> Shape {
     match (*s, plane) {
         (StaticShape::Sphere { center, radius }, _) => Shape::Circle {
             center: plane.project(&p3(&center)),
@@ -219,4 +220,65 @@ pub fn write_flight_plots(
         written.push(clearance.write(dir, "clearance")?);
     }
     Ok(written)
+}
+
+/// Colours of the planners in comparison figures, in the order given.
+pub const PLANNER_COLORS: [Color; 6] = [
+    Color::rgb(20, 20, 120),
+    Color::rgb(200, 60, 40),
+    Color::rgb(40, 150, 60),
+    Color::rgb(160, 90, 200),
+    Color::rgb(230, 160, 20),
+    Color::rgb(60, 160, 200),
+];
+
+/// A top view of one world with several flights over it (the static obstacles of `header`, the
+/// first flight's true obstacle tracks, and each flight's path in its own colour): the
+/// representative trial of a study. `flights` holds `(label, states)` pairs.
+///
+/// # Errors
+/// [`PlotError`] naming the file.
+pub fn write_comparison_view(
+    dir: &Path,
+    name: &str,
+    title: &str,
+    header: &Header,
+    flights: &[(String, &[StateRecord])],
+) -> Result<Written, PlotError> {
+    let plane = Plane::Xy;
+    let lo = plane.project(&p3(&header.bounds.min));
+    let hi = plane.project(&p3(&header.bounds.max));
+    let (xl, yl) = plane.axis_labels();
+    let mut v = MapView::new(title, Bounds::new(lo, hi))
+        .plane(plane)
+        .axis_labels(xl, yl)
+        .shapes(header.static_shapes.iter().map(|s| static_shape(plane, s)))
+        .shape_style(Color::rgb(150, 150, 150), "static obstacles");
+    if let Some((_, states)) = flights.first() {
+        let n = header.obstacles.len();
+        if n > 0 {
+            let tracks: Vec<Vec<Point2<f64>>> = (0..n)
+                .map(|i| {
+                    states
+                        .iter()
+                        .filter_map(|s| s.obstacles.get(i))
+                        .map(|o| plane.project(&p3(o)))
+                        .collect()
+                })
+                .collect();
+            v = v.tracks(tracks, Color::rgb(240, 190, 160), "moving obstacles (true)");
+        }
+    }
+    for (k, (label, states)) in flights.iter().enumerate() {
+        let pts = states.iter().map(|s| plane.project(&p3(&s.p))).collect();
+        v = v.polyline(
+            Polyline::new(pts)
+                .label(label.clone())
+                .color(PLANNER_COLORS[k % PLANNER_COLORS.len()])
+                .width_px(2),
+        );
+    }
+    v.marker(Marker::start(plane.project(&p3(&header.start))))
+        .marker(Marker::goal(plane.project(&p3(&header.goal))))
+        .write(dir, name)
 }

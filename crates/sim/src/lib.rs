@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod audit;
+pub mod e3;
 pub mod error;
 pub mod flight_plots;
 pub mod planner;
@@ -15,6 +16,7 @@ pub mod run;
 pub mod runlog;
 pub mod scenario;
 pub mod sensing;
+pub mod study;
 pub mod traffic;
 pub mod vehicle;
 pub mod world;

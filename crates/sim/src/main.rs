@@ -4,6 +4,9 @@
 //! trust-sim run SCENARIO.toml [--planner NAME] [--seed S] [--out DIR] [--vehicle quadrotor|perfect]
 //! trust-sim validate SCENARIO.toml...
 //! trust-sim audit RUN.jsonl...
+//! trust-sim ablate [--scenario FILE] [--trials N] [--seed S] [--planners a,b] [--variant V]
+//!                  [--out DIR] [--jobs J] [--shard K/M] [--time-limit T] [--no-plots]
+//! trust-sim ablate-merge --out DIR SHARD_DIR...
 //! ```
 
 use std::io::IsTerminal;
@@ -18,6 +21,7 @@ use trust_sim::planner::PlannerPreset;
 use trust_sim::run::{RunOptions, fly, header};
 use trust_sim::runlog::RunLog;
 use trust_sim::scenario::{Scenario, VehicleModel};
+use trust_sim::study::{RunStudyOptions, Shard, StudyConfig, merge, run_study};
 use trust_sim::world::World;
 
 #[derive(Parser)]
@@ -67,6 +71,70 @@ enum Cmd {
         /// Scenario files.
         #[arg(required = true)]
         scenarios: Vec<PathBuf>,
+    },
+    /// Run a comparative study (the paper's E4 by default): every planner on the same trials;
+    /// writes runs.csv, summary.json, report.md, plots and every run log.
+    Ablate {
+        /// The scenario of every trial.
+        #[arg(long, default_value = "scenarios/e4.toml")]
+        scenario: PathBuf,
+        /// Trials per planner (100 is the paper's size).
+        #[arg(long, default_value_t = 4)]
+        trials: usize,
+        /// Base seed: trial i flies the scenario with seed S + i.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Planners, comma-separated, in report order.
+        #[arg(
+            long,
+            default_value = "trust,baseline1,baseline2,baseline3",
+            value_delimiter = ','
+        )]
+        planners: Vec<String>,
+        /// One-component ablation applied to every planner it concerns: none, vprm, minco, uvd,
+        /// no-pdc, no-ggs, no-history, no-hysteresis, perfect, quadrotor, mu=X, fault=X.
+        #[arg(long, default_value = "none")]
+        variant: String,
+        /// Output directory.
+        #[arg(long, default_value = "target/ablate")]
+        out: PathBuf,
+        /// Worker threads (default: one per core).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Run only shard K of M (trials i with i mod M = K - 1); combine with ablate-merge.
+        #[arg(long, default_value = "1/1")]
+        shard: String,
+        /// Simulated time limit per flight (s), replacing the scenario's.
+        #[arg(long)]
+        time_limit: Option<f64>,
+        /// Skip the plots.
+        #[arg(long)]
+        no_plots: bool,
+    },
+    /// Experiment E3 (paper Table Sim-B-1): the branches of one cold cycle, beside the paper's
+    /// table; writes summary.json, report.md and a top view with the forecasts.
+    E3 {
+        /// The scenario.
+        #[arg(long, default_value = "scenarios/e3.toml")]
+        scenario: PathBuf,
+        /// Trial seed, replacing the scenario's.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Output directory.
+        #[arg(long, default_value = "out/e3")]
+        out: PathBuf,
+    },
+    /// Combine the directories of a sharded study into one report, as a single run would write.
+    AblateMerge {
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// The shards' output directories.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Skip the plots.
+        #[arg(long)]
+        no_plots: bool,
     },
     /// Re-check run logs: recompute the outcome from the header and state records with
     /// independent geometry and compare (exit status 1 on any disagreement).
@@ -132,6 +200,73 @@ fn run_cli() -> Result<ExitCode> {
             }
             run(&s, &out, zero_timing, !no_plots)
         }
+        Cmd::Ablate {
+            scenario,
+            trials,
+            seed,
+            planners,
+            variant,
+            out,
+            jobs,
+            shard,
+            time_limit,
+            no_plots,
+        } => {
+            let planners = planners
+                .iter()
+                .map(|p| parse_preset(p.trim()))
+                .collect::<Result<Vec<_>>>()?;
+            let scenario_name = Scenario::load(&scenario)?.name;
+            let config = StudyConfig {
+                scenario,
+                scenario_name,
+                trials,
+                seed,
+                planners,
+                variant: variant.parse()?,
+                time_limit_s: time_limit,
+                shard: Shard::parse(&shard)?,
+            };
+            let flights = config.my_trials().len() * config.planners.len();
+            eprintln!(
+                "{} trial(s) × {} planner(s) = {flights} flight(s) of `{}`, variant `{}`, shard {}/{}",
+                config.my_trials().len(),
+                config.planners.len(),
+                config.scenario_name,
+                config.variant,
+                config.shard.index,
+                config.shard.count
+            );
+            let options = RunStudyOptions {
+                jobs,
+                no_plots,
+                progress: std::io::stderr().is_terminal(),
+            };
+            let rows = run_study(&config, &out, &options)?;
+            print_study(&out, rows.len())
+        }
+        Cmd::E3 {
+            scenario,
+            seed,
+            out,
+        } => {
+            let mut s = Scenario::load(&scenario)?;
+            if let Some(seed) = seed {
+                s = s.with_seed(seed);
+            }
+            let summary = trust_sim::e3::run_e3(&s, &out)?;
+            println!("{}", trust_sim::e3::report_md(&summary));
+            println!("wrote {}", out.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::AblateMerge {
+            out,
+            dirs,
+            no_plots,
+        } => {
+            let rows = merge(&dirs, &out, !no_plots)?;
+            print_study(&out, rows.len())
+        }
         Cmd::Validate { scenarios } => {
             let mut bad = 0;
             for path in &scenarios {
@@ -180,6 +315,16 @@ fn run_cli() -> Result<ExitCode> {
             })
         }
     }
+}
+
+fn print_study(out: &Path, flights: usize) -> Result<ExitCode> {
+    let report = std::fs::read_to_string(out.join("report.md"))
+        .with_context(|| format!("reading {}", out.join("report.md").display()))?;
+    // The table and the targets: everything up to "## Reading it".
+    let head = report.split("## Reading it").next().unwrap_or(&report);
+    println!("{}", head.trim_end());
+    println!("\n{flights} flight(s); wrote {}", out.display());
+    Ok(ExitCode::SUCCESS)
 }
 
 fn parse_preset(name: &str) -> Result<PlannerPreset> {

@@ -276,8 +276,8 @@ pub fn fly(
     let hover = Reference::hover(start);
     let mut vehicle: Box<dyn Vehicle> = match scenario.vehicle.model {
         VehicleModel::Quadrotor => Box::new(ControlledQuadrotor::starting_on(
-            scenario.vehicle.quadrotor.clone(),
-            scenario.vehicle.gains.clone(),
+            scenario.vehicle.quadrotor,
+            scenario.vehicle.gains,
             0.0,
             &hover,
         )?),

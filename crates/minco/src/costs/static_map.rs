@@ -260,8 +260,8 @@ mod tests {
             let (mut hi, mut lo) = (p, p);
             hi[d] += h;
             lo[d] -= h;
-            let fd = (term.sample(&state(hi), &mut SampleGrad::ZERO)
-                - term.sample(&state(lo), &mut SampleGrad::ZERO))
+            let fd = (term.sample(&state(hi), &mut { SampleGrad::ZERO })
+                - term.sample(&state(lo), &mut { SampleGrad::ZERO }))
                 / (2.0 * h);
             assert_relative_eq!(g.p[d], fd, epsilon = 1e-6, max_relative = 1e-6);
         }
@@ -348,8 +348,8 @@ mod tests {
             let (mut a, mut b) = (p, p);
             a[k] += h;
             b[k] -= h;
-            let fd = (term.sample(&state(a), &mut SampleGrad::ZERO)
-                - term.sample(&state(b), &mut SampleGrad::ZERO))
+            let fd = (term.sample(&state(a), &mut { SampleGrad::ZERO })
+                - term.sample(&state(b), &mut { SampleGrad::ZERO }))
                 / (2.0 * h);
             assert_relative_eq!(fd, g.p[k], epsilon = 1e-5, max_relative = 1e-5);
         }

@@ -254,6 +254,38 @@ impl World {
         })
     }
 
+    /// This world with `scenario` in place of the one it was built from, when the two agree on
+    /// everything the world is made of (seed, world, static map, obstacles, mission and vehicle
+    /// radius) and differ only in how the trial is flown (planner, vehicle model and limits,
+    /// sensing, traffic faults, clocks, time limit); otherwise a world built from `scenario`.
+    /// Studies fly several planners and variants over one world without rebuilding its ESDF.
+    ///
+    /// # Errors
+    /// As [`World::build`] when a rebuild is needed.
+    pub fn with_scenario(mut self, scenario: &Scenario) -> Result<World, SimError> {
+        let (a, b) = (&self.scenario, scenario);
+        let same_world = a.seed == b.seed
+            && a.world == b.world
+            && a.static_map == b.static_map
+            && a.obstacles == b.obstacles
+            && a.random_obstacles == b.random_obstacles
+            && a.mission == b.mission
+            && a.vehicle.radius_m == b.vehicle.radius_m
+            && a.path == b.path;
+        if !same_world {
+            return World::build(scenario);
+        }
+        let problems = scenario.validate();
+        if !problems.is_empty() {
+            return Err(SimError::Invalid {
+                path: scenario.origin(),
+                problems,
+            });
+        }
+        self.scenario = scenario.clone();
+        Ok(self)
+    }
+
     /// The scenario it was built from.
     pub fn scenario(&self) -> &Scenario {
         &self.scenario
