@@ -519,7 +519,7 @@ fn coarse_minima(distances: &[f64], dims: [usize; 3]) -> (Vec<f64>, [usize; 3]) 
     let blocks = |v: usize, n_blocks: usize| {
         let b = v / COARSE_BLOCK;
         let own = b.min(n_blocks - 1);
-        let below = (v % COARSE_BLOCK == 0 && b > 0).then(|| b - 1);
+        let below = (v.is_multiple_of(COARSE_BLOCK) && b > 0).then(|| b - 1);
         (own, below)
     };
     for z in 0..dims[2] {
