@@ -20,7 +20,7 @@ use trust_core::{
 };
 
 use crate::ggs::Terminal;
-use crate::prm::{COINCIDENT_M, check_query, coincident_result};
+use crate::prm::check_or_trivial_answer;
 use crate::shortcut::shortcut;
 use crate::visibility::Obstacles;
 
@@ -240,12 +240,11 @@ impl PathFrontend for SparseAStar {
     ) -> Result<SearchResult, PlanError> {
         let since = Instant::now();
         let budget = self.params.budget()?;
-        check_query(query, scene)?;
+        if let Some(answer) = check_or_trivial_answer(query, scene, since)? {
+            return Ok(answer);
+        }
         let p = &self.params;
         let start = query.start.p;
-        if (query.goal - start).norm() <= COINCIDENT_M {
-            return coincident_result(query, since);
-        }
         let deadline = since + budget;
         let terminal = if p.goal_guidance_surface {
             Terminal::goal_guidance_surface(

@@ -54,18 +54,26 @@ pub fn check_query(query: &PathQuery, scene: &Scene<'_>) -> Result<(), PlanError
     Ok(())
 }
 
-/// The answer for coincident start and goal: one zero-length path `[start, goal]`.
-pub(crate) fn coincident_result(
+/// What every frontend of this crate does before it plans: validates the query ([`check_query`])
+/// and answers coincident start and goal (closer than [`COINCIDENT_M`]) with one zero-length path
+/// `[start, goal]` without any sampling — `Some(answer)` then, `None` when there is something to
+/// plan. `since` is when the search call began (for [`SearchStats::elapsed`]).
+pub(crate) fn check_or_trivial_answer(
     query: &PathQuery,
+    scene: &Scene<'_>,
     since: Instant,
-) -> Result<SearchResult, PlanError> {
-    Ok(SearchResult {
+) -> Result<Option<SearchResult>, PlanError> {
+    check_query(query, scene)?;
+    if (query.goal - query.start.p).norm() > COINCIDENT_M {
+        return Ok(None);
+    }
+    Ok(Some(SearchResult {
         paths: vec![GuidePath::new(vec![query.start.p, query.goal])?],
         stats: SearchStats {
             elapsed: since.elapsed(),
             ..SearchStats::default()
         },
-    })
+    }))
 }
 
 /// How the moving obstacles enter the roadmap's visibility test.
@@ -265,11 +273,10 @@ pub(crate) fn run(
     rng: &mut Rng,
 ) -> Result<SearchResult, PlanError> {
     let since = Instant::now();
-    check_query(query, scene)?;
-    let start = query.start.p;
-    if (query.goal - start).norm() <= COINCIDENT_M {
-        return coincident_result(query, since);
+    if let Some(answer) = check_or_trivial_answer(query, scene, since)? {
+        return Ok(answer);
     }
+    let start = query.start.p;
     let deadline = since + setup.budget("prm")?;
 
     let terminal = if setup.goal_surface {

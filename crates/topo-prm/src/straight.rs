@@ -7,7 +7,7 @@ use trust_core::{
     GuidePath, PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult, SearchStats,
 };
 
-use crate::prm::{COINCIDENT_M, check_query, coincident_result};
+use crate::prm::check_or_trivial_answer;
 
 /// Baseline 1 as a [`PathFrontend`] (`"straight-line"`): one path `[start, end]` where `end` is the goal
 /// if it lies within `T_h·v_max`, else the point at that distance toward the goal (which lies on the
@@ -42,11 +42,10 @@ impl PathFrontend for StraightLine {
         _rng: &mut Rng,
     ) -> Result<SearchResult, PlanError> {
         let since = Instant::now();
-        check_query(query, scene)?;
-        let start = query.start.p;
-        if (query.goal - start).norm() <= COINCIDENT_M {
-            return coincident_result(query, since);
+        if let Some(answer) = check_or_trivial_answer(query, scene, since)? {
+            return Ok(answer);
         }
+        let start = query.start.p;
         let reach = query.horizon_s * query.limits.v_max;
         let end = straight_end(&start, &query.goal, reach);
         Ok(SearchResult {
