@@ -235,10 +235,7 @@ fn trust_sim(root: &Path, args: &[String]) -> Result<()> {
         .output()
         && out.status.success()
     {
-        cmd.env(
-            "TRUST_GIT_SHA",
-            String::from_utf8_lossy(&out.stdout).trim(),
-        );
+        cmd.env("TRUST_GIT_SHA", String::from_utf8_lossy(&out.stdout).trim());
     }
     run_status(&mut cmd)
 }

@@ -29,23 +29,6 @@ fn quickstart() -> Scenario {
     Scenario::load(&scenarios_dir().join("quickstart.toml")).expect("quickstart loads")
 }
 
-/// Strips what differs between two runs of one configuration: the measured times of the cycle
-/// records (the only machine-dependent part of a log with a fixed latency).
-fn without_timing(log: &str) -> String {
-    log.lines()
-        .map(|line| {
-            let mut v: serde_json::Value = serde_json::from_str(line).unwrap();
-            if v["type"] == "cycle" {
-                for k in ["wall_ms", "frontend_ms", "backend_ms", "checker_ms"] {
-                    v[k] = serde_json::json!(0.0);
-                }
-            }
-            v.to_string()
-        })
-        .collect::<Vec<_>>()
-        .join("\n")
-}
-
 #[test]
 fn quickstart_arrives_and_its_log_passes_the_independent_audit() {
     let s = quickstart();
