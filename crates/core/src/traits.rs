@@ -8,7 +8,8 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{check_finite_vec, check_positive};
+use crate::error::{check_positive, check_scaled, check_scaled_vec};
+use trust_geometry::scale::Quantity;
 use crate::{Curve, GuidePath, Limits, PlanError, PolyTraj, Rng, Scene, Solution, State, Vec3};
 
 /// A request for guide paths.
@@ -28,9 +29,10 @@ impl PathQuery {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
         self.start.validate("query.start")?;
-        check_finite_vec("query.goal", &self.goal)?;
+        check_scaled_vec("query.goal", &self.goal, Quantity::Position)?;
         self.limits.validate()?;
         check_positive("query.horizon_s", self.horizon_s)?;
+        check_scaled("query.horizon_s", self.horizon_s, Quantity::PositiveDuration)?;
         Ok(())
     }
 }
@@ -143,10 +145,14 @@ impl TrajRequest<'_> {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
         self.start.validate("request.start")?;
-        check_finite_vec("request.goal", &self.goal)?;
+        check_scaled_vec("request.goal", &self.goal, Quantity::Position)?;
         self.limits.validate()?;
         if let Some(h) = self.horizon_s {
             check_positive("request.horizon_s", h)?;
+            check_scaled("request.horizon_s", h, Quantity::PositiveDuration)?;
+        }
+        if let InitialGuess::Guide(path) = self.initial {
+            path.validate("request.initial.guide")?;
         }
         if self.max_evaluations == Some(0) {
             return Err(PlanError::invalid(

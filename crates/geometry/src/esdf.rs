@@ -319,6 +319,7 @@ impl Esdf {
         points: &[Vec3],
         resolution: f64,
     ) -> Result<Self, GeometryError> {
+        crate::aabb::check_box("bounds", &bounds.min, &bounds.max)?;
         bounds.check_volume("bounds")?;
         check_positive("resolution", resolution)?;
         let ext = bounds.extent();
@@ -332,7 +333,10 @@ impl Esdf {
         let count = checked_voxel_count(dims)?;
         let mut occupied = vec![false; count];
         for (idx, p) in points.iter().enumerate() {
-            crate::error::check_vec(&format!("points[{idx}]"), p)?;
+            for (i, axis) in ['x', 'y', 'z'].into_iter().enumerate() {
+                crate::error::check_finite(&format!("points[{idx}].{axis}"), p[i])?;
+            }
+            // Finite points beyond the scale policy lie outside the (validated) bounds too.
             if !bounds.contains(p) {
                 continue;
             }

@@ -3,7 +3,7 @@
 use parry3d_f64::bounding_volume::Aabb as PAabb;
 use parry3d_f64::math::{Pose, Vector as PVec};
 use parry3d_f64::query;
-use parry3d_f64::shape::{Ball, Cuboid, Cylinder as PCylinder, Segment};
+use parry3d_f64::shape::{Cuboid, Cylinder as PCylinder, Segment};
 
 use crate::Vec3;
 use crate::aabb::Aabb;
@@ -26,8 +26,16 @@ pub(crate) fn segment_shape_distance(shape: &Shape, a: &Vec3, b: &Vec3) -> f64 {
     let id = Pose::IDENTITY;
     let result = match shape {
         Shape::Sphere(s) => {
-            let seg = Segment::new(to_p(&(a - s.center)), to_p(&(b - s.center)));
-            query::distance(&id, &seg, &id, &Ball::new(s.radius))
+            // Closed form: distance from the centre to the segment, minus the radius.
+            let d = b - a;
+            let len2 = d.norm_squared();
+            let t = if len2 > 0.0 {
+                ((s.center - a).dot(&d) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let gap = (a + d * t - s.center).norm() - s.radius;
+            return if gap.is_nan() { 0.0 } else { gap.max(0.0) };
         }
         Shape::Cylinder(c) => {
             let swap = |p: &Vec3| {

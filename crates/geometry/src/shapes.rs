@@ -24,7 +24,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::Vec3;
 use crate::aabb::{Aabb, check_box};
-use crate::error::{GeometryError, check_finite, check_non_negative, check_vec};
+use crate::error::{GeometryError, check_coord, check_non_negative, check_vec};
 
 /// The direction used where the distance to a sphere's centre (or a cylinder's axis) has no
 /// direction.
@@ -316,8 +316,8 @@ impl Cylinder {
         z_max: f64,
         radius: f64,
     ) -> Result<Self, GeometryError> {
-        check_finite("cylinder.z_min", z_min)?;
-        check_finite("cylinder.z_max", z_max)?;
+        check_coord("cylinder.z_min", z_min)?;
+        check_coord("cylinder.z_max", z_max)?;
         if z_min > z_max {
             return Err(GeometryError::InvertedBox {
                 field: "cylinder".into(),

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use trust_geometry::{Aabb, Vec3, cylinder_sdf_with_size_gradient, sphere_sdf};
 
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec};
+use trust_geometry::scale::Quantity;
 use crate::{Pdc, PredictError};
 
 /// Base shape of a moving obstacle.
@@ -111,14 +112,14 @@ impl Forecast {
     /// # Errors
     /// The first violated invariant, naming the field and value.
     pub fn validate(&self) -> Result<(), PredictError> {
-        check_vec("forecast.p0", &self.p0)?;
-        check_vec("forecast.v0", &self.v0)?;
-        check_finite("forecast.t0", self.t0)?;
-        check_positive("forecast.r_o", self.r_o)?;
-        check_non_negative("forecast.r_safe", self.r_safe)?;
-        check_non_negative("forecast.mu", self.mu)?;
+        check_vec("forecast.p0", &self.p0, Quantity::Position)?;
+        check_vec("forecast.v0", &self.v0, Quantity::Velocity)?;
+        check_finite("forecast.t0", self.t0, Quantity::Time)?;
+        check_positive("forecast.r_o", self.r_o, Quantity::Length)?;
+        check_non_negative("forecast.r_safe", self.r_safe, Quantity::Length)?;
+        check_non_negative("forecast.mu", self.mu, Quantity::Rate)?;
         if let ObstacleShape::Cylinder { half_height } = self.shape {
-            check_positive("forecast.shape.half_height", half_height)?;
+            check_positive("forecast.shape.half_height", half_height, Quantity::Length)?;
         }
         Ok(())
     }
@@ -221,8 +222,8 @@ impl Forecast {
     /// # Errors
     /// [`PredictError`] if a time is non-finite or `t_a > t_b`.
     pub fn aabb_over(&self, t_a: f64, t_b: f64) -> Result<Aabb, PredictError> {
-        check_finite("t_a", t_a)?;
-        check_finite("t_b", t_b)?;
+        check_finite("t_a", t_a, Quantity::Time)?;
+        check_finite("t_b", t_b, Quantity::Time)?;
         if t_a > t_b {
             return Err(PredictError::InvalidWindow {
                 t_start: t_a,

@@ -54,6 +54,7 @@ use crate::convex::{
     min_over_convex_polygon, segment_segment_distance,
 };
 use crate::error::{check_finite, check_non_negative};
+use trust_geometry::scale::Quantity;
 use crate::{Forecast, ObstacleShape, PredictError};
 
 mod samples;
@@ -95,7 +96,7 @@ impl Pdc {
     /// # Errors
     /// [`PredictError`] if the forecast is invalid or `horizon` is non-finite or negative.
     pub fn new(forecast: &Forecast, horizon: f64) -> Result<Self, PredictError> {
-        check_non_negative("horizon", horizon)?;
+        check_non_negative("horizon", horizon, Quantity::Duration)?;
         Self::over_window(forecast, forecast.t0, forecast.t0 + horizon)
     }
 
@@ -111,8 +112,8 @@ impl Pdc {
         t_end: f64,
     ) -> Result<Self, PredictError> {
         forecast.validate()?;
-        check_finite("t_start", t_start)?;
-        check_finite("t_end", t_end)?;
+        check_finite("t_start", t_start, Quantity::Time)?;
+        check_finite("t_end", t_end, Quantity::Time)?;
         if t_end < t_start {
             return Err(PredictError::InvalidWindow {
                 t_start,
