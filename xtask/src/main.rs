@@ -9,6 +9,9 @@
 //!   number of dynamic obstacles; writes `out/e1/results.json` and `out/e1/report.md`.
 //! - `experiment e2`: paper Table Sim-A-2, UTF-MINCO vs MINCO on the static and dynamic 50×20×10 m
 //!   scenes; writes `out/e2/results.json` and `out/e2/report.md`.
+//! - `fuzz [--cases N] [--seed S] [--only API]`: adversarial inputs against every public entry
+//!   point of the library crates (`trust-fuzz`, release build); fails on any panic, hang,
+//!   non-finite output, wrong answer or call over 1 s.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -17,6 +20,8 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use serde_json::Value;
+
+mod fuzz;
 
 #[derive(Parser)]
 #[command(
@@ -45,6 +50,19 @@ enum Cmd {
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
+    },
+    /// Throw random, adversarial and boundary inputs at every public API (release build of
+    /// `trust-fuzz`); fails on any panic, hang, non-finite output, wrong answer or slow call.
+    Fuzz {
+        /// Total number of calls.
+        #[arg(long, default_value_t = 1_000_000)]
+        cases: u64,
+        /// Seed of the run.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Only the APIs whose name contains this.
+        #[arg(long)]
+        only: Option<String>,
     },
 }
 
@@ -80,6 +98,7 @@ fn main() -> Result<()> {
                 Experiment::E2 => experiment_e2(&root, trials, &out.join("e2")),
             }
         }
+        Cmd::Fuzz { cases, seed, only } => fuzz::run(&root, cases, seed, only.as_deref()),
     }
 }
 

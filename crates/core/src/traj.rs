@@ -279,7 +279,12 @@ impl PolyTraj {
         let (i, s) = self.locate(t);
         let piece = &self.pieces[i];
         State {
-            t: t.clamp(self.t_start, self.t_end()),
+            // A NaN time maps to the start, as in `locate`.
+            t: if t.is_nan() {
+                self.t_start
+            } else {
+                t.clamp(self.t_start, self.t_end())
+            },
             p: eval_piece(piece, 0, s),
             v: eval_piece(piece, 1, s),
             a: eval_piece(piece, 2, s),

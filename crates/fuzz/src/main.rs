@@ -203,6 +203,9 @@ fn main() -> Result<()> {
                      (replay: trust-fuzz --only '{api}' --replay {case})",
                     args.hang_ms
                 );
+                if let Ok(stats) = stats.lock() {
+                    print_table(&names, &stats, args.seed, run_start);
+                }
                 std::process::exit(3);
             }
         }
@@ -212,6 +215,17 @@ fn main() -> Result<()> {
         .map_err(|_| anyhow::anyhow!("worker thread died"))?;
 
     let stats = stats.lock().map_err(|_| anyhow::anyhow!("poisoned"))?;
+    let bad = print_table(&names, &stats, args.seed, run_start);
+    if bad > 0 {
+        println!("FAIL: {bad} calls panicked, returned non-finite or wrong output, or were slow");
+        std::process::exit(1);
+    }
+    println!("OK: 0 panics, 0 hangs, 0 non-finite outputs, 0 wrong answers, 0 slow calls");
+    Ok(())
+}
+
+/// Prints the per-API table and the failing examples; returns the number of bad calls.
+fn print_table(names: &[&str], stats: &[Stats], seed: u64, run_start: Instant) -> u64 {
     println!(
         "{:<38} {:>9} {:>9} {:>7} {:>10} {:>6} {:>6} {:>9}",
         "api", "calls", "errors", "panics", "non-finite", "wrong", "slow", "max ms"
@@ -245,7 +259,7 @@ fn main() -> Result<()> {
     );
     println!(
         "seed {}, {:.1} s wall",
-        args.seed,
+        seed,
         run_start.elapsed().as_secs_f64()
     );
     for (name, s) in names.iter().zip(stats.iter()) {
@@ -253,10 +267,5 @@ fn main() -> Result<()> {
             println!("  {name}: {e}");
         }
     }
-    if bad > 0 {
-        println!("FAIL: {bad} calls panicked, returned non-finite or wrong output, or were slow");
-        std::process::exit(1);
-    }
-    println!("OK: 0 panics, 0 hangs, 0 non-finite outputs, 0 wrong answers, 0 slow calls");
-    Ok(())
+    bad
 }

@@ -24,7 +24,7 @@ const ESDF_LIPSCHITZ: f64 = 2.0 * 1.732_050_807_568_877_3;
 
 /// Most sphere-tracing steps one ESDF line-of-sight test takes before it gives up (answers "not
 /// clear"): a count that does not depend on any float being finite.
-pub const MAX_TRACE_STEPS: usize = 1 << 20;
+pub const MAX_TRACE_STEPS: usize = 1 << 16;
 
 /// The static world: bounds, analytic [`Shape`]s and an optional voxel [`Esdf`] from a point cloud.
 ///

@@ -35,7 +35,11 @@ pub(crate) fn segment_shape_distance(shape: &Shape, a: &Vec3, b: &Vec3) -> f64 {
                 0.0
             };
             let gap = (a + d * t - s.center).norm() - s.radius;
-            return if gap.is_nan() { 0.0 } else { gap.max(0.0) };
+            // Rounding in the projection is a few ulps of the coordinates' magnitude: a gap
+            // below that is reported as contact (conservative), so that a tiny sphere on a long
+            // segment is never missed.
+            let ulps = 8.0 * f64::EPSILON * (a.amax() + b.amax() + s.center.amax() + s.radius);
+            return if gap.is_nan() || gap <= ulps { 0.0 } else { gap };
         }
         Shape::Cylinder(c) => {
             let swap = |p: &Vec3| {

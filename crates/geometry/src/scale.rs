@@ -54,6 +54,18 @@ pub const MAX_SOLVED_SAMPLE_COUNT: usize = 100_000;
 /// Largest number of vertices of a path or pieces of a trajectory.
 pub const MAX_VERTEX_COUNT: usize = 100_000;
 
+/// Largest coordinate magnitude at which the free distance functions (`sphere_sdf`, `box_sdf`,
+/// cone distances, ...) still answer: far beyond the policy, but small enough that squared
+/// distances stay finite. Beyond it (or for a non-finite point) they return `(-inf, 0)`: "not free",
+/// the convention of [`crate::StaticMap::distance_and_gradient`] for non-finite queries.
+pub const QUERY_LIMIT: f64 = 1.0e100;
+
+/// True if every argument is finite with magnitude at most [`QUERY_LIMIT`].
+#[inline]
+pub fn queryable(values: &[f64]) -> bool {
+    values.iter().all(|v| v.abs() <= QUERY_LIMIT)
+}
+
 /// The kind of a checked number, which fixes its accepted range.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Quantity {

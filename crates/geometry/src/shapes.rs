@@ -42,6 +42,9 @@ fn side(x: f64) -> f64 {
 /// to the other arguments follow directly: `∂d/∂center = -gradient`, `∂d/∂radius = -1`.
 #[inline]
 pub fn sphere_sdf(center: &Vec3, radius: f64, p: &Vec3) -> (f64, Vec3) {
+    if !crate::scale::queryable(&[p.x, p.y, p.z, center.x, center.y, center.z, radius]) {
+        return (f64::NEG_INFINITY, Vec3::zeros());
+    }
     let d = p - center;
     let n = d.norm();
     if n > 0.0 {
@@ -88,6 +91,23 @@ pub fn cylinder_sdf_with_size_gradient(
     half_height: f64,
     p: &Vec3,
 ) -> CylinderSdf {
+    if !crate::scale::queryable(&[
+        p.x,
+        p.y,
+        p.z,
+        center.x,
+        center.y,
+        center.z,
+        radius,
+        half_height,
+    ]) {
+        return CylinderSdf {
+            distance: f64::NEG_INFINITY,
+            gradient: Vec3::zeros(),
+            d_radius: 0.0,
+            d_half_height: 0.0,
+        };
+    }
     let q = p - center;
     let rho = q.x.hypot(q.y);
     let radial = if rho > 0.0 {
@@ -132,6 +152,9 @@ pub fn cylinder_sdf_with_size_gradient(
 /// normal of the nearest face (ties: `x` before `y` before `z`, `+` side on the mid-plane).
 /// `min <= max` is assumed (not checked).
 pub fn box_sdf(min: &Vec3, max: &Vec3, p: &Vec3) -> (f64, Vec3) {
+    if !crate::scale::queryable(&[p.x, p.y, p.z, min.x, min.y, min.z, max.x, max.y, max.z]) {
+        return (f64::NEG_INFINITY, Vec3::zeros());
+    }
     let c = 0.5 * (min + max);
     let h = 0.5 * (max - min);
     let rel = p - c;

@@ -67,11 +67,18 @@ impl Default for LbfgsParams {
     }
 }
 
+/// Largest accepted [`LbfgsParams::memory`]: the correction pairs are allocated up front.
+pub const MAX_MEMORY: usize = 1024;
+
 impl LbfgsParams {
     /// Checks every field's range; the error names the first offending field and its value.
     pub fn validate(&self) -> Result<(), LbfgsError> {
-        if self.memory == 0 {
-            return Err(invalid("memory", 0.0, "an integer >= 1"));
+        if self.memory == 0 || self.memory > MAX_MEMORY {
+            return Err(invalid(
+                "memory",
+                self.memory as f64,
+                "an integer in [1, 1024] (MAX_MEMORY)",
+            ));
         }
         if self.max_linesearch == 0 {
             return Err(invalid("max_linesearch", 0.0, "an integer >= 1"));

@@ -184,12 +184,20 @@ impl Forecast {
     /// `p`, `∂d/∂t = −∂d/∂p · v0 + ∂d/∂size · radius_rate(t)` (paper eq. gradients-of-Io (b): centre
     /// motion plus size growth).
     ///
+    /// A non-finite `p` or `t`, or one beyond `trust_geometry::scale::QUERY_LIMIT` (`1e90` s for
+    /// `t`), gives `(-inf, 0, 0)`: "not free".
+    ///
     /// Where `d` is not differentiable (sphere centre, cylinder axis, medial surfaces, and `t = t0`
     /// where the radius rate jumps) the gradient is a documented element of the subdifferential
     /// (see `trust_geometry::shapes`; at `t = t0` the right derivative). Add the ego term
     /// `∂d/∂p · ṗ` yourself for eq. gradients-of-Io (a).
     #[inline]
     pub fn distance_and_gradients(&self, p: &Vec3, t: f64) -> (f64, Vec3, f64) {
+        // Beyond these magnitudes (or for non-finite input) the answer is "not free", with zero
+        // gradients, as for the static map's non-finite queries.
+        if !(trust_geometry::scale::queryable(&[p.x, p.y, p.z]) && t.abs() <= 1e90) {
+            return (f64::NEG_INFINITY, Vec3::zeros(), 0.0);
+        }
         let c = self.center(t);
         let rate = self.radius_rate(t);
         let (distance, d_p, d_size) = match self.shape {

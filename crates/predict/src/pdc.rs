@@ -206,9 +206,13 @@ impl Pdc {
     ///
     /// Spheres: exact outside; inside negative with magnitude at most the true depth. Cylinders:
     /// the square-rim distance of the module documentation (exact in the core and away from the
-    /// rims). `p` is assumed finite.
+    /// rims). A non-finite `p`, or one beyond `trust_geometry::scale::QUERY_LIMIT`, gives
+    /// `(-inf, 0)`: "not free".
     #[inline]
     pub fn distance_and_gradient(&self, p: &Vec3) -> (f64, Vec3) {
+        if !trust_geometry::scale::queryable(&[p.x, p.y, p.z]) {
+            return (f64::NEG_INFINITY, Vec3::zeros());
+        }
         if !self.cylinder {
             return round_cone_sdf(&self.a, &self.b, self.ra, self.rb, p);
         }
