@@ -245,10 +245,15 @@ fn geo_segment_through_sphere(g: &mut Gen, _: &Fixtures) -> Outcome {
     let c = Vec3::new(g.num(-1e5, 1e5), g.num(-1e5, 1e5), g.num(-1e5, 1e5));
     let r = g.num(1e-3, 10.0);
     let s = tri!(Sphere::new(c, r));
+    let len = 10f64.powf(g.num(-2.0, 6.5));
+    // Below the rounding of the segment's own coordinates the represented segment may truly miss
+    // the sphere: no oracle there.
+    if !(r > 1e-9 * (c.amax() + len)) {
+        return Outcome::Err;
+    }
     let bounds = tri!(Aabb::new(Vec3::repeat(-1e6), Vec3::repeat(1e6)));
     let map = tri!(StaticMap::from_shapes(bounds, vec![s.into()]));
     let dir = Vec3::new(g.num(-1.0, 1.0), g.num(-1.0, 1.0), g.num(-1.0, 1.0));
-    let len = 10f64.powf(g.num(-2.0, 6.5));
     let (a, b) = (c - dir * len, c + dir * len);
     if !(fin3(&a) && fin3(&b)) || dir.norm() < 1e-3 {
         return Outcome::Err;
@@ -303,9 +308,12 @@ fn pred_forecast(g: &mut Gen, _: &Fixtures) -> Outcome {
     let (p, t) = (g.v3(), g.time());
     let (d, dp, dt) = f.distance_and_gradients(&p, t);
     require!(!d.is_nan() && !nan3(&dp) && !dt.is_nan(), NonFinite, "{f:?} at {p:?}, t {t}: {d} {dp:?} {dt}");
-    let c = f.center(t);
-    let r = f.radius(t);
-    require!(!nan3(&c) && !r.is_nan(), NonFinite, "{f:?} center/radius at {t}: {c:?} {r}");
+    if t.abs() <= 1e7 {
+        // The plain getters are defined for times inside the scale policy.
+        let c = f.center(t);
+        let r = f.radius(t);
+        require!(fin3(&c) && r.is_finite(), NonFinite, "{f:?} center/radius at {t}: {c:?} {r}");
+    }
     let _ = f.segment_clear(&g.v3(), &g.v3(), t, g.size());
     if let Ok(b) = f.aabb_over(g.time(), g.time()) {
         require!(!nan3(&b.min) && !nan3(&b.max), NonFinite, "aabb_over of {f:?}: {b:?}");

@@ -10,8 +10,11 @@ use crate::Vec3;
 use crate::aabb::Aabb;
 use crate::error::{GeometryError, check_positive};
 
-/// Largest number of voxels a grid may have (200 million; about 1.6 GB of `f64`).
-pub const MAX_VOXELS: usize = 200_000_000;
+/// Largest number of voxels a grid may have: 2²⁴ ≈ 16.8 million (134 MB of `f64`; building the
+/// field takes about 40 ns per voxel on the 2-core development machine, so at most about 0.7 s — the
+/// scale policy's bound on one call, see [`crate::scale`]). A 50 × 20 × 10 m world at 0.1 m is
+/// 1 million voxels.
+pub const MAX_VOXELS: usize = 1 << 24;
 
 /// Reusable buffers for [`edt_1d_with_scratch`] (avoids allocating per line).
 #[derive(Debug, Clone, Default)]

@@ -329,7 +329,10 @@ impl StaticMap {
         if self.shapes.is_empty() {
             return true;
         }
-        let query = to_p_aabb(&Aabb::from_segment(a, b).inflated(clearance));
+        // Inflated by a few ulps too, so that a shape the segment touches within rounding is a
+        // candidate (the exact tests below are conservative at that scale).
+        let ulps = 8.0 * f64::EPSILON * (a.amax() + b.amax());
+        let query = to_p_aabb(&Aabb::from_segment(a, b).inflated(clearance + ulps));
         let mut candidates = self.bvh.intersect_aabb(&query);
         // Each shape sees only the part of the segment inside its box inflated by the clearance
         // (a closest pair closer than the clearance lies there): a long segment past a small

@@ -124,7 +124,8 @@ impl Forecast {
         Ok(())
     }
 
-    /// Obstacle centre at time `t`: `p0 + v0·(t − t0)` (also for `t < t0`).
+    /// Obstacle centre at time `t`: `p0 + v0·(t − t0)` (also for `t < t0`). Finite for every `t`
+    /// inside the scale policy (`|t| ≤ 1e7` s); a NaN `t` gives NaN (no time, no place).
     #[inline]
     pub fn center(&self, t: f64) -> Vec3 {
         self.p0 + self.v0 * (t - self.t0)

@@ -309,6 +309,12 @@ impl Pdc {
     /// tests); the start centre for `d = 0` or a non-finite `d`.
     #[inline]
     pub fn support(&self, d: &Vec3) -> Vec3 {
+        // Only the direction matters: rescale so that huge components cannot overflow the norm.
+        let m = d.amax();
+        if !(m.is_finite() && m > 0.0) {
+            return self.a;
+        }
+        let d = &(d / m);
         if !self.cylinder {
             let n = d.norm();
             if n.is_nan() || n <= 0.0 {
@@ -500,6 +506,9 @@ fn norm_affine_crossings(w: &Vec3, u: &Vec3, alpha: f64, beta: f64) -> impl Iter
 /// lateral surface, cap `b`).
 #[inline]
 pub fn round_cone_sdf(a: &Vec3, b: &Vec3, ra: f64, rb: f64, p: &Vec3) -> (f64, Vec3) {
+    if !trust_geometry::scale::queryable(&[a.x, a.y, a.z, b.x, b.y, b.z, ra, rb, p.x, p.y, p.z]) {
+        return (f64::NEG_INFINITY, Vec3::zeros());
+    }
     let ab = b - a;
     let len = ab.norm();
     // One ball contains the other (or the sweep is a point): a single sphere.
