@@ -152,7 +152,7 @@ impl TrajRequest<'_> {
             check_scaled("request.horizon_s", h, Quantity::PositiveDuration)?;
         }
         if let InitialGuess::Guide(path) = self.initial {
-            path.validate("request.initial.guide")?;
+            path.validate("request.initial")?;
         }
         if self.max_evaluations == Some(0) {
             return Err(PlanError::invalid(

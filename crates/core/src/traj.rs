@@ -304,10 +304,11 @@ impl PolyTraj {
     ) -> Result<(), PlanError> {
         check_positive("dt_s", dt)?;
         let ratio = (self.duration() / dt).floor();
-        // Saturating conversion (the ratio is finite and non-negative here, or +inf).
+        // Saturating conversion (the ratio is non-negative here, possibly +inf; 1e30 is far
+        // above the cap and leaves room for the + 1).
         let steps = scale::check_count(
             "samples (trajectory duration / dt_s)",
-            ratio.min(u128::MAX as f64) as u128 + 1,
+            ratio.min(1e30) as u128 + 1,
             scale::MAX_SAMPLE_COUNT,
         )? - 1;
         for k in 0..=steps {

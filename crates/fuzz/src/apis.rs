@@ -529,8 +529,12 @@ fn lbfgs_minimize(g: &mut Gen, _: &Fixtures) -> Outcome {
 // ---------------------------------------------------------------- minco
 
 fn minco_solve(g: &mut Gen, _: &Fixtures) -> Outcome {
-    let n = g.count(5).min(500);
+    let n = g.count(5);
+    // The constructor must reject huge counts itself (it allocates).
     let mut m = tri!(trust_minco::MincoS3::new(n));
+    if n > 500 {
+        return Outcome::Err;
+    }
     let head = [g.v3(), g.vel(), g.vel()];
     let tail = [g.v3(), g.vel(), g.vel()];
     let wps: Vec<Vector3<f64>> = (0..n.saturating_sub(1)).map(|_| g.v3()).collect();
@@ -573,16 +577,16 @@ fn minco_jerk_energy(g: &mut Gen, _: &Fixtures) -> Outcome {
     Outcome::Ok
 }
 
-fn request<'a>(g: &mut Gen, initial: InitialGuess<'a>) -> TrajRequest<'a> {
+fn request<'a>(g: &mut Gen, start_p: Vec3, goal: Vec3, initial: InitialGuess<'a>) -> TrajRequest<'a> {
     let start = State {
         t: g.time(),
-        p: g.v3(),
+        p: start_p,
         v: g.vel(),
         a: g.vel() * 0.1,
     };
     TrajRequest {
         start,
-        goal: g.v3(),
+        goal,
         limits: Limits {
             v_max: g.num(1.0, 10.0),
             a_max: g.num(1.0, 15.0),
@@ -597,15 +601,22 @@ fn request<'a>(g: &mut Gen, initial: InitialGuess<'a>) -> TrajRequest<'a> {
 fn minco_backends(g: &mut Gen, fx: &Fixtures) -> Outcome {
     let map = pick_map(g, fx);
     let scene = tri!(Scene::new(map, &fx.forecasts, 0.0));
-    let guide = GuidePath {
-        points: g.points(4),
-    };
+    let (s, e) = (g.in_box(map.bounds()), g.in_box(map.bounds()));
+    let mut points = vec![s];
+    for _ in 0..g.count(3).min(6) {
+        points.push(g.in_box(map.bounds()));
+    }
+    points.push(e);
+    if g.chance(0.1) {
+        points = g.points(4);
+    }
+    let guide = GuidePath { points };
     let warm = any_traj(g);
     let initial = match (&warm, g.chance(0.3)) {
         (Ok(t), true) => InitialGuess::WarmStart(t),
         _ => InitialGuess::Guide(&guide),
     };
-    let req = request(g, initial);
+    let req = request(g, s, e, initial);
     let sol = if g.chance(0.5) {
         tri!(trust_minco::UtfMinco::default().optimize(&req, &scene))
     } else {
@@ -627,8 +638,8 @@ fn topo_frontends(g: &mut Gen, fx: &Fixtures) -> Outcome {
     let map = pick_map(g, fx);
     let scene = tri!(Scene::new(map, &fx.forecasts, 0.0));
     let q = PathQuery {
-        start: State::at_rest(g.time(), g.v3()),
-        goal: g.v3(),
+        start: State::at_rest(g.time(), g.in_box(map.bounds())),
+        goal: g.in_box(map.bounds()),
         limits: Limits {
             v_max: g.num(1.0, 10.0),
             a_max: g.num(1.0, 15.0),
@@ -652,8 +663,20 @@ fn topo_frontends(g: &mut Gen, fx: &Fixtures) -> Outcome {
 fn topo_uvd(g: &mut Gen, fx: &Fixtures) -> Outcome {
     let map = pick_map(g, fx);
     let scene = tri!(Scene::new(map, &fx.forecasts, 0.0));
-    let a = GuidePath { points: g.points(5) };
-    let b = GuidePath { points: g.points(5) };
+    let (s, e) = (g.in_box(map.bounds()), g.in_box(map.bounds()));
+    let path = |g: &mut Gen| {
+        let mut points = vec![s];
+        for _ in 0..g.count(3).min(6) {
+            points.push(g.in_box(map.bounds()));
+        }
+        points.push(e);
+        if g.chance(0.1) {
+            points = g.points(4);
+        }
+        GuidePath { points }
+    };
+    let a = path(g);
+    let b = path(g);
     let uvd = if g.chance(0.5) {
         trust_topo_prm::Uvd::default()
     } else {
@@ -733,10 +756,200 @@ pub fn all() -> Vec<Api> {
         api!("minco::MincoS3", 50, minco_solve),
         api!("minco::eval_json", 20, minco_eval_json),
         api!("minco::jerk_energy", 50, minco_jerk_energy),
-        api!("minco::backends", 1, minco_backends),
-        api!("topo-prm::frontends", 1, topo_frontends),
+        api!("minco::backends", 5, minco_backends),
+        api!("topo-prm::frontends", 5, topo_frontends),
         api!("topo-prm::uvd", 10, topo_uvd),
         api!("topo-prm::tvd", 5, topo_tvd),
         api!("topo-prm::helpers", 50, topo_helpers),
+        api!("params::frontends", 3, params_frontends),
+        api!("params::checkers", 5, params_checkers),
+        api!("params::backends", 3, params_backends),
+        api!("params::ekf+lbfgs+scenes", 20, params_misc),
     ]
+}
+
+// ---------------------------------------------------------------- parameters (every params struct)
+
+/// Replaces one to three numbers in `params`' JSON form by adversarial ones (finite: JSON has no
+/// NaN), and deserializes it back; `None` when the result no longer deserializes.
+fn mutate<T: serde::Serialize + serde::de::DeserializeOwned>(g: &mut Gen, params: &T) -> Option<T> {
+    fn numbers(v: &serde_json::Value) -> usize {
+        match v {
+            serde_json::Value::Number(_) => 1,
+            serde_json::Value::Array(a) => a.iter().map(numbers).sum(),
+            serde_json::Value::Object(o) => o.values().map(numbers).sum(),
+            _ => 0,
+        }
+    }
+    let mut v = serde_json::to_value(params).ok()?;
+    // The k-th number in document order (the walk is repeated for each edit).
+    fn nth_number<'a>(v: &'a mut serde_json::Value, k: &mut usize) -> Option<&'a mut serde_json::Value> {
+        match v {
+            serde_json::Value::Number(_) => {
+                if *k == 0 {
+                    Some(v)
+                } else {
+                    *k -= 1;
+                    None
+                }
+            }
+            serde_json::Value::Array(a) => a.iter_mut().find_map(|x| nth_number(x, k)),
+            serde_json::Value::Object(o) => o.values_mut().find_map(|x| nth_number(x, k)),
+            _ => None,
+        }
+    }
+    let n = numbers(&v);
+    if n == 0 {
+        return serde_json::from_value(v).ok();
+    }
+    for _ in 0..1 + g.index(3) {
+        let mut k = g.index(n);
+        if let Some(slot) = nth_number(&mut v, &mut k) {
+            let is_int = slot.is_u64() || slot.is_i64();
+            *slot = if is_int {
+                let choices = [0u64, 1, 2, 1_000_000, u64::from(u32::MAX), u64::MAX];
+                serde_json::Value::from(choices[g.index(choices.len())])
+            } else {
+                let x = g.num(-10.0, 10.0);
+                if !x.is_finite() {
+                    serde_json::Value::from(if x > 0.0 { f64::MAX } else { f64::MIN })
+                } else {
+                    serde_json::Value::from(x)
+                }
+            };
+        }
+    }
+    serde_json::from_value(v).ok()
+}
+
+fn valid_query(g: &mut Gen, map: &StaticMap) -> PathQuery {
+    let b = map.bounds();
+    let p = |g: &mut Gen| {
+        let mut v = Vec3::zeros();
+        for i in 0..3 {
+            v[i] = b.min[i] + (b.max[i] - b.min[i]) * g.num(0.05, 0.95).clamp(0.0, 1.0);
+        }
+        v
+    };
+    PathQuery {
+        start: State::at_rest(0.0, p(g)),
+        goal: p(g),
+        limits: Limits::default(),
+        horizon_s: 3.0,
+    }
+}
+
+fn params_frontends(g: &mut Gen, fx: &Fixtures) -> Outcome {
+    let map = pick_map(g, fx);
+    let scene = tri!(Scene::new(map, &fx.forecasts, 0.0));
+    let q = valid_query(g, map);
+    let mut rng = <trust_core::Rng as rand::SeedableRng>::seed_from_u64(7);
+    let result = match g.index(3) {
+        0 => {
+            let Some(p) = mutate(g, &trust_topo_prm::DevPrmParams::default()) else {
+                return Outcome::Err;
+            };
+            tri!(tri!(trust_topo_prm::DevPrm::new(p)).search(&q, &scene, &mut rng))
+        }
+        1 => {
+            let Some(p) = mutate(g, &trust_topo_prm::VprmParams::default()) else {
+                return Outcome::Err;
+            };
+            tri!(tri!(trust_topo_prm::Vprm::new(p)).search(&q, &scene, &mut rng))
+        }
+        _ => {
+            let Some(p) = mutate(g, &trust_topo_prm::SparseAStarParams::default()) else {
+                return Outcome::Err;
+            };
+            tri!(tri!(trust_topo_prm::SparseAStar::new(p)).search(&q, &scene, &mut rng))
+        }
+    };
+    for p in &result.paths {
+        require!(p.points.iter().all(fin3), NonFinite, "path {p:?}");
+    }
+    Outcome::Ok
+}
+
+fn params_checkers(g: &mut Gen, fx: &Fixtures) -> Outcome {
+    let map = pick_map(g, fx);
+    let scene = tri!(Scene::new(map, &fx.forecasts, 0.0));
+    let q = valid_query(g, map);
+    let a = tri!(GuidePath::new(vec![q.start.p, q.goal]));
+    let b = tri!(GuidePath::new(vec![q.start.p, (q.start.p + q.goal) * 0.5 + Vec3::new(0.0, 3.0, 0.0), q.goal]));
+    if g.chance(0.5) {
+        let Some(p) = mutate(g, &trust_topo_prm::UvdParams::default()) else {
+            return Outcome::Err;
+        };
+        let _ = tri!(tri!(trust_topo_prm::Uvd::new(p)).equivalent(&a, &b, &scene));
+    } else {
+        let Some(p) = mutate(g, &trust_topo_prm::TvdParams::default()) else {
+            return Outcome::Err;
+        };
+        let ta = tri!(PolyTraj::hold(0.0, q.start.p, 2.0));
+        let tb = tri!(PolyTraj::hold(0.0, q.goal, 2.0));
+        let _ = tri!(tri!(trust_topo_prm::Tvd::new(p)).equivalent(&ta, &tb, &scene));
+    }
+    Outcome::Ok
+}
+
+fn params_backends(g: &mut Gen, fx: &Fixtures) -> Outcome {
+    let map = pick_map(g, fx);
+    let scene = tri!(Scene::new(map, &fx.forecasts, 0.0));
+    let q = valid_query(g, map);
+    let guide = tri!(GuidePath::new(vec![q.start.p, q.goal]));
+    let mut req = request(g, q.start.p, q.goal, InitialGuess::Guide(&guide));
+    req.start.v = Vec3::zeros();
+    req.start.a = Vec3::zeros();
+    let sol = if g.chance(0.5) {
+        let Some(p) = mutate(g, &trust_minco::UtfMincoParams::default()) else {
+            return Outcome::Err;
+        };
+        tri!(tri!(trust_minco::UtfMinco::new(p)).optimize(&req, &scene))
+    } else {
+        let Some(p) = mutate(g, &trust_minco::MincoParams::default()) else {
+            return Outcome::Err;
+        };
+        tri!(tri!(trust_minco::Minco::new(p)).optimize(&req, &scene))
+    };
+    let c = &sol.costs;
+    require!(
+        [c.ht, c.hs, c.io, c.id, c.ie, c.total].iter().all(|v| v.is_finite()),
+        NonFinite,
+        "costs {c:?}"
+    );
+    Outcome::Ok
+}
+
+fn params_misc(g: &mut Gen, _: &Fixtures) -> Outcome {
+    match g.index(3) {
+        0 => {
+            let Some(p) = mutate(g, &EkfParams::default()) else {
+                return Outcome::Err;
+            };
+            let mut ekf = tri!(CvEkf::new(0.0, Vec3::zeros(), p));
+            for k in 1..20 {
+                let _ = ekf.step(0.05 * f64::from(k), Some(Vec3::new(0.1 * f64::from(k), 0.0, 1.0)));
+            }
+            let f = tri!(ekf.forecast(ObstacleShape::Sphere, 0.5, 0.1));
+            let (d, dp, dt) = f.distance_and_gradients(&Vec3::zeros(), 1.0);
+            require!(!d.is_nan() && !nan3(&dp) && !dt.is_nan(), NonFinite, "{f:?}");
+        }
+        1 => {
+            let Some(p) = mutate(g, &trust_lbfgs::LbfgsParams::default()) else {
+                return Outcome::Err;
+            };
+            let mut x = vec![-1.2, 1.0, 0.5];
+            let r = tri!(trust_lbfgs::minimize(&mut x, trust_lbfgs::test_functions::rosenbrock, &p));
+            require!(r.cost.is_finite(), NonFinite, "cost {}", r.cost);
+        }
+        _ => {
+            let Some(p) = mutate(g, &trust_topo_prm::scenes::SceneParams::default()) else {
+                return Outcome::Err;
+            };
+            let mut rng = <trust_core::Rng as rand::SeedableRng>::seed_from_u64(3);
+            let k = g.count(5).min(64);
+            let _ = tri!(trust_topo_prm::scenes::random_dynamic_scene(k, &p, &mut rng));
+        }
+    }
+    Outcome::Ok
 }

@@ -111,6 +111,19 @@ impl Gen {
         Vec3::new(self.coord(), self.coord(), self.coord())
     }
 
+    /// A point inside `b` most of the time (adversarial otherwise).
+    pub fn in_box(&mut self, b: &trust_core::Aabb) -> Vec3 {
+        if self.chance(0.85) {
+            let mut p = Vec3::zeros();
+            for i in 0..3 {
+                p[i] = self.rng.random_range(b.min[i]..=b.max[i]);
+            }
+            p
+        } else {
+            self.v3()
+        }
+    }
+
     /// A velocity.
     pub fn vel(&mut self) -> Vec3 {
         Vec3::new(

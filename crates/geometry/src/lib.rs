@@ -26,7 +26,8 @@
 //!
 //! Signs and conventions: distances are negative inside obstacles; gradients are unit outward
 //! directions, defined (never NaN) at non-differentiable points as documented in [`shapes`]; a map
-//! with no obstacles reports `f64::INFINITY` with a zero gradient.
+//! with no obstacles reports `f64::INFINITY` with a zero gradient; a non-finite query point, or one
+//! beyond [`scale::QUERY_LIMIT`], reports `f64::NEG_INFINITY` ("not free") with a zero gradient.
 #![warn(missing_docs)]
 
 mod aabb;

@@ -200,6 +200,8 @@ impl StaticMap {
 
     /// Signed distance from `p` to the nearest obstacle and its gradient: the gradient of the
     /// nearest shape's SDF or of the ESDF interpolant, whichever is smaller (shapes win ties).
+    /// A non-finite `p` gives `(-inf, 0)` ("not free"); so does a point beyond
+    /// [`crate::scale::QUERY_LIMIT`] near a shape (the shapes' distance functions answer so).
     pub fn distance_and_gradient(&self, p: &Vec3) -> (f64, Vec3) {
         if !p.iter().all(|c| c.is_finite()) {
             return (f64::NEG_INFINITY, Vec3::zeros());

@@ -137,7 +137,7 @@ impl fmt::Display for Sci {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let v = self.0;
         let a = v.abs();
-        if !v.is_finite() || v == 0.0 || (1.0e-4..1.0e6).contains(&a) {
+        if !v.is_finite() || v == 0.0 || (1.0e-6..1.0e6).contains(&a) {
             return write!(f, "{v}");
         }
         let s = format!("{v:e}");

@@ -255,7 +255,7 @@ mod tests {
         let message = params.validate().unwrap_err().to_string();
         assert_eq!(
             message,
-            "invalid LbfgsParams: memory = 0, expected an integer >= 1"
+            "invalid LbfgsParams: memory = 0, expected an integer in [1, 1024] (MAX_MEMORY)"
         );
     }
 

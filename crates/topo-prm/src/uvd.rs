@@ -59,7 +59,7 @@ pub fn check_curves(a: &dyn Curve, b: &dyn Curve, resolution: f64) -> Result<usi
     let needed = (a.length().max(b.length()) / resolution).ceil() + 1.0;
     trust_core::scale::check_count(
         "uvd matched points (curve length / uvd.resolution)",
-        needed.min(u128::MAX as f64) as u128,
+        needed.min(1e30) as u128,
         MAX_POINTS,
     )?;
     Ok(point_count(a.length(), b.length(), resolution))
