@@ -70,6 +70,9 @@ impl Default for LbfgsParams {
 /// Largest accepted [`LbfgsParams::memory`]: the correction pairs are allocated up front.
 pub const MAX_MEMORY: usize = 1024;
 
+/// Largest accepted [`LbfgsParams::past`]: the past costs are allocated up front.
+pub const MAX_PAST: usize = 65_536;
+
 impl LbfgsParams {
     /// Checks every field's range; the error names the first offending field and its value.
     pub fn validate(&self) -> Result<(), LbfgsError> {
@@ -78,6 +81,13 @@ impl LbfgsParams {
                 "memory",
                 self.memory as f64,
                 "an integer in [1, 1024] (MAX_MEMORY)",
+            ));
+        }
+        if self.past > MAX_PAST {
+            return Err(invalid(
+                "past",
+                self.past as f64,
+                "an integer in [0, 65536] (MAX_PAST)",
             ));
         }
         if self.max_linesearch == 0 {

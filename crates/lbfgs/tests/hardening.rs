@@ -3,6 +3,16 @@
 use trust_lbfgs::{LbfgsParams, MAX_MEMORY, minimize};
 
 #[test]
+fn huge_past_is_an_error_not_an_allocation_failure() {
+    // Fuzz (params::ekf+lbfgs+scenes): `past = u64::MAX` aborted on allocation.
+    let params = LbfgsParams {
+        past: usize::MAX,
+        ..LbfgsParams::default()
+    };
+    assert!(params.validate().unwrap_err().to_string().contains("past"));
+}
+
+#[test]
 fn huge_memory_is_an_error_not_a_capacity_overflow_panic() {
     for memory in [usize::MAX, MAX_MEMORY + 1] {
         let params = LbfgsParams {

@@ -61,3 +61,13 @@ fn straight_end_with_huge_points_is_not_nan() {
     );
     assert!(end.iter().all(|c| !c.is_nan()));
 }
+
+#[test]
+fn sparse_astar_with_usize_max_turn_branches_is_rejected() {
+    // Fuzz (params::frontends): every expansion looped over `usize::MAX` headings.
+    let params = trust_topo_prm::SparseAStarParams {
+        turn_branches: usize::MAX,
+        ..trust_topo_prm::SparseAStarParams::default()
+    };
+    assert!(trust_topo_prm::SparseAStar::new(params).is_err());
+}
