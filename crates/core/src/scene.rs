@@ -4,8 +4,8 @@ use trust_geometry::StaticMap;
 use trust_predict::Forecast;
 
 use crate::error::{check_finite_vec, check_scaled};
-use trust_geometry::scale::Quantity;
 use crate::{PlanError, Vec3};
+use trust_geometry::scale::Quantity;
 
 /// The world as one planning call sees it: the static map plus forecasts of moving obstacles, all made
 /// at time `t0` (s). Cheap to build (it only borrows), so build one per planning cycle.

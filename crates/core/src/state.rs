@@ -3,8 +3,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{check_positive, check_scaled, check_scaled_vec};
-use trust_geometry::scale::Quantity;
 use crate::{PlanError, Vec3};
+use trust_geometry::scale::Quantity;
 
 /// Kinematic state of the vehicle at absolute time `t` (seconds): position, velocity, acceleration.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

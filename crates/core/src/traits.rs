@@ -9,8 +9,8 @@ use std::time::{Duration, Instant};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{check_positive, check_scaled, check_scaled_vec};
-use trust_geometry::scale::Quantity;
 use crate::{Curve, GuidePath, Limits, PlanError, PolyTraj, Rng, Scene, Solution, State, Vec3};
+use trust_geometry::scale::Quantity;
 
 /// A request for guide paths.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,7 +32,11 @@ impl PathQuery {
         check_scaled_vec("query.goal", &self.goal, Quantity::Position)?;
         self.limits.validate()?;
         check_positive("query.horizon_s", self.horizon_s)?;
-        check_scaled("query.horizon_s", self.horizon_s, Quantity::PositiveDuration)?;
+        check_scaled(
+            "query.horizon_s",
+            self.horizon_s,
+            Quantity::PositiveDuration,
+        )?;
         Ok(())
     }
 }

@@ -391,9 +391,9 @@ fn derivative_bound(piece: &Piece, duration: f64) -> f64 {
     let mut worst: f64 = 0.0;
     for r in 0..6 {
         let mut sum = 0.0;
-        for k in r..6 {
+        for (k, c) in piece.iter().enumerate().skip(r) {
             let falling: f64 = ((k - r + 1)..=k).map(|j| j as f64).product();
-            sum += falling * piece[k].amax() * duration.powi((k - r) as i32);
+            sum += falling * c.amax() * duration.powi((k - r) as i32);
         }
         if sum.is_nan() {
             return f64::INFINITY;

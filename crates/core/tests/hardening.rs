@@ -58,7 +58,12 @@ fn out_of_scale_inputs_name_the_field_in_scientific_notation() {
     let e = PolyTraj::hold(f64::MAX, Vec3::zeros(), 1.0).unwrap_err();
     assert!(e.to_string().contains("traj.t_start"), "{e}");
     let s = State::at_rest(0.0, Vec3::new(0.0, 0.0, -2e6));
-    assert!(s.validate("start").unwrap_err().to_string().contains("start.p.z"));
+    assert!(
+        s.validate("start")
+            .unwrap_err()
+            .to_string()
+            .contains("start.p.z")
+    );
 }
 
 #[test]

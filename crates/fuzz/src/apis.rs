@@ -7,7 +7,7 @@ use trust_core::{
     Curve, GuidePath, HomotopyChecker, InitialGuess, Limits, PathFrontend, PathQuery, PolyTraj,
     Scene, State, TrajRequest, TrajectoryBackend, Vec3,
 };
-use trust_geometry::{Aabb, AaBox, Cylinder, Esdf, Shape, Sphere, StaticMap};
+use trust_geometry::{AaBox, Aabb, Cylinder, Esdf, Shape, Sphere, StaticMap};
 use trust_predict::{CvEkf, EkfParams, Forecast, ObstacleShape, Pdc};
 
 use crate::inputs::Gen;
@@ -49,11 +49,22 @@ impl Fixtures {
         let mut cloud = Vec::new();
         for i in 0..200 {
             let a = f64::from(i) * 0.1;
-            cloud.push(Vec3::new(4.0 + a.cos(), -3.0 + a.sin(), 0.02 * f64::from(i)));
+            cloud.push(Vec3::new(
+                4.0 + a.cos(),
+                -3.0 + a.sin(),
+                0.02 * f64::from(i),
+            ));
         }
         let cloud_map = StaticMap::new(bounds)?.with_point_cloud(&cloud, 0.5)?;
         let forecasts = vec![
-            Forecast::sphere(Vec3::new(0.0, 5.0, 2.0), Vec3::new(1.0, -1.0, 0.0), 0.0, 0.6, 0.2, 0.3)?,
+            Forecast::sphere(
+                Vec3::new(0.0, 5.0, 2.0),
+                Vec3::new(1.0, -1.0, 0.0),
+                0.0,
+                0.6,
+                0.2,
+                0.3,
+            )?,
             Forecast::new(
                 ObstacleShape::Cylinder { half_height: 2.0 },
                 Vec3::new(-3.0, -5.0, 2.0),
@@ -125,7 +136,11 @@ fn any_shape(g: &mut Gen) -> Result<Shape, Outcome> {
         1 => res(Cylinder::new(g.v3(), g.size(), g.size()))?.into(),
         _ => {
             let (a, b) = (g.v3(), g.v3());
-            res(AaBox::new(a.inf(&b), if g.chance(0.1) { a } else { a.sup(&b) }))?.into()
+            res(AaBox::new(
+                a.inf(&b),
+                if g.chance(0.1) { a } else { a.sup(&b) },
+            ))?
+            .into()
         }
     })
 }
@@ -153,9 +168,15 @@ fn region(g: &mut Gen) -> Aabb {
     let (a, b) = (g.v3(), g.v3());
     if g.chance(0.1) {
         // Inverted on purpose (public fields allow it).
-        Aabb { min: a.sup(&b), max: a.inf(&b) }
+        Aabb {
+            min: a.sup(&b),
+            max: a.inf(&b),
+        }
     } else {
-        Aabb { min: a.inf(&b), max: a.sup(&b) }
+        Aabb {
+            min: a.inf(&b),
+            max: a.sup(&b),
+        }
     }
 }
 
@@ -165,13 +186,25 @@ fn geo_shapes(g: &mut Gen, _: &Fixtures) -> Outcome {
     let s = tri!(any_shape(g));
     let p = g.v3();
     let (d, grad) = s.distance_and_gradient(&p);
-    require!(!d.is_nan() && !nan3(&grad), NonFinite, "{s:?} at {p:?}: d {d}, grad {grad:?}");
+    require!(
+        !d.is_nan() && !nan3(&grad),
+        NonFinite,
+        "{s:?} at {p:?}: d {d}, grad {grad:?}"
+    );
     let b = s.aabb();
-    require!(!nan3(&b.min) && !nan3(&b.max), NonFinite, "aabb of {s:?}: {b:?}");
+    require!(
+        !nan3(&b.min) && !nan3(&b.max),
+        NonFinite,
+        "aabb of {s:?}: {b:?}"
+    );
     let r = g.size();
     let inflated = s.inflated(r);
     let d2 = inflated.signed_distance(&p);
-    require!(!d2.is_nan(), NonFinite, "{s:?} inflated by {r} at {p:?}: {d2}");
+    require!(
+        !d2.is_nan(),
+        NonFinite,
+        "{s:?} inflated by {r} at {p:?}: {d2}"
+    );
     Outcome::Ok
 }
 
@@ -185,7 +218,11 @@ fn geo_sdf_free_functions(g: &mut Gen, _: &Fixtures) -> Outcome {
     ];
     if c.iter().chain(p.iter()).all(|x| x.is_finite()) && r.is_finite() && h.is_finite() {
         for (d, grad) in outs {
-            require!(!d.is_nan() && !nan3(&grad), NonFinite, "c {c:?} p {p:?} r {r} h {h}: {d} {grad:?}");
+            require!(
+                !d.is_nan() && !nan3(&grad),
+                NonFinite,
+                "c {c:?} p {p:?} r {r} h {h}: {d} {grad:?}"
+            );
         }
     }
     Outcome::Ok
@@ -213,7 +250,11 @@ fn geo_map_build(g: &mut Gen, _: &Fixtures) -> Outcome {
     };
     let p = g.v3();
     let (d, grad) = map.distance_and_gradient(&p);
-    require!(!d.is_nan() && !nan3(&grad), NonFinite, "map distance at {p:?}: {d} {grad:?}");
+    require!(
+        !d.is_nan() && !nan3(&grad),
+        NonFinite,
+        "map distance at {p:?}: {d} {grad:?}"
+    );
     let _ = map.segment_clear(&g.v3(), &g.v3(), g.size());
     Outcome::Ok
 }
@@ -222,14 +263,22 @@ fn geo_map_queries(g: &mut Gen, fx: &Fixtures) -> Outcome {
     let map = pick_map(g, fx);
     let p = g.v3();
     let (d, grad) = map.distance_and_gradient(&p);
-    require!(!d.is_nan() && !nan3(&grad), NonFinite, "distance at {p:?}: {d} {grad:?}");
+    require!(
+        !d.is_nan() && !nan3(&grad),
+        NonFinite,
+        "distance at {p:?}: {d} {grad:?}"
+    );
     let _ = map.is_free(&p, g.size());
     let _ = map.nearest_shape(&p);
     let mut out = Vec::new();
     map.shapes_near(&region(g), &mut out);
     let idx: Vec<usize> = (0..g.count(6).min(64)).map(|_| g.index(10)).collect();
     let (d, grad) = map.distance_and_gradient_among(&p, &idx);
-    require!(!d.is_nan() && !nan3(&grad), NonFinite, "distance among at {p:?}: {d} {grad:?}");
+    require!(
+        !d.is_nan() && !nan3(&grad),
+        NonFinite,
+        "distance among at {p:?}: {d} {grad:?}"
+    );
     Outcome::Ok
 }
 
@@ -259,7 +308,11 @@ fn geo_segment_through_sphere(g: &mut Gen, _: &Fixtures) -> Outcome {
         return Outcome::Err;
     }
     let clear = map.segment_clear(&a, &b, 0.0);
-    require!(!clear, Wrong, "segment {a:?}..{b:?} through sphere {c:?} r {r} reported clear");
+    require!(
+        !clear,
+        Wrong,
+        "segment {a:?}..{b:?} through sphere {c:?} r {r} reported clear"
+    );
     Outcome::Ok
 }
 
@@ -287,7 +340,11 @@ fn geo_esdf(g: &mut Gen, _: &Fixtures) -> Outcome {
     let e = tri!(Esdf::from_occupancy(g.v3(), g.size(), dims, &occ));
     let p = g.v3();
     let (d, grad) = e.distance_and_gradient(&p);
-    require!(!d.is_nan() && !nan3(&grad), NonFinite, "esdf at {p:?}: {d} {grad:?}");
+    require!(
+        !d.is_nan() && !nan3(&grad),
+        NonFinite,
+        "esdf at {p:?}: {d} {grad:?}"
+    );
     let lb = e.lower_bound(&p);
     require!(!lb.is_nan(), NonFinite, "lower bound at {p:?}");
     Outcome::Ok
@@ -295,7 +352,9 @@ fn geo_esdf(g: &mut Gen, _: &Fixtures) -> Outcome {
 
 fn geo_edt(g: &mut Gen, _: &Fixtures) -> Outcome {
     let n = g.count(40).min(100_000);
-    let f: Vec<f64> = (0..n).map(|_| if g.chance(0.3) { 0.0 } else { f64::INFINITY }).collect();
+    let f: Vec<f64> = (0..n)
+        .map(|_| if g.chance(0.3) { 0.0 } else { f64::INFINITY })
+        .collect();
     let mut out = vec![0.0; n];
     trust_geometry::edt_1d(&f, &mut out);
     Outcome::Ok
@@ -307,16 +366,28 @@ fn pred_forecast(g: &mut Gen, _: &Fixtures) -> Outcome {
     let f = tri!(forecast(g));
     let (p, t) = (g.v3(), g.time());
     let (d, dp, dt) = f.distance_and_gradients(&p, t);
-    require!(!d.is_nan() && !nan3(&dp) && !dt.is_nan(), NonFinite, "{f:?} at {p:?}, t {t}: {d} {dp:?} {dt}");
+    require!(
+        !d.is_nan() && !nan3(&dp) && !dt.is_nan(),
+        NonFinite,
+        "{f:?} at {p:?}, t {t}: {d} {dp:?} {dt}"
+    );
     if t.abs() <= 1e7 {
         // The plain getters are defined for times inside the scale policy.
         let c = f.center(t);
         let r = f.radius(t);
-        require!(fin3(&c) && r.is_finite(), NonFinite, "{f:?} center/radius at {t}: {c:?} {r}");
+        require!(
+            fin3(&c) && r.is_finite(),
+            NonFinite,
+            "{f:?} center/radius at {t}: {c:?} {r}"
+        );
     }
     let _ = f.segment_clear(&g.v3(), &g.v3(), t, g.size());
     if let Ok(b) = f.aabb_over(g.time(), g.time()) {
-        require!(!nan3(&b.min) && !nan3(&b.max), NonFinite, "aabb_over of {f:?}: {b:?}");
+        require!(
+            !nan3(&b.min) && !nan3(&b.max),
+            NonFinite,
+            "aabb_over of {f:?}: {b:?}"
+        );
     }
     Outcome::Ok
 }
@@ -330,7 +401,11 @@ fn pred_pdc(g: &mut Gen, _: &Fixtures) -> Outcome {
     };
     let p = g.v3();
     let (d, grad) = pdc.distance_and_gradient(&p);
-    require!(!d.is_nan() && !nan3(&grad), NonFinite, "{pdc:?} at {p:?}: {d} {grad:?}");
+    require!(
+        !d.is_nan() && !nan3(&grad),
+        NonFinite,
+        "{pdc:?} at {p:?}: {d} {grad:?}"
+    );
     let _ = pdc.contains(&p);
     let _ = pdc.point_clear(&p, g.size());
     let _ = pdc.segment_clear(&g.v3(), &g.v3(), g.size());
@@ -366,7 +441,11 @@ fn pred_ekf(g: &mut Gen, _: &Fixtures) -> Outcome {
         let _ = ekf.step(t, z);
     }
     let p = ekf.position();
-    require!(!nan3(&p) && !ekf.uncertainty_rate().is_nan(), NonFinite, "ekf {ekf:?}");
+    require!(
+        !nan3(&p) && !ekf.uncertainty_rate().is_nan(),
+        NonFinite,
+        "ekf {ekf:?}"
+    );
     let _ = tri!(ekf.forecast(ObstacleShape::Sphere, g.size(), g.size()));
     Outcome::Ok
 }
@@ -376,11 +455,19 @@ fn pred_convex(g: &mut Gen, _: &Fixtures) -> Outcome {
     let (s, t) = trust_predict::convex::segment_segment_params(&a, &b, &c, &d);
     let all_finite = [a, b, c, d].iter().all(fin3);
     if all_finite {
-        require!(!s.is_nan() && !t.is_nan(), NonFinite, "segment_segment_params {a:?} {b:?} {c:?} {d:?}: {s} {t}");
+        require!(
+            !s.is_nan() && !t.is_nan(),
+            NonFinite,
+            "segment_segment_params {a:?} {b:?} {c:?} {d:?}: {s} {t}"
+        );
     }
     let (dist, grad) = trust_predict::round_cone_sdf(&a, &b, g.size(), g.size(), &c);
     if all_finite {
-        require!(!dist.is_nan() && !nan3(&grad), NonFinite, "round_cone_sdf {a:?} {b:?} at {c:?}: {dist} {grad:?}");
+        require!(
+            !dist.is_nan() && !nan3(&grad),
+            NonFinite,
+            "round_cone_sdf {a:?} {b:?} at {c:?}: {dist} {grad:?}"
+        );
     }
     Outcome::Ok
 }
@@ -407,16 +494,32 @@ fn core_polytraj(g: &mut Gen, _: &Fixtures) -> Outcome {
         Ok(t) => t,
         Err(o) => return o,
     };
-    let t = if g.chance(0.5) { g.time() } else { traj.t_start() + g.num(0.0, traj.duration()) };
+    let t = if g.chance(0.5) {
+        g.time()
+    } else {
+        traj.t_start() + g.num(0.0, traj.duration())
+    };
     let s = traj.state(t);
-    require!(fin3(&s.p) && fin3(&s.v) && fin3(&s.a) && !s.t.is_nan(), NonFinite, "state at {t}: {s:?}");
+    require!(
+        fin3(&s.p) && fin3(&s.v) && fin3(&s.a) && !s.t.is_nan(),
+        NonFinite,
+        "state at {t}: {s:?}"
+    );
     let j = traj.snap(t);
     require!(fin3(&j), NonFinite, "snap at {t}: {j:?}");
     if t.is_nan() {
-        require!(traj.checked_state(t).is_err(), Wrong, "checked_state(NaN) accepted");
+        require!(
+            traj.checked_state(t).is_err(),
+            Wrong,
+            "checked_state(NaN) accepted"
+        );
     }
     let (vm, am) = traj.max_speed_and_acceleration(g.count(8).min(1000));
-    require!(vm.is_finite() && am.is_finite(), NonFinite, "max speed/acc {vm} {am}");
+    require!(
+        vm.is_finite() && am.is_finite(),
+        NonFinite,
+        "max speed/acc {vm} {am}"
+    );
     let len = traj.arc_length(g.count(8).min(1000));
     require!(len.is_finite(), NonFinite, "arc length {len}");
     Outcome::Ok
@@ -521,7 +624,12 @@ fn lbfgs_minimize(g: &mut Gen, _: &Fixtures) -> Outcome {
         }
     };
     let report = tri!(trust_lbfgs::minimize(&mut x, f, &params));
-    require!(report.cost.is_finite() || kind == 2, NonFinite, "cost {}", report.cost);
+    require!(
+        report.cost.is_finite() || kind == 2,
+        NonFinite,
+        "cost {}",
+        report.cost
+    );
     require!(x.iter().all(|v| !v.is_nan()), NonFinite, "x {x:?}");
     Outcome::Ok
 }
@@ -559,12 +667,21 @@ fn minco_eval_json(g: &mut Gen, _: &Fixtures) -> Outcome {
     let durs: Vec<String> = (0..n).map(|_| format!("{:e}", g.num(0.1, 3.0))).collect();
     let input = format!(
         "{{\"head\": [{}, {}, {}], \"tail\": [{}, {}, {}], \"waypoints\": [{}], \"durations\": [{}]}}",
-        v(g), v(g), v(g), v(g), v(g), v(g),
+        v(g),
+        v(g),
+        v(g),
+        v(g),
+        v(g),
+        v(g),
         wps.join(","),
         durs.join(",")
     );
     let out = tri!(trust_minco::eval_json(&input));
-    require!(!out.contains("NaN") && !out.contains("null") && !out.contains("inf"), NonFinite, "output {out}");
+    require!(
+        !out.contains("NaN") && !out.contains("null") && !out.contains("inf"),
+        NonFinite,
+        "output {out}"
+    );
     Outcome::Ok
 }
 
@@ -577,7 +694,12 @@ fn minco_jerk_energy(g: &mut Gen, _: &Fixtures) -> Outcome {
     Outcome::Ok
 }
 
-fn request<'a>(g: &mut Gen, start_p: Vec3, goal: Vec3, initial: InitialGuess<'a>) -> TrajRequest<'a> {
+fn request<'a>(
+    g: &mut Gen,
+    start_p: Vec3,
+    goal: Vec3,
+    initial: InitialGuess<'a>,
+) -> TrajRequest<'a> {
     let start = State {
         t: g.time(),
         p: start_p,
@@ -593,7 +715,11 @@ fn request<'a>(g: &mut Gen, start_p: Vec3, goal: Vec3, initial: InitialGuess<'a>
         },
         initial,
         deadline: Some(std::time::Instant::now() + std::time::Duration::from_millis(300)),
-        horizon_s: if g.chance(0.5) { Some(g.num(0.5, 5.0)) } else { None },
+        horizon_s: if g.chance(0.5) {
+            Some(g.num(0.5, 5.0))
+        } else {
+            None
+        },
         max_evaluations: Some(g.count(60).clamp(1, 200)),
     }
 }
@@ -624,11 +750,17 @@ fn minco_backends(g: &mut Gen, fx: &Fixtures) -> Outcome {
     };
     let c = &sol.costs;
     require!(
-        [c.ht, c.hs, c.io, c.id, c.ie, c.total].iter().all(|v| v.is_finite()),
+        [c.ht, c.hs, c.io, c.id, c.ie, c.total]
+            .iter()
+            .all(|v| v.is_finite()),
         NonFinite,
         "costs {c:?}"
     );
-    require!(sol.traj.pieces().iter().all(|p| p.iter().all(fin3)), NonFinite, "trajectory");
+    require!(
+        sol.traj.pieces().iter().all(|p| p.iter().all(fin3)),
+        NonFinite,
+        "trajectory"
+    );
     Outcome::Ok
 }
 
@@ -702,8 +834,17 @@ fn topo_tvd(g: &mut Gen, fx: &Fixtures) -> Outcome {
         Ok(t) => t,
         Err(o) => return o,
     };
-    let _ = tri!(trust_topo_prm::tvd::equivalent(&a, &b, &scene, g.num(0.01, 0.5)));
-    let _ = tri!(trust_topo_prm::tvd::sample_times(g.time(), g.time(), g.num(0.01, 0.5)));
+    let _ = tri!(trust_topo_prm::tvd::equivalent(
+        &a,
+        &b,
+        &scene,
+        g.num(0.01, 0.5)
+    ));
+    let _ = tri!(trust_topo_prm::tvd::sample_times(
+        g.time(),
+        g.time(),
+        g.num(0.01, 0.5)
+    ));
     let _ = tri!(trust_topo_prm::Tvd::default().equivalent(&a, &b, &scene));
     Outcome::Ok
 }
@@ -713,13 +854,21 @@ fn topo_helpers(g: &mut Gen, _: &Fixtures) -> Outcome {
     let mut out = Vec::new();
     trust_topo_prm::shortcut::discretize(&pts, g.size(), &mut out);
     for p in &out {
-        require!(fin3(p) || !pts.iter().all(fin3), NonFinite, "discretize {pts:?}: {p:?}");
+        require!(
+            fin3(p) || !pts.iter().all(fin3),
+            NonFinite,
+            "discretize {pts:?}: {p:?}"
+        );
     }
     let n = trust_topo_prm::uvd::point_count(g.size(), g.size(), g.size());
     trust_topo_prm::uvd::resample_polyline(&pts, n.min(10_000), &mut out);
     let (s, gl) = (g.v3(), g.v3());
     let end = trust_topo_prm::straight::straight_end(&s, &gl, g.size());
-    require!(!nan3(&end) || !(fin3(&s) && fin3(&gl)), NonFinite, "straight_end {s:?} {gl:?}: {end:?}");
+    require!(
+        !nan3(&end) || !(fin3(&s) && fin3(&gl)),
+        NonFinite,
+        "straight_end {s:?} {gl:?}: {end:?}"
+    );
     let poly = trust_topo_prm::uvd::Polyline(&pts);
     let _ = poly.length();
     Outcome::Ok
@@ -729,7 +878,11 @@ fn topo_helpers(g: &mut Gen, _: &Fixtures) -> Outcome {
 pub fn all() -> Vec<Api> {
     macro_rules! api {
         ($name:literal, $w:expr, $f:expr) => {
-            Api { name: $name, weight: $w, run: $f }
+            Api {
+                name: $name,
+                weight: $w,
+                run: $f,
+            }
         };
     }
     vec![
@@ -739,7 +892,11 @@ pub fn all() -> Vec<Api> {
         api!("geometry::StaticMap::build", 20, geo_map_build),
         api!("geometry::StaticMap::queries", 100, geo_map_queries),
         api!("geometry::StaticMap::segment_clear", 100, geo_segment_clear),
-        api!("geometry::segment_through_sphere", 30, geo_segment_through_sphere),
+        api!(
+            "geometry::segment_through_sphere",
+            30,
+            geo_segment_through_sphere
+        ),
         api!("geometry::Esdf", 20, geo_esdf),
         api!("geometry::edt_1d", 50, geo_edt),
         api!("predict::Forecast", 100, pred_forecast),
@@ -783,7 +940,10 @@ fn mutate<T: serde::Serialize + serde::de::DeserializeOwned>(g: &mut Gen, params
     }
     let mut v = serde_json::to_value(params).ok()?;
     // The k-th number in document order (the walk is repeated for each edit).
-    fn nth_number<'a>(v: &'a mut serde_json::Value, k: &mut usize) -> Option<&'a mut serde_json::Value> {
+    fn nth_number<'a>(
+        v: &'a mut serde_json::Value,
+        k: &mut usize,
+    ) -> Option<&'a mut serde_json::Value> {
         match v {
             serde_json::Value::Number(_) => {
                 if *k == 0 {
@@ -875,7 +1035,11 @@ fn params_checkers(g: &mut Gen, fx: &Fixtures) -> Outcome {
     let scene = tri!(Scene::new(map, &fx.forecasts, 0.0));
     let q = valid_query(g, map);
     let a = tri!(GuidePath::new(vec![q.start.p, q.goal]));
-    let b = tri!(GuidePath::new(vec![q.start.p, (q.start.p + q.goal) * 0.5 + Vec3::new(0.0, 3.0, 0.0), q.goal]));
+    let b = tri!(GuidePath::new(vec![
+        q.start.p,
+        (q.start.p + q.goal) * 0.5 + Vec3::new(0.0, 3.0, 0.0),
+        q.goal
+    ]));
     if g.chance(0.5) {
         let Some(p) = mutate(g, &trust_topo_prm::UvdParams::default()) else {
             return Outcome::Err;
@@ -913,7 +1077,9 @@ fn params_backends(g: &mut Gen, fx: &Fixtures) -> Outcome {
     };
     let c = &sol.costs;
     require!(
-        [c.ht, c.hs, c.io, c.id, c.ie, c.total].iter().all(|v| v.is_finite()),
+        [c.ht, c.hs, c.io, c.id, c.ie, c.total]
+            .iter()
+            .all(|v| v.is_finite()),
         NonFinite,
         "costs {c:?}"
     );
@@ -928,18 +1094,29 @@ fn params_misc(g: &mut Gen, _: &Fixtures) -> Outcome {
             };
             let mut ekf = tri!(CvEkf::new(0.0, Vec3::zeros(), p));
             for k in 1..20 {
-                let _ = ekf.step(0.05 * f64::from(k), Some(Vec3::new(0.1 * f64::from(k), 0.0, 1.0)));
+                let _ = ekf.step(
+                    0.05 * f64::from(k),
+                    Some(Vec3::new(0.1 * f64::from(k), 0.0, 1.0)),
+                );
             }
             let f = tri!(ekf.forecast(ObstacleShape::Sphere, 0.5, 0.1));
             let (d, dp, dt) = f.distance_and_gradients(&Vec3::zeros(), 1.0);
-            require!(!d.is_nan() && !nan3(&dp) && !dt.is_nan(), NonFinite, "{f:?}");
+            require!(
+                !d.is_nan() && !nan3(&dp) && !dt.is_nan(),
+                NonFinite,
+                "{f:?}"
+            );
         }
         1 => {
             let Some(p) = mutate(g, &trust_lbfgs::LbfgsParams::default()) else {
                 return Outcome::Err;
             };
             let mut x = vec![-1.2, 1.0, 0.5];
-            let r = tri!(trust_lbfgs::minimize(&mut x, trust_lbfgs::test_functions::rosenbrock, &p));
+            let r = tri!(trust_lbfgs::minimize(
+                &mut x,
+                trust_lbfgs::test_functions::rosenbrock,
+                &p
+            ));
             require!(r.cost.is_finite(), NonFinite, "cost {}", r.cost);
         }
         _ => {
@@ -948,7 +1125,9 @@ fn params_misc(g: &mut Gen, _: &Fixtures) -> Outcome {
             };
             let mut rng = <trust_core::Rng as rand::SeedableRng>::seed_from_u64(3);
             let k = g.count(5).min(64);
-            let _ = tri!(trust_topo_prm::scenes::random_dynamic_scene(k, &p, &mut rng));
+            let _ = tri!(trust_topo_prm::scenes::random_dynamic_scene(
+                k, &p, &mut rng
+            ));
         }
     }
     Outcome::Ok

@@ -102,7 +102,11 @@ fn main() -> Result<()> {
     let fx = Fixtures::new()?;
     let apis: Vec<Api> = apis::all()
         .into_iter()
-        .filter(|a| args.only.as_ref().is_none_or(|o| a.name.contains(o.as_str())))
+        .filter(|a| {
+            args.only
+                .as_ref()
+                .is_none_or(|o| a.name.contains(o.as_str()))
+        })
         .collect();
     anyhow::ensure!(!apis.is_empty(), "no API matches --only");
 

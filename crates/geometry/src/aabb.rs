@@ -128,7 +128,15 @@ impl Aabb {
                 return None;
             }
         }
-        let at = |t: f64| if t <= 0.0 { *a } else if t >= 1.0 { *b } else { a + d * t };
+        let at = |t: f64| {
+            if t <= 0.0 {
+                *a
+            } else if t >= 1.0 {
+                *b
+            } else {
+                a + d * t
+            }
+        };
         Some((at(lo), at(hi)))
     }
 

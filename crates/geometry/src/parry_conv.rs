@@ -39,7 +39,11 @@ pub(crate) fn segment_shape_distance(shape: &Shape, a: &Vec3, b: &Vec3) -> f64 {
             // below that is reported as contact (conservative), so that a tiny sphere on a long
             // segment is never missed.
             let ulps = 8.0 * f64::EPSILON * (a.amax() + b.amax() + s.center.amax() + s.radius);
-            return if gap.is_nan() || gap <= ulps { 0.0 } else { gap };
+            return if gap.is_nan() || gap <= ulps {
+                0.0
+            } else {
+                gap
+            };
         }
         Shape::Cylinder(c) => {
             let swap = |p: &Vec3| {
@@ -47,13 +51,18 @@ pub(crate) fn segment_shape_distance(shape: &Shape, a: &Vec3, b: &Vec3) -> f64 {
                 PVec::new(q.x, q.z, q.y)
             };
             let seg = Segment::new(swap(a), swap(b));
-            query::distance(&id, &seg, &id, &PCylinder::new(c.half_height, c.radius))
+            query::distance(
+                &id,
+                &seg,
+                &id,
+                &PCylinder::new(c.half_height.abs(), c.radius.abs()),
+            )
         }
         Shape::AaBox(bx) => {
             let center = 0.5 * (bx.min + bx.max);
             let half = 0.5 * (bx.max - bx.min);
             let seg = Segment::new(to_p(&(a - center)), to_p(&(b - center)));
-            query::distance(&id, &seg, &id, &Cuboid::new(to_p(&half)))
+            query::distance(&id, &seg, &id, &Cuboid::new(to_p(&half.abs())))
         }
     };
     // Segment against ball/cylinder/cuboid is always supported by the default dispatcher; if it

@@ -284,7 +284,11 @@ impl Sphere {
     pub fn new(center: Vec3, radius: f64) -> Result<Self, GeometryError> {
         check_vec("sphere.center", &center)?;
         check_non_negative("sphere.radius", radius)?;
-        Ok(Self { center, radius })
+        // `abs` turns an accepted `-0.0` into `+0.0` (parry asserts positive signs).
+        Ok(Self {
+            center,
+            radius: radius.abs(),
+        })
     }
 
     /// Exact signed distance from `p` (negative inside).
@@ -323,10 +327,11 @@ impl Cylinder {
         check_vec("cylinder.center", &center)?;
         check_non_negative("cylinder.radius", radius)?;
         check_non_negative("cylinder.half_height", half_height)?;
+        // `abs` turns an accepted `-0.0` into `+0.0` (parry asserts positive signs).
         Ok(Self {
             center,
-            radius,
-            half_height,
+            radius: radius.abs(),
+            half_height: half_height.abs(),
         })
     }
 

@@ -21,7 +21,11 @@ fn esdf_segment_clear_whose_length_overflows_returns_not_clear() {
     // Issue 11: the step count became infinite and the tracer never returned.
     let map = cloud_map();
     assert!(!map.segment_clear(&Vec3::zeros(), &Vec3::new(1e155, 0.0, 0.0), 0.0));
-    assert!(!map.segment_clear(&Vec3::new(-1e300, 0.0, 0.0), &Vec3::new(1e300, 0.0, 0.0), 0.1));
+    assert!(!map.segment_clear(
+        &Vec3::new(-1e300, 0.0, 0.0),
+        &Vec3::new(1e300, 0.0, 0.0),
+        0.1
+    ));
 }
 
 #[test]
@@ -98,6 +102,25 @@ fn out_of_scale_errors_name_field_value_and_range() {
     let e = Sphere::new(Vec3::zeros(), 2e6).unwrap_err();
     assert!(e.to_string().contains("sphere.radius"), "{e}");
     assert!(scale::Quantity::Length.accepts(1e6));
+}
+
+#[test]
+fn negative_zero_sizes_do_not_trip_parry_assertions() {
+    // Fuzz case 4898001090487889764: a cylinder with half_height -0.0 passed validation, then
+    // parry asserted `half_height.is_sign_positive()` in `segment_clear`.
+    let bounds = Aabb::new(Vec3::repeat(-10.0), Vec3::repeat(10.0)).unwrap();
+    let shapes: Vec<Shape> = vec![
+        trust_geometry::Cylinder::new(Vec3::zeros(), -0.0, -0.0)
+            .unwrap()
+            .into(),
+        Sphere::new(Vec3::new(1.0, 0.0, 0.0), -0.0).unwrap().into(),
+        trust_geometry::AaBox::new(Vec3::new(2.0, 0.0, 0.0), Vec3::new(2.0, 0.0, 0.0))
+            .unwrap()
+            .into(),
+    ];
+    let map = StaticMap::from_shapes(bounds, shapes).unwrap();
+    assert!(!map.segment_clear(&Vec3::new(-5.0, 0.0, 0.0), &Vec3::new(5.0, 0.0, 0.0), 0.0));
+    assert!(map.segment_clear(&Vec3::new(-5.0, 5.0, 0.0), &Vec3::new(5.0, 5.0, 0.0), 0.0));
 }
 
 #[test]

@@ -22,10 +22,16 @@ fn huge_memory_is_an_error_not_a_capacity_overflow_panic() {
         let e = params.validate().unwrap_err();
         assert!(e.to_string().contains("memory"), "{e}");
         let mut x = [1.0, 2.0];
-        assert!(minimize(&mut x, |x, g| {
-            g.copy_from_slice(x);
-            0.5 * (x[0] * x[0] + x[1] * x[1])
-        }, &params)
-        .is_err());
+        assert!(
+            minimize(
+                &mut x,
+                |x, g| {
+                    g.copy_from_slice(x);
+                    0.5 * (x[0] * x[0] + x[1] * x[1])
+                },
+                &params
+            )
+            .is_err()
+        );
     }
 }

@@ -48,7 +48,10 @@ fn check_gradient(
                 break;
             }
         }
-        prop_assert!(agrees, "entry {i}: finite difference {last} vs analytic {an}");
+        prop_assert!(
+            agrees,
+            "entry {i}: finite difference {last} vs analytic {an}"
+        );
     }
     Ok(())
 }

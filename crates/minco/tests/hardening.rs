@@ -17,7 +17,11 @@ fn jerk_energy_overflow_is_an_error_naming_the_piece() {
 
 #[test]
 fn huge_piece_count_is_an_error_before_allocating() {
-    for n in [usize::MAX, usize::MAX / 6 + 1, trust_minco::minco::MAX_PIECES + 1] {
+    for n in [
+        usize::MAX,
+        usize::MAX / 6 + 1,
+        trust_minco::minco::MAX_PIECES + 1,
+    ] {
         assert!(
             matches!(MincoS3::new(n), Err(MincoError::TooManyPieces { .. })),
             "{n}"
@@ -42,7 +46,8 @@ fn tiny_speed_limit_names_the_limit_not_an_infinite_cost() {
         Aabb, GuidePath, InitialGuess, Limits, Scene, State, StaticMap, TrajRequest,
         TrajectoryBackend, Vec3,
     };
-    let map = StaticMap::new(Aabb::new(Vec3::repeat(-100.0), Vec3::repeat(100.0)).unwrap()).unwrap();
+    let map =
+        StaticMap::new(Aabb::new(Vec3::repeat(-100.0), Vec3::repeat(100.0)).unwrap()).unwrap();
     let scene = Scene::new(&map, &[], 0.0).unwrap();
     let guide = GuidePath::new(vec![Vec3::zeros(), Vec3::new(50.0, 0.0, 0.0)]).unwrap();
     for (v_max, a_max) in [(1e-300, 1.0), (1e-9, 1e-9), (1e-6, 1.0)] {

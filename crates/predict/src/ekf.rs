@@ -27,8 +27,8 @@ use serde::{Deserialize, Serialize};
 use trust_geometry::Vec3;
 
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec};
-use trust_geometry::scale::{self, Quantity};
 use crate::{Forecast, ObstacleShape, PredictError};
+use trust_geometry::scale::{self, Quantity};
 
 /// Parameters of [`CvEkf`] and of the growth rate it reports.
 ///
@@ -93,7 +93,11 @@ impl EkfParams {
     pub fn validate(&self) -> Result<(), PredictError> {
         check_positive("ekf.meas_std", self.meas_std, Quantity::PositiveLength)?;
         check_non_negative("ekf.accel_psd", self.accel_psd, Quantity::Length)?;
-        check_positive("ekf.init_vel_std", self.init_vel_std, Quantity::PositiveSpeed)?;
+        check_positive(
+            "ekf.init_vel_std",
+            self.init_vel_std,
+            Quantity::PositiveSpeed,
+        )?;
         check_non_negative("ekf.sigma_scale", self.sigma_scale, Quantity::Length)?;
         check_non_negative("ekf.mu_min", self.mu_min, Quantity::Rate)?;
         Ok(())

@@ -123,11 +123,7 @@ pub(crate) fn check_positive(field: &str, value: f64, q: Quantity) -> Result<(),
 }
 
 /// Finite and `>= 0`, then within the range of `q`.
-pub(crate) fn check_non_negative(
-    field: &str,
-    value: f64,
-    q: Quantity,
-) -> Result<(), PredictError> {
+pub(crate) fn check_non_negative(field: &str, value: f64, q: Quantity) -> Result<(), PredictError> {
     if !value.is_finite() {
         return check_finite(field, value, q);
     }

@@ -5,8 +5,8 @@ use serde::{Deserialize, Serialize};
 use trust_geometry::{Aabb, Vec3, cylinder_sdf_with_size_gradient, sphere_sdf};
 
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec};
-use trust_geometry::scale::Quantity;
 use crate::{Pdc, PredictError};
+use trust_geometry::scale::Quantity;
 
 /// Base shape of a moving obstacle.
 ///

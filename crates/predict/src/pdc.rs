@@ -54,8 +54,8 @@ use crate::convex::{
     min_over_convex_polygon, segment_segment_distance,
 };
 use crate::error::{check_finite, check_non_negative};
-use trust_geometry::scale::Quantity;
 use crate::{Forecast, ObstacleShape, PredictError};
+use trust_geometry::scale::Quantity;
 
 mod samples;
 

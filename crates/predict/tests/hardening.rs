@@ -9,8 +9,15 @@ use trust_predict::{
 #[test]
 fn forecast_accepting_1e300_speed_is_now_a_scale_error() {
     // Issue 11: magnitudes like 1e300 or f64::MAX were accepted, then gave NaN gradients.
-    let e = Forecast::sphere(Vec3::zeros(), Vec3::new(1e300, 0.0, 0.0), 0.0, 1.0, 0.0, 0.0)
-        .unwrap_err();
+    let e = Forecast::sphere(
+        Vec3::zeros(),
+        Vec3::new(1e300, 0.0, 0.0),
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+    )
+    .unwrap_err();
     assert!(matches!(e, PredictError::Scale(_)), "{e:?}");
     assert!(e.to_string().contains("forecast.v0.x"), "{e}");
     assert!(e.to_string().contains("1.0e300"), "{e}");
@@ -42,13 +49,24 @@ fn million_sample_cone_surface_is_a_count_error() {
     };
     let e = pdc.surface_samples(1000, 1000, 0.1, &region).unwrap_err();
     assert!(matches!(e, PredictError::Count(_)), "{e:?}");
-    assert!(pdc.surface_samples(usize::MAX, usize::MAX, 0.1, &region).is_err());
+    assert!(
+        pdc.surface_samples(usize::MAX, usize::MAX, 0.1, &region)
+            .is_err()
+    );
 }
 
 #[test]
 fn pdc_support_with_huge_direction_is_finite() {
     // Fuzz case 16281829902901881008: a direction with a 1e300 component gave NaN.
-    let f = Forecast::sphere(Vec3::zeros(), Vec3::new(4.2, 2.9, -0.5), 0.0, 1.9, 2.0, 0.13).unwrap();
+    let f = Forecast::sphere(
+        Vec3::zeros(),
+        Vec3::new(4.2, 2.9, -0.5),
+        0.0,
+        1.9,
+        2.0,
+        0.13,
+    )
+    .unwrap();
     let pdc = Pdc::new(&f, 0.2).unwrap();
     for d in [
         Vec3::new(1e300, -1e300, 0.5),

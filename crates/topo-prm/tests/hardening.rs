@@ -26,7 +26,11 @@ fn uvd_with_a_vertex_1e8_m_away_answers_at_once() {
     let map = map();
     let scene = Scene::new(&map, &[], 0.0).unwrap();
     let far = GuidePath {
-        points: vec![Vec3::zeros(), Vec3::new(1e8, 0.0, 0.0), Vec3::new(5.0, 0.0, 0.0)],
+        points: vec![
+            Vec3::zeros(),
+            Vec3::new(1e8, 0.0, 0.0),
+            Vec3::new(5.0, 0.0, 0.0),
+        ],
     };
     let near = GuidePath::new(vec![Vec3::zeros(), Vec3::new(5.0, 0.0, 0.0)]).unwrap();
     let e = Uvd::default().equivalent(&far, &near, &scene).unwrap_err();
@@ -44,7 +48,10 @@ fn discretize_output_is_capped_and_finite() {
     assert!(out.len() <= trust_core::scale::MAX_SAMPLE_COUNT + 3);
     // Fuzz case 10103411442046952351: finite vertices whose difference overflows.
     shortcut::discretize(
-        &[Vec3::new(1e300, 0.0, -1e155), Vec3::new(-f64::MAX, 0.0, 0.0)],
+        &[
+            Vec3::new(1e300, 0.0, -1e155),
+            Vec3::new(-f64::MAX, 0.0, 0.0),
+        ],
         0.5,
         &mut out,
     );

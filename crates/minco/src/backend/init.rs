@@ -26,7 +26,11 @@ impl InitialTrajectory {
     ///
     /// # Errors
     /// [`PlanError::InvalidInput`] naming `limits.v_max` / `limits.a_max` and the guide length.
-    pub fn check_duration(&self, guess: &InitialGuess<'_>, limits: &Limits) -> Result<(), PlanError> {
+    pub fn check_duration(
+        &self,
+        guess: &InitialGuess<'_>,
+        limits: &Limits,
+    ) -> Result<(), PlanError> {
         let t = self.total_duration;
         if t.is_finite() && t <= trust_core::scale::MAX_TIME_S {
             return Ok(());

@@ -64,7 +64,10 @@ impl PieceParams {
             return Err(PlanError::invalid(
                 format!("{prefix}.max_pieces"),
                 self.max_pieces,
-                format!("an integer <= {} (minco::MAX_PIECES)", crate::minco::MAX_PIECES),
+                format!(
+                    "an integer <= {} (minco::MAX_PIECES)",
+                    crate::minco::MAX_PIECES
+                ),
             ));
         }
         if self.max_pieces < self.min_pieces {
