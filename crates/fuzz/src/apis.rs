@@ -297,7 +297,7 @@ fn geo_segment_through_sphere(g: &mut Gen, _: &Fixtures) -> Outcome {
     let len = 10f64.powf(g.num(-2.0, 6.5));
     // Below the rounding of the segment's own coordinates the represented segment may truly miss
     // the sphere: no oracle there.
-    if !(r > 1e-9 * (c.amax() + len)) {
+    if r.is_nan() || r <= 1e-9 * (c.amax() + len) {
         return Outcome::Err;
     }
     let bounds = tri!(Aabb::new(Vec3::repeat(-1e6), Vec3::repeat(1e6)));
@@ -865,7 +865,7 @@ fn topo_helpers(g: &mut Gen, _: &Fixtures) -> Outcome {
     let (s, gl) = (g.v3(), g.v3());
     let end = trust_topo_prm::straight::straight_end(&s, &gl, g.size());
     require!(
-        !nan3(&end) || !(fin3(&s) && fin3(&gl)),
+        !(nan3(&end) && fin3(&s) && fin3(&gl)),
         NonFinite,
         "straight_end {s:?} {gl:?}: {end:?}"
     );

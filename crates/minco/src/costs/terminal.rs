@@ -171,8 +171,11 @@ mod tests {
 
     #[test]
     fn guidance_surface_gradient_matches_finite_differences() {
-        let mut params = PenaltyParams::default();
-        params.goal_radius_m = 100.0; // α > 0: the velocity part is active too
+        // α > 0: the velocity part is active too.
+        let params = PenaltyParams {
+            goal_radius_m: 100.0,
+            ..PenaltyParams::default()
+        };
         let goal = Vec3::new(12.0, -3.0, 2.0);
         let cost =
             TerminalCost::new(goal, &Vec3::new(1.0, 0.0, 0.0), &params).with_guidance_surface(10.0);
