@@ -28,7 +28,9 @@ pub fn run(root: &Path, cases: u64, seed: u64, only: Option<&str>) -> Result<()>
     if let Some(only) = only {
         cmd.args(["--only", only]);
     }
-    let status = cmd.status().context("failed to start cargo for trust-fuzz")?;
+    let status = cmd
+        .status()
+        .context("failed to start cargo for trust-fuzz")?;
     if !status.success() {
         bail!("trust-fuzz reported failures ({status}); see the table above");
     }
