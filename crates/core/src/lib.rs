@@ -59,7 +59,7 @@ pub use traits::{
     HomotopyChecker, InitialGuess, PathFrontend, PathQuery, SearchResult, SearchStats, TrajRequest,
     TrajectoryBackend,
 };
-pub use traj::{Derivative, Piece, PolyTraj, eval_piece};
+pub use traj::{Derivative, MAX_DERIVATIVE_BOUND, Piece, PolyTraj, eval_piece};
 
 pub use trust_geometry::{Aabb, StaticMap, Vec3, scale};
 pub use trust_predict::{Forecast, ObstacleShape};
