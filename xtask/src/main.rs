@@ -13,6 +13,9 @@
 //! - `experiment e4` / `ablate [ARGS]`: paper Fig. baseline-test-3, baselines 1–3 vs
 //!   TRUST-Planner in closed loop (`trust-sim ablate`, see its `--help`); `ablate merge DIR...`
 //!   combines the shards of a study.
+//! - `fuzz [--cases N] [--seed S] [--only API]`: adversarial inputs against every public entry
+//!   point of the library crates (`trust-fuzz`, release build); fails on any panic, hang,
+//!   non-finite output, wrong answer or call over 1 s.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -21,6 +24,8 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use serde_json::Value;
+
+mod fuzz;
 
 #[derive(Parser)]
 #[command(
@@ -58,6 +63,19 @@ enum Cmd {
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
+    },
+    /// Throw random, adversarial and boundary inputs at every public API (release build of
+    /// `trust-fuzz`); fails on any panic, hang, non-finite output, wrong answer or slow call.
+    Fuzz {
+        /// Total number of calls.
+        #[arg(long, default_value_t = 1_000_000)]
+        cases: u64,
+        /// Seed of the run.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Only the APIs whose name contains this.
+        #[arg(long)]
+        only: Option<String>,
     },
 }
 
@@ -133,6 +151,7 @@ fn main() -> Result<()> {
             }
             trust_sim(&root, &full)
         }
+        Cmd::Fuzz { cases, seed, only } => fuzz::run(&root, cases, seed, only.as_deref()),
     }
 }
 

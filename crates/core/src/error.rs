@@ -3,7 +3,23 @@
 //! `Err` is for misuse and invalid input (style rule 6). A planner that runs but does not find a good
 //! answer returns a value with a status instead (see [`crate::SolveStatus`]).
 
+use trust_geometry::scale::{self, CountError, Quantity, ScaleError, Sci};
+
 use crate::Vec3;
+
+/// Three decimals for ordinary magnitudes, scientific notation for huge or tiny ones.
+struct Sci3(f64);
+
+impl std::fmt::Display for Sci3 {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if self.0.is_finite() && (a == 0.0 || (1e-3..1e6).contains(&a)) {
+            write!(f, "{:.3}", self.0)
+        } else {
+            write!(f, "{}", Sci(self.0))
+        }
+    }
+}
 
 /// Why a planning call was rejected.
 ///
@@ -24,7 +40,9 @@ pub enum PlanError {
     },
     /// A point that must lie in free space lies inside (or too close to) an obstacle.
     #[error(
-        "`{field}` at {point:?} is in collision (clearance {clearance:.3} m, needed {needed:.3} m)"
+        "`{field}` at {point:?} is in collision (clearance {} m, needed {} m)",
+        Sci3(*.clearance),
+        Sci3(*.needed)
     )]
     InCollision {
         /// Which point (`start`, `goal`, ...).
@@ -63,6 +81,13 @@ pub enum PlanError {
     /// Invalid obstacle forecast.
     #[error(transparent)]
     Predict(#[from] trust_predict::PredictError),
+    /// A number outside the scale policy (`trust_geometry::scale`, re-exported as
+    /// [`crate::scale`]).
+    #[error(transparent)]
+    Scale(#[from] ScaleError),
+    /// A count above its cap ([`crate::scale`]).
+    #[error(transparent)]
+    Count(#[from] CountError),
     /// An error reported by a concrete component (optimizer, frontend, ...), kept with its source.
     #[error("{component}: {source}")]
     Component {
@@ -114,6 +139,22 @@ pub fn check_non_negative(field: &str, x: f64) -> Result<(), PlanError> {
     } else {
         Err(PlanError::invalid(field, x, "a finite number >= 0"))
     }
+}
+
+/// Checks that `x` is finite and inside the scale policy's range for `quantity`
+/// ([`crate::scale`]).
+pub fn check_scaled(field: &str, x: f64, quantity: Quantity) -> Result<(), PlanError> {
+    check_finite(field, x)?;
+    scale::check(field, x, quantity)?;
+    Ok(())
+}
+
+/// Checks that every component of `v` is finite and inside the scale policy's range for
+/// `quantity` ([`crate::scale`]).
+pub fn check_scaled_vec(field: &str, v: &Vec3, quantity: Quantity) -> Result<(), PlanError> {
+    check_finite_vec(field, v)?;
+    scale::check_vec(field, v, quantity)?;
+    Ok(())
 }
 
 /// Checks that every component of `v` is finite.

@@ -18,6 +18,16 @@
 //! yourself. It depends only on `trust-geometry` and `trust-predict`; implementations depend on it,
 //! never the reverse.
 //!
+//! # Scale policy
+//!
+//! Every public entry point of the planner accepts only the magnitudes of [`scale`] (defined in
+//! `trust-geometry`, re-exported here): positions `|x| ≤ 1e6` m, lengths and sizes `≤ 1e6` m,
+//! speeds `≤ 1e4` m/s, accelerations `≤ 1e5` m/s², times and durations `≤ 1e7` s, strictly
+//! positive limits, durations and steps `≥ 1e-9`, generated samples `≤ 1e6` per call. Inside these
+//! ranges every computation stays finite; outside them the call returns [`PlanError::Scale`] (or
+//! [`PlanError::Count`]) naming the field, the value in scientific notation and the accepted
+//! range. Points outside the map bounds give [`PlanError::OutOfBounds`].
+//!
 //! ```
 //! use trust_core::{PolyTraj, Vec3};
 //!
@@ -37,7 +47,10 @@ mod traits;
 mod traj;
 
 pub use curve::Curve;
-pub use error::{PlanError, check_finite, check_finite_vec, check_non_negative, check_positive};
+pub use error::{
+    PlanError, check_finite, check_finite_vec, check_non_negative, check_positive, check_scaled,
+    check_scaled_vec,
+};
 pub use path::GuidePath;
 pub use scene::Scene;
 pub use solution::{CostBreakdown, RankingWeights, Solution, SolveStats, SolveStatus};
@@ -46,9 +59,9 @@ pub use traits::{
     HomotopyChecker, InitialGuess, PathFrontend, PathQuery, SearchResult, SearchStats, TrajRequest,
     TrajectoryBackend,
 };
-pub use traj::{Derivative, Piece, PolyTraj, eval_piece};
+pub use traj::{Derivative, MAX_DERIVATIVE_BOUND, Piece, PolyTraj, eval_piece};
 
-pub use trust_geometry::{Aabb, StaticMap, Vec3};
+pub use trust_geometry::{Aabb, StaticMap, Vec3, scale};
 pub use trust_predict::{Forecast, ObstacleShape};
 
 /// The random number generator every randomized component takes: seeded, portable, fast

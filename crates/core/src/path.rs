@@ -2,7 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::check_finite_vec;
+use trust_geometry::scale::{self, Quantity};
+
+use crate::error::check_scaled_vec;
 use crate::{PlanError, Vec3};
 
 /// A polyline from the start (first point) toward the goal (last point), untimed.
@@ -17,29 +19,47 @@ pub struct GuidePath {
 }
 
 impl GuidePath {
-    /// A validated path: at least one point, all finite.
+    /// A validated path: at least one point and at most [`scale::MAX_VERTEX_COUNT`], every point a
+    /// position inside the scale policy ([`crate::scale`]).
     pub fn new(points: Vec<Vec3>) -> Result<Self, PlanError> {
-        if points.is_empty() {
+        let path = GuidePath { points };
+        path.validate("path")?;
+        Ok(path)
+    }
+
+    /// Re-checks the invariants of [`GuidePath::new`] (the `points` field is public); `field`
+    /// prefixes the names in the error. Every API that takes a path calls it.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] for an empty path, [`PlanError::Count`] for too many points,
+    /// [`PlanError`] naming the first bad point otherwise.
+    pub fn validate(&self, field: &str) -> Result<(), PlanError> {
+        if self.points.is_empty() {
             return Err(PlanError::invalid(
-                "path.points",
+                format!("{field}.points"),
                 "[]",
                 "at least one point",
             ));
         }
-        for (i, p) in points.iter().enumerate() {
-            check_finite_vec(&format!("path.points[{i}]"), p)?;
+        scale::check_count(
+            &format!("{field}.points.len()"),
+            self.points.len() as u128,
+            scale::MAX_VERTEX_COUNT,
+        )?;
+        for (i, p) in self.points.iter().enumerate() {
+            check_scaled_vec(&format!("{field}.points[{i}]"), p, Quantity::Position)?;
         }
-        Ok(GuidePath { points })
+        Ok(())
     }
 
-    /// First point.
+    /// First point (the origin for an empty path, which [`GuidePath::new`] never builds).
     pub fn start(&self) -> Vec3 {
-        self.points[0]
+        self.points.first().copied().unwrap_or_else(Vec3::zeros)
     }
 
-    /// Last point.
+    /// Last point (the origin for an empty path, which [`GuidePath::new`] never builds).
     pub fn end(&self) -> Vec3 {
-        self.points[self.points.len() - 1]
+        self.points.last().copied().unwrap_or_else(Vec3::zeros)
     }
 
     /// Total length (m).
@@ -66,11 +86,15 @@ impl GuidePath {
         self.end()
     }
 
-    /// `count` points (at least 2) evenly spaced by arc length, start and end included, appended to `out`
-    /// after clearing it. One pass over the polyline.
+    /// `count` points (at least 2, at most [`scale::MAX_SAMPLE_COUNT`]: larger counts are capped)
+    /// evenly spaced by arc length, start and end included, appended to `out` after clearing it.
+    /// One pass over the polyline. Writes nothing for an empty path.
     pub fn resample_into(&self, count: usize, out: &mut Vec<Vec3>) {
         out.clear();
-        let count = count.max(2);
+        if self.points.is_empty() {
+            return;
+        }
+        let count = count.clamp(2, scale::MAX_SAMPLE_COUNT);
         let total = self.length();
         if total <= 0.0 {
             out.resize(count, self.start());
@@ -106,9 +130,19 @@ impl GuidePath {
         }
     }
 
+    /// [`GuidePath::resample`] that rejects a count above [`scale::MAX_SAMPLE_COUNT`] instead of
+    /// capping it.
+    ///
+    /// # Errors
+    /// [`PlanError::Count`] naming `count`.
+    pub fn try_resample(&self, count: usize) -> Result<Vec<Vec3>, PlanError> {
+        scale::check_count("count", count as u128, scale::MAX_SAMPLE_COUNT)?;
+        Ok(self.resample(count))
+    }
+
     /// Convenience wrapper around [`GuidePath::resample_into`].
     pub fn resample(&self, count: usize) -> Vec<Vec3> {
-        let mut out = Vec::with_capacity(count.max(2));
+        let mut out = Vec::with_capacity(count.clamp(2, scale::MAX_SAMPLE_COUNT));
         self.resample_into(count, &mut out);
         out
     }

@@ -3,8 +3,9 @@
 use trust_geometry::StaticMap;
 use trust_predict::Forecast;
 
-use crate::error::{check_finite, check_finite_vec};
+use crate::error::{check_finite_vec, check_scaled};
 use crate::{PlanError, Vec3};
+use trust_geometry::scale::Quantity;
 
 /// The world as one planning call sees it: the static map plus forecasts of moving obstacles, all made
 /// at time `t0` (s). Cheap to build (it only borrows), so build one per planning cycle.
@@ -22,11 +23,11 @@ impl<'a> Scene<'a> {
     /// A validated scene: `t0` finite and every forecast valid (finite vectors and times, positive
     /// size, non-negative margin and growth rate). The error names the forecast's index.
     pub fn new(map: &'a StaticMap, forecasts: &'a [Forecast], t0: f64) -> Result<Self, PlanError> {
-        check_finite("scene.t0", t0)?;
+        check_scaled("scene.t0", t0, Quantity::Time)?;
         for (i, f) in forecasts.iter().enumerate() {
             check_finite_vec(&format!("scene.forecasts[{i}].p0"), &f.p0)?;
             check_finite_vec(&format!("scene.forecasts[{i}].v0"), &f.v0)?;
-            check_finite(&format!("scene.forecasts[{i}].t0"), f.t0)?;
+            check_scaled(&format!("scene.forecasts[{i}].t0"), f.t0, Quantity::Time)?;
             f.validate().map_err(|e| {
                 PlanError::invalid(format!("scene.forecasts[{i}]"), f, e.to_string())
             })?;

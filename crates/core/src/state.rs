@@ -2,8 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{check_finite, check_finite_vec, check_positive};
+use crate::error::{check_positive, check_scaled, check_scaled_vec};
 use crate::{PlanError, Vec3};
+use trust_geometry::scale::Quantity;
 
 /// Kinematic state of the vehicle at absolute time `t` (seconds): position, velocity, acceleration.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -30,13 +31,13 @@ impl State {
         }
     }
 
-    /// Checks that all numbers are finite; `field` prefixes the field names in the error
+    /// Checks that all numbers are finite and inside the scale policy ([`crate::scale`]); `field` prefixes the field names in the error
     /// (e.g. `start` gives `start.v`).
     pub fn validate(&self, field: &str) -> Result<(), PlanError> {
-        check_finite(&format!("{field}.t"), self.t)?;
-        check_finite_vec(&format!("{field}.p"), &self.p)?;
-        check_finite_vec(&format!("{field}.v"), &self.v)?;
-        check_finite_vec(&format!("{field}.a"), &self.a)?;
+        check_scaled(&format!("{field}.t"), self.t, Quantity::Time)?;
+        check_scaled_vec(&format!("{field}.p"), &self.p, Quantity::Position)?;
+        check_scaled_vec(&format!("{field}.v"), &self.v, Quantity::Velocity)?;
+        check_scaled_vec(&format!("{field}.a"), &self.a, Quantity::Acceleration)?;
         Ok(())
     }
 }
@@ -63,6 +64,8 @@ impl Limits {
     pub fn validate(&self) -> Result<(), PlanError> {
         check_positive("limits.v_max", self.v_max)?;
         check_positive("limits.a_max", self.a_max)?;
+        check_scaled("limits.v_max", self.v_max, Quantity::PositiveSpeed)?;
+        check_scaled("limits.a_max", self.a_max, Quantity::PositiveAcceleration)?;
         Ok(())
     }
 }

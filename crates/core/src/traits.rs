@@ -8,8 +8,9 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{check_finite_vec, check_positive};
+use crate::error::{check_positive, check_scaled, check_scaled_vec};
 use crate::{Curve, GuidePath, Limits, PlanError, PolyTraj, Rng, Scene, Solution, State, Vec3};
+use trust_geometry::scale::Quantity;
 
 /// A request for guide paths.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -28,9 +29,14 @@ impl PathQuery {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
         self.start.validate("query.start")?;
-        check_finite_vec("query.goal", &self.goal)?;
+        check_scaled_vec("query.goal", &self.goal, Quantity::Position)?;
         self.limits.validate()?;
         check_positive("query.horizon_s", self.horizon_s)?;
+        check_scaled(
+            "query.horizon_s",
+            self.horizon_s,
+            Quantity::PositiveDuration,
+        )?;
         Ok(())
     }
 }
@@ -143,10 +149,14 @@ impl TrajRequest<'_> {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
         self.start.validate("request.start")?;
-        check_finite_vec("request.goal", &self.goal)?;
+        check_scaled_vec("request.goal", &self.goal, Quantity::Position)?;
         self.limits.validate()?;
         if let Some(h) = self.horizon_s {
             check_positive("request.horizon_s", h)?;
+            check_scaled("request.horizon_s", h, Quantity::PositiveDuration)?;
+        }
+        if let InitialGuess::Guide(path) = self.initial {
+            path.validate("request.initial")?;
         }
         if self.max_evaluations == Some(0) {
             return Err(PlanError::invalid(

@@ -3,8 +3,16 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{check_finite, check_finite_vec, check_positive};
+use trust_geometry::scale::{self, Quantity};
+
+use crate::error::{check_finite, check_finite_vec, check_positive, check_scaled};
 use crate::{PlanError, State, Vec3};
+
+/// Largest accepted bound on any derivative (orders 0 to 5) of a piece over its duration:
+/// `Σ_{k≥r} k!/(k−r)!·‖c_k‖_∞·T^{k−r} ≤ MAX_DERIVATIVE_BOUND` for every order `r`. It keeps every
+/// evaluation, sample, arc length and energy of an accepted trajectory finite (scale policy,
+/// [`crate::scale`]).
+pub const MAX_DERIVATIVE_BOUND: f64 = 1.0e30;
 
 /// Coefficients of one quintic piece, ascending powers: `p(s) = Σ_k c[k] s^k`, `s ∈ [0, T_i]`.
 pub type Piece = [Vec3; 6];
@@ -94,9 +102,17 @@ impl From<PolyTraj> for RawPolyTraj {
 }
 
 impl PolyTraj {
-    /// A validated trajectory.
+    /// A validated trajectory: finite numbers inside the scale policy ([`crate::scale`]): `t_start`
+    /// a time, durations in `[1e-9, 1e7]` s with a total of at most `1e7` s, at most
+    /// [`scale::MAX_VERTEX_COUNT`] pieces, and every derivative bounded by
+    /// [`MAX_DERIVATIVE_BOUND`] over its piece.
     pub fn new(t_start: f64, durations: Vec<f64>, pieces: Vec<Piece>) -> Result<Self, PlanError> {
-        check_finite("traj.t_start", t_start)?;
+        check_scaled("traj.t_start", t_start, Quantity::Time)?;
+        scale::check_count(
+            "traj.durations.len()",
+            durations.len() as u128,
+            scale::MAX_VERTEX_COUNT,
+        )?;
         if durations.is_empty() {
             return Err(PlanError::invalid(
                 "traj.durations",
@@ -113,13 +129,36 @@ impl PolyTraj {
         }
         for (i, &d) in durations.iter().enumerate() {
             check_positive(&format!("traj.durations[{i}]"), d)?;
+            check_scaled(
+                &format!("traj.durations[{i}]"),
+                d,
+                Quantity::PositiveDuration,
+            )?;
         }
         for (i, piece) in pieces.iter().enumerate() {
             for (k, c) in piece.iter().enumerate() {
                 check_finite_vec(&format!("traj.pieces[{i}][{k}]"), c)?;
             }
+            let bound = derivative_bound(piece, durations[i]);
+            if bound > MAX_DERIVATIVE_BOUND {
+                return Err(PlanError::invalid(
+                    format!("traj.pieces[{i}]"),
+                    format!(
+                        "coefficients whose derivatives reach {} over the piece's {} s",
+                        scale::Sci(bound),
+                        scale::Sci(durations[i])
+                    ),
+                    format!(
+                        "every derivative bounded by {} (scale policy)",
+                        scale::Sci(MAX_DERIVATIVE_BOUND)
+                    ),
+                ));
+            }
         }
         let ends = cumulative(&durations);
+        let total = ends.last().copied().unwrap_or(0.0);
+        check_scaled("traj total duration", total, Quantity::Duration)?;
+        check_scaled("traj.t_end", t_start + total, Quantity::Time)?;
         Ok(PolyTraj {
             t_start,
             durations,
@@ -189,7 +228,28 @@ impl PolyTraj {
         eval_piece(&self.pieces[i], which.order(), s)
     }
 
-    /// Position at absolute time `t`.
+    /// Position, velocity and acceleration at absolute time `t`, rejecting a NaN time instead of
+    /// clamping it (the plain [`PolyTraj::state`] maps NaN to the start).
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] naming `t` if it is NaN.
+    pub fn checked_state(&self, t: f64) -> Result<State, PlanError> {
+        if t.is_nan() {
+            return Err(PlanError::invalid("t", t, "a time, not NaN"));
+        }
+        Ok(self.state(t))
+    }
+
+    /// Position at absolute time `t`, rejecting a NaN time (see [`PolyTraj::checked_state`]).
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] naming `t` if it is NaN.
+    pub fn checked_position(&self, t: f64) -> Result<Vec3, PlanError> {
+        Ok(self.checked_state(t)?.p)
+    }
+
+    /// Position at absolute time `t` (clamped to the span; a NaN time gives the start: use
+    /// [`PolyTraj::checked_position`] to have it rejected).
     pub fn position(&self, t: f64) -> Vec3 {
         self.derivative(Derivative::Position, t)
     }
@@ -219,21 +279,38 @@ impl PolyTraj {
         let (i, s) = self.locate(t);
         let piece = &self.pieces[i];
         State {
-            t: t.clamp(self.t_start, self.t_end()),
+            // A NaN time maps to the start, as in `locate`.
+            t: if t.is_nan() {
+                self.t_start
+            } else {
+                t.clamp(self.t_start, self.t_end())
+            },
             p: eval_piece(piece, 0, s),
             v: eval_piece(piece, 1, s),
             a: eval_piece(piece, 2, s),
         }
     }
 
-    /// Calls `f(t, state)` at `t_start, t_start + dt, …` and always at `t_end`. `dt` must be `> 0`.
+    /// Calls `f(t, state)` at `t_start, t_start + dt, …` and always at `t_end`. `dt` must be `> 0`
+    /// and give at most [`scale::MAX_SAMPLE_COUNT`] samples.
+    ///
+    /// # Errors
+    /// [`PlanError`] naming `dt_s` if it is not a positive duration, [`PlanError::Count`] if the
+    /// duration divided by `dt` exceeds the sample cap.
     pub fn for_each_sample(
         &self,
         dt: f64,
         mut f: impl FnMut(f64, &State),
     ) -> Result<(), PlanError> {
         check_positive("dt_s", dt)?;
-        let steps = (self.duration() / dt).floor() as usize;
+        let ratio = (self.duration() / dt).floor();
+        // Saturating conversion (the ratio is non-negative here, possibly +inf; 1e30 is far
+        // above the cap and leaves room for the + 1).
+        let steps = scale::check_count(
+            "samples (trajectory duration / dt_s)",
+            ratio.min(1e30) as u128 + 1,
+            scale::MAX_SAMPLE_COUNT,
+        )? - 1;
         for k in 0..=steps {
             let t = self.t_start + k as f64 * dt;
             f(t, &self.state(t));
@@ -252,8 +329,12 @@ impl PolyTraj {
     }
 
     /// Arc length, by Simpson's rule on `samples_per_piece` (even, at least 2) intervals per piece.
+    /// The total number of samples is capped at [`scale::MAX_SAMPLE_COUNT`] (fewer per piece).
     pub fn arc_length(&self, samples_per_piece: usize) -> f64 {
-        let m = samples_per_piece.max(2).next_multiple_of(2);
+        let m = self
+            .capped_per_piece(samples_per_piece)
+            .max(2)
+            .next_multiple_of(2);
         let mut total = 0.0;
         for (piece, &d) in self.pieces.iter().zip(&self.durations) {
             let h = d / m as f64;
@@ -276,13 +357,22 @@ impl PolyTraj {
     /// The same trajectory shifted to start at `t_start`.
     pub fn with_start_time(mut self, t_start: f64) -> Result<Self, PlanError> {
         check_finite("traj.t_start", t_start)?;
+        check_scaled("traj.t_start", t_start, Quantity::Time)?;
+        check_scaled("traj.t_end", t_start + self.duration(), Quantity::Time)?;
         self.t_start = t_start;
         Ok(self)
     }
 
-    /// The largest speed and acceleration norm over `samples_per_piece + 1` samples per piece.
+    /// `samples_per_piece`, reduced so that all pieces together take at most
+    /// [`scale::MAX_SAMPLE_COUNT`] samples.
+    fn capped_per_piece(&self, samples_per_piece: usize) -> usize {
+        samples_per_piece.min(scale::MAX_SAMPLE_COUNT / self.pieces.len().max(1))
+    }
+
+    /// The largest speed and acceleration norm over `samples_per_piece + 1` samples per piece
+    /// (the total capped at [`scale::MAX_SAMPLE_COUNT`], fewer per piece).
     pub fn max_speed_and_acceleration(&self, samples_per_piece: usize) -> (f64, f64) {
-        let m = samples_per_piece.max(1);
+        let m = self.capped_per_piece(samples_per_piece).max(1);
         let mut v_max: f64 = 0.0;
         let mut a_max: f64 = 0.0;
         for (piece, &d) in self.pieces.iter().zip(&self.durations) {
@@ -294,6 +384,23 @@ impl PolyTraj {
         }
         (v_max, a_max)
     }
+}
+
+/// `max_r Σ_{k≥r} k!/(k−r)!·‖c_k‖_∞·T^{k−r}`: bounds every derivative of the piece over `[0, T]`.
+fn derivative_bound(piece: &Piece, duration: f64) -> f64 {
+    let mut worst: f64 = 0.0;
+    for r in 0..6 {
+        let mut sum = 0.0;
+        for (k, c) in piece.iter().enumerate().skip(r) {
+            let falling: f64 = ((k - r + 1)..=k).map(|j| j as f64).product();
+            sum += falling * c.amax() * duration.powi((k - r) as i32);
+        }
+        if sum.is_nan() {
+            return f64::INFINITY;
+        }
+        worst = worst.max(sum);
+    }
+    worst
 }
 
 fn cumulative(durations: &[f64]) -> Vec<f64> {

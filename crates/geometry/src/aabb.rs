@@ -106,6 +106,40 @@ impl Aabb {
         Ok(())
     }
 
+    /// The part of the segment `[a, b]` inside the closed box, as its end points, or `None` if the
+    /// segment misses the box (slab method). A degenerate segment gives its point if inside.
+    pub fn clip_segment(&self, a: &Vec3, b: &Vec3) -> Option<(Vec3, Vec3)> {
+        let d = b - a;
+        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+        for i in 0..3 {
+            if d[i] == 0.0 {
+                if a[i] < self.min[i] || a[i] > self.max[i] {
+                    return None;
+                }
+                continue;
+            }
+            let t0 = (self.min[i] - a[i]) / d[i];
+            let t1 = (self.max[i] - a[i]) / d[i];
+            let (t0, t1) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
+            lo = lo.max(t0);
+            hi = hi.min(t1);
+            // Also false for NaN bounds.
+            if lo.is_nan() || hi.is_nan() || lo > hi {
+                return None;
+            }
+        }
+        let at = |t: f64| {
+            if t <= 0.0 {
+                *a
+            } else if t >= 1.0 {
+                *b
+            } else {
+                a + d * t
+            }
+        };
+        Some((at(lo), at(hi)))
+    }
+
     /// True if `p` lies in the closed box.
     pub fn contains(&self, p: &Vec3) -> bool {
         (0..3).all(|i| p[i] >= self.min[i] && p[i] <= self.max[i])

@@ -2,6 +2,8 @@
 
 use thiserror::Error;
 
+use crate::scale::{self, CountError, Quantity, ScaleError, Sci};
+
 /// Invalid input to a constructor or builder of this crate.
 ///
 /// Every variant names the offending field and value and says what was expected.
@@ -17,7 +19,7 @@ pub enum GeometryError {
         value: f64,
     },
     /// A size (radius, half-height, clearance, …) was negative.
-    #[error("{field} must be >= 0, got {value}")]
+    #[error("{field} must be >= 0, got {}", Sci(*.value))]
     Negative {
         /// Name of the field.
         field: String,
@@ -25,7 +27,7 @@ pub enum GeometryError {
         value: f64,
     },
     /// A quantity that must be strictly positive (e.g. a voxel resolution) was zero or negative.
-    #[error("{field} must be > 0, got {value}")]
+    #[error("{field} must be > 0, got {}", Sci(*.value))]
     NonPositive {
         /// Name of the field.
         field: String,
@@ -33,7 +35,7 @@ pub enum GeometryError {
         value: f64,
     },
     /// A box whose minimum exceeds its maximum along some axis.
-    #[error("{field}: min.{axis} = {min} exceeds max.{axis} = {max}; expected min <= max")]
+    #[error("{field}: min.{axis} = {} exceeds max.{axis} = {}; expected min <= max", Sci(*.min), Sci(*.max))]
     InvertedBox {
         /// Name of the box (e.g. `"bounds"`).
         field: String,
@@ -45,7 +47,10 @@ pub enum GeometryError {
         max: f64,
     },
     /// Bounds with zero extent along some axis (zero volume) where a volume is required.
-    #[error("{field}: zero extent along {axis} (min = max = {value}); expected a positive volume")]
+    #[error(
+        "{field}: zero extent along {axis} (min = max = {}); expected a positive volume",
+        Sci(*.value)
+    )]
     EmptyBounds {
         /// Name of the box (e.g. `"bounds"`).
         field: String,
@@ -81,6 +86,12 @@ pub enum GeometryError {
         /// The expected length.
         expected: usize,
     },
+    /// A number outside the scale policy ([`crate::scale`]).
+    #[error(transparent)]
+    Scale(#[from] ScaleError),
+    /// A count above its cap ([`crate::scale`]).
+    #[error(transparent)]
+    Count(#[from] CountError),
 }
 
 impl GeometryError {
@@ -101,7 +112,7 @@ pub(crate) fn check_finite(field: &str, value: f64) -> Result<f64, GeometryError
     }
 }
 
-/// Checks that `value` is finite and `>= 0`.
+/// Checks that `value` is a length: finite, `>= 0` and within the scale policy.
 pub(crate) fn check_non_negative(field: &str, value: f64) -> Result<f64, GeometryError> {
     check_finite(field, value)?;
     if value < 0.0 {
@@ -110,15 +121,15 @@ pub(crate) fn check_non_negative(field: &str, value: f64) -> Result<f64, Geometr
             value,
         })
     } else {
-        Ok(value)
+        Ok(scale::check(field, value, Quantity::Length)?)
     }
 }
 
-/// Checks that `value` is finite and `> 0`.
+/// Checks that `value` is a strictly positive length: finite, `> 0` and within the scale policy.
 pub(crate) fn check_positive(field: &str, value: f64) -> Result<f64, GeometryError> {
     check_finite(field, value)?;
     if value > 0.0 {
-        Ok(value)
+        Ok(scale::check(field, value, Quantity::PositiveLength)?)
     } else {
         Err(GeometryError::NonPositive {
             field: field.into(),
@@ -127,12 +138,19 @@ pub(crate) fn check_positive(field: &str, value: f64) -> Result<f64, GeometryErr
     }
 }
 
-/// Checks that every component of `v` is finite; the field name gets `.x`/`.y`/`.z` appended.
+/// Checks that every component of `v` is a finite position within the scale policy; the field
+/// name gets `.x`/`.y`/`.z` appended.
 pub(crate) fn check_vec(field: &str, v: &crate::Vec3) -> Result<(), GeometryError> {
     for (i, axis) in ['x', 'y', 'z'].into_iter().enumerate() {
         if !v[i].is_finite() {
             return Err(GeometryError::non_finite(format!("{field}.{axis}"), v[i]));
         }
     }
-    Ok(())
+    Ok(scale::check_vec(field, v, Quantity::Position)?)
+}
+
+/// Checks that `value` is a finite position coordinate within the scale policy.
+pub(crate) fn check_coord(field: &str, value: f64) -> Result<f64, GeometryError> {
+    check_finite(field, value)?;
+    Ok(scale::check(field, value, Quantity::Position)?)
 }

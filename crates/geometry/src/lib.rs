@@ -19,9 +19,15 @@
 //! obstacles. All public math is `f64` and nalgebra ([`Vec3`]); parry3d-f64 (glam) is used inside
 //! for the BVH and the segment–shape distance queries and never appears in the API.
 //!
+//! Scale policy: every public constructor accepts only the magnitudes listed in [`scale`]
+//! (positions `|x| ≤ 1e6` m, sizes `≤ 1e6` m, speeds `≤ 1e4` m/s, times `≤ 1e7` s, generated counts
+//! `≤ 1e6`); the other crates of the planner apply the same policy at their entry points, so that
+//! every internal computation stays finite. Out-of-range input is a [`ScaleError`].
+//!
 //! Signs and conventions: distances are negative inside obstacles; gradients are unit outward
 //! directions, defined (never NaN) at non-differentiable points as documented in [`shapes`]; a map
-//! with no obstacles reports `f64::INFINITY` with a zero gradient.
+//! with no obstacles reports `f64::INFINITY` with a zero gradient; a non-finite query point, or one
+//! beyond [`scale::QUERY_LIMIT`], reports `f64::NEG_INFINITY` ("not free") with a zero gradient.
 #![warn(missing_docs)]
 
 mod aabb;
@@ -29,6 +35,7 @@ mod error;
 pub mod esdf;
 mod map;
 mod parry_conv;
+pub mod scale;
 pub mod shapes;
 
 /// The public vector type: `nalgebra::Vector3<f64>`.
@@ -40,7 +47,8 @@ pub use esdf::{
     EdtScratch, Esdf, MAX_VOXELS, checked_voxel_count, edt_1d, edt_1d_with_scratch, edt_3d,
     voxel_index,
 };
-pub use map::{DEFAULT_RESOLUTION, StaticMap};
+pub use map::{DEFAULT_RESOLUTION, MAX_TRACE_STEPS, StaticMap};
+pub use scale::{CountError, Quantity, ScaleError, Sci};
 pub use shapes::{
     AaBox, Cylinder, CylinderSdf, Shape, Sphere, box_sdf, cylinder_sdf,
     cylinder_sdf_with_size_gradient, sphere_sdf,

@@ -22,6 +22,10 @@ pub const DEFAULT_RESOLUTION: f64 = 0.1;
 /// most 3.
 const ESDF_LIPSCHITZ: f64 = 2.0 * 1.732_050_807_568_877_3;
 
+/// Most sphere-tracing steps one ESDF line-of-sight test takes before it gives up (answers "not
+/// clear"): a count that does not depend on any float being finite.
+pub const MAX_TRACE_STEPS: usize = 1 << 16;
+
 /// The static world: bounds, analytic [`Shape`]s and an optional voxel [`Esdf`] from a point cloud.
 ///
 /// * Bounds are where the planner may go ([`StaticMap::contains`]); distance queries are defined
@@ -96,6 +100,7 @@ fn node_sdf(node: &BvhNode, p: &Vec3) -> f64 {
 impl StaticMap {
     /// An obstacle-free map with the given bounds; errors if the bounds have zero volume.
     pub fn new(bounds: Aabb) -> Result<Self, GeometryError> {
+        crate::aabb::check_box("bounds", &bounds.min, &bounds.max)?;
         bounds.check_volume("bounds")?;
         Ok(Self {
             bounds,
@@ -195,6 +200,8 @@ impl StaticMap {
 
     /// Signed distance from `p` to the nearest obstacle and its gradient: the gradient of the
     /// nearest shape's SDF or of the ESDF interpolant, whichever is smaller (shapes win ties).
+    /// A non-finite `p` gives `(-inf, 0)` ("not free"); so does a point beyond
+    /// [`crate::scale::QUERY_LIMIT`] near a shape (the shapes' distance functions answer so).
     pub fn distance_and_gradient(&self, p: &Vec3) -> (f64, Vec3) {
         if !p.iter().all(|c| c.is_finite()) {
             return (f64::NEG_INFINITY, Vec3::zeros());
@@ -301,11 +308,15 @@ impl StaticMap {
     ///   tracer advances by `(d - clearance) / L` with `L = 2√3` bounding the slope of the
     ///   interpolant, so no point in between can fall below the clearance. It gives up (returns
     ///   `false`) if the segment stays within `resolution / 1000` of the clearance level or needs
-    ///   more than `64 + 64 * length / resolution` steps.
+    ///   more than `min(64 + 64 * length / resolution, MAX_TRACE_STEPS)` steps.
     /// * A zero-length segment is [`StaticMap::is_free`] of its point. Negative clearances are
-    ///   treated as 0; a NaN clearance or non-finite end point gives `false`.
+    ///   treated as 0; a NaN clearance, a non-finite end point or one outside the scale policy
+    ///   ([`crate::scale`]: a coordinate beyond [`crate::scale::MAX_COORD_M`]) gives `false`.
     pub fn segment_clear(&self, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
-        if clearance.is_nan() || !a.iter().chain(b.iter()).all(|c| c.is_finite()) {
+        if clearance.is_nan()
+            || !crate::scale::position_in_scale(a)
+            || !crate::scale::position_in_scale(b)
+        {
             return false;
         }
         let clearance = clearance.max(0.0);
@@ -320,10 +331,21 @@ impl StaticMap {
         if self.shapes.is_empty() {
             return true;
         }
-        let query = to_p_aabb(&Aabb::from_segment(a, b).inflated(clearance));
+        // Inflated by a few ulps too, so that a shape the segment touches within rounding is a
+        // candidate (the exact tests below are conservative at that scale).
+        let ulps = 8.0 * f64::EPSILON * (a.amax() + b.amax());
+        let query = to_p_aabb(&Aabb::from_segment(a, b).inflated(clearance + ulps));
         let mut candidates = self.bvh.intersect_aabb(&query);
+        // Each shape sees only the part of the segment inside its box inflated by the clearance
+        // (a closest pair closer than the clearance lies there): a long segment past a small
+        // shape then costs GJK no precision.
+        let pad = clearance + 1e-9 * (1.0 + clearance);
         !candidates.any(|i| {
-            let d = segment_shape_distance(&self.shapes[i as usize], a, b);
+            let shape = &self.shapes[i as usize];
+            let Some((p, q)) = shape.aabb().inflated(pad).clip_segment(a, b) else {
+                return false;
+            };
+            let d = segment_shape_distance(shape, &p, &q);
             !(d > 0.0 && d >= clearance)
         })
     }
@@ -345,13 +367,16 @@ impl StaticMap {
 /// [`StaticMap::segment_clear`]).
 fn esdf_segment_clear(esdf: &Esdf, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
     let len = (b - a).norm();
+    if !(len.is_finite() && len > 0.0) {
+        return false;
+    }
     let res = esdf.resolution();
     let margin = res * 1e-3;
-    let max_steps = 64.0 + 64.0 * len / res;
+    // Saturating float-to-int conversion; NaN (impossible here) would give 0 steps.
+    let max_steps = ((64.0 + 64.0 * len / res) as usize).min(MAX_TRACE_STEPS);
     let dir = (b - a) / len;
     let mut t = 0.0;
-    let mut steps = 0.0;
-    loop {
+    for _ in 0..=max_steps {
         let p = if t >= len { *b } else { a + dir * t };
         let d = esdf.signed_distance(&p);
         if d < clearance {
@@ -361,15 +386,12 @@ fn esdf_segment_clear(esdf: &Esdf, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
             return true;
         }
         let slack = d - clearance;
-        if slack < margin {
-            return false;
-        }
-        steps += 1.0;
-        if steps > max_steps {
+        if slack.is_nan() || slack < margin {
             return false;
         }
         t += slack / ESDF_LIPSCHITZ;
     }
+    false
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 use parry3d_f64::bounding_volume::Aabb as PAabb;
 use parry3d_f64::math::{Pose, Vector as PVec};
 use parry3d_f64::query;
-use parry3d_f64::shape::{Ball, Cuboid, Cylinder as PCylinder, Segment};
+use parry3d_f64::shape::{Cuboid, Cylinder as PCylinder, Segment};
 
 use crate::Vec3;
 use crate::aabb::Aabb;
@@ -26,8 +26,24 @@ pub(crate) fn segment_shape_distance(shape: &Shape, a: &Vec3, b: &Vec3) -> f64 {
     let id = Pose::IDENTITY;
     let result = match shape {
         Shape::Sphere(s) => {
-            let seg = Segment::new(to_p(&(a - s.center)), to_p(&(b - s.center)));
-            query::distance(&id, &seg, &id, &Ball::new(s.radius))
+            // Closed form: distance from the centre to the segment, minus the radius.
+            let d = b - a;
+            let len2 = d.norm_squared();
+            let t = if len2 > 0.0 {
+                ((s.center - a).dot(&d) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let gap = (a + d * t - s.center).norm() - s.radius;
+            // Rounding in the projection is a few ulps of the coordinates' magnitude: a gap
+            // below that is reported as contact (conservative), so that a tiny sphere on a long
+            // segment is never missed.
+            let ulps = 8.0 * f64::EPSILON * (a.amax() + b.amax() + s.center.amax() + s.radius);
+            return if gap.is_nan() || gap <= ulps {
+                0.0
+            } else {
+                gap
+            };
         }
         Shape::Cylinder(c) => {
             let swap = |p: &Vec3| {
@@ -35,13 +51,18 @@ pub(crate) fn segment_shape_distance(shape: &Shape, a: &Vec3, b: &Vec3) -> f64 {
                 PVec::new(q.x, q.z, q.y)
             };
             let seg = Segment::new(swap(a), swap(b));
-            query::distance(&id, &seg, &id, &PCylinder::new(c.half_height, c.radius))
+            query::distance(
+                &id,
+                &seg,
+                &id,
+                &PCylinder::new(c.half_height.abs(), c.radius.abs()),
+            )
         }
         Shape::AaBox(bx) => {
             let center = 0.5 * (bx.min + bx.max);
             let half = 0.5 * (bx.max - bx.min);
             let seg = Segment::new(to_p(&(a - center)), to_p(&(b - center)));
-            query::distance(&id, &seg, &id, &Cuboid::new(to_p(&half)))
+            query::distance(&id, &seg, &id, &Cuboid::new(to_p(&half.abs())))
         }
     };
     // Segment against ball/cylinder/cuboid is always supported by the default dispatcher; if it

@@ -24,7 +24,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::Vec3;
 use crate::aabb::{Aabb, check_box};
-use crate::error::{GeometryError, check_finite, check_non_negative, check_vec};
+use crate::error::{GeometryError, check_coord, check_non_negative, check_vec};
 
 /// The direction used where the distance to a sphere's centre (or a cylinder's axis) has no
 /// direction.
@@ -42,6 +42,9 @@ fn side(x: f64) -> f64 {
 /// to the other arguments follow directly: `∂d/∂center = -gradient`, `∂d/∂radius = -1`.
 #[inline]
 pub fn sphere_sdf(center: &Vec3, radius: f64, p: &Vec3) -> (f64, Vec3) {
+    if !crate::scale::queryable(&[p.x, p.y, p.z, center.x, center.y, center.z, radius]) {
+        return (f64::NEG_INFINITY, Vec3::zeros());
+    }
     let d = p - center;
     let n = d.norm();
     if n > 0.0 {
@@ -88,6 +91,23 @@ pub fn cylinder_sdf_with_size_gradient(
     half_height: f64,
     p: &Vec3,
 ) -> CylinderSdf {
+    if !crate::scale::queryable(&[
+        p.x,
+        p.y,
+        p.z,
+        center.x,
+        center.y,
+        center.z,
+        radius,
+        half_height,
+    ]) {
+        return CylinderSdf {
+            distance: f64::NEG_INFINITY,
+            gradient: Vec3::zeros(),
+            d_radius: 0.0,
+            d_half_height: 0.0,
+        };
+    }
     let q = p - center;
     let rho = q.x.hypot(q.y);
     let radial = if rho > 0.0 {
@@ -132,6 +152,9 @@ pub fn cylinder_sdf_with_size_gradient(
 /// normal of the nearest face (ties: `x` before `y` before `z`, `+` side on the mid-plane).
 /// `min <= max` is assumed (not checked).
 pub fn box_sdf(min: &Vec3, max: &Vec3, p: &Vec3) -> (f64, Vec3) {
+    if !crate::scale::queryable(&[p.x, p.y, p.z, min.x, min.y, min.z, max.x, max.y, max.z]) {
+        return (f64::NEG_INFINITY, Vec3::zeros());
+    }
     let c = 0.5 * (min + max);
     let h = 0.5 * (max - min);
     let rel = p - c;
@@ -261,7 +284,11 @@ impl Sphere {
     pub fn new(center: Vec3, radius: f64) -> Result<Self, GeometryError> {
         check_vec("sphere.center", &center)?;
         check_non_negative("sphere.radius", radius)?;
-        Ok(Self { center, radius })
+        // `abs` turns an accepted `-0.0` into `+0.0` (parry asserts positive signs).
+        Ok(Self {
+            center,
+            radius: radius.abs(),
+        })
     }
 
     /// Exact signed distance from `p` (negative inside).
@@ -300,10 +327,11 @@ impl Cylinder {
         check_vec("cylinder.center", &center)?;
         check_non_negative("cylinder.radius", radius)?;
         check_non_negative("cylinder.half_height", half_height)?;
+        // `abs` turns an accepted `-0.0` into `+0.0` (parry asserts positive signs).
         Ok(Self {
             center,
-            radius,
-            half_height,
+            radius: radius.abs(),
+            half_height: half_height.abs(),
         })
     }
 
@@ -316,8 +344,8 @@ impl Cylinder {
         z_max: f64,
         radius: f64,
     ) -> Result<Self, GeometryError> {
-        check_finite("cylinder.z_min", z_min)?;
-        check_finite("cylinder.z_max", z_max)?;
+        check_coord("cylinder.z_min", z_min)?;
+        check_coord("cylinder.z_max", z_max)?;
         if z_min > z_max {
             return Err(GeometryError::InvertedBox {
                 field: "cylinder".into(),

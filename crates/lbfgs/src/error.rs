@@ -11,7 +11,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum LbfgsError {
     /// A field of [`crate::LbfgsParams`] is out of its valid range.
-    #[error("invalid LbfgsParams: {field} = {value}, expected {expected}")]
+    #[error("invalid LbfgsParams: {field} = {}, expected {expected}", Readable(*.value))]
     InvalidParam {
         /// Name of the field (e.g. `"memory"`).
         field: &'static str,
@@ -32,7 +32,7 @@ pub enum LbfgsError {
         expected: usize,
     },
     /// An entry of the start point is NaN or infinite.
-    #[error("start point x[{index}] = {value}, expected a finite number")]
+    #[error("start point x[{index}] = {}, expected a finite number", Readable(*.value))]
     NonFiniteStart {
         /// Index of the first non-finite entry.
         index: usize,
@@ -61,4 +61,20 @@ pub(crate) fn first_non_finite(v: &[f64]) -> Option<(usize, f64)> {
         .copied()
         .enumerate()
         .find(|(_, value)| !value.is_finite())
+}
+
+/// A number for messages: plain for ordinary magnitudes, scientific notation (`1e300`) for huge or
+/// tiny ones, so that a message never carries a 300-digit decimal. (This crate depends on nothing
+/// of the planner's, so it does not use `trust_geometry::scale::Sci`.)
+struct Readable(f64);
+
+impl std::fmt::Display for Readable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if !self.0.is_finite() || a == 0.0 || (1e-6..1e6).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
 }

@@ -68,6 +68,6 @@ mod vector;
 pub use error::LbfgsError;
 pub use line_search::SplitObjective;
 pub use monitor::{Deadline, FnMonitor, Monitor, Progress, monitor_fn};
-pub use params::LbfgsParams;
+pub use params::{LbfgsParams, MAX_MEMORY, MAX_PAST};
 pub use report::{LineSearchFailure, Report, Termination};
 pub use solver::{Lbfgs, minimize};

@@ -67,11 +67,28 @@ impl Default for LbfgsParams {
     }
 }
 
+/// Largest accepted [`LbfgsParams::memory`]: the correction pairs are allocated up front.
+pub const MAX_MEMORY: usize = 1024;
+
+/// Largest accepted [`LbfgsParams::past`]: the past costs are allocated up front.
+pub const MAX_PAST: usize = 65_536;
+
 impl LbfgsParams {
     /// Checks every field's range; the error names the first offending field and its value.
     pub fn validate(&self) -> Result<(), LbfgsError> {
-        if self.memory == 0 {
-            return Err(invalid("memory", 0.0, "an integer >= 1"));
+        if self.memory == 0 || self.memory > MAX_MEMORY {
+            return Err(invalid(
+                "memory",
+                self.memory as f64,
+                "an integer in [1, 1024] (MAX_MEMORY)",
+            ));
+        }
+        if self.past > MAX_PAST {
+            return Err(invalid(
+                "past",
+                self.past as f64,
+                "an integer in [0, 65536] (MAX_PAST)",
+            ));
         }
         if self.max_linesearch == 0 {
             return Err(invalid("max_linesearch", 0.0, "an integer >= 1"));
@@ -248,7 +265,7 @@ mod tests {
         let message = params.validate().unwrap_err().to_string();
         assert_eq!(
             message,
-            "invalid LbfgsParams: memory = 0, expected an integer >= 1"
+            "invalid LbfgsParams: memory = 0, expected an integer in [1, 1024] (MAX_MEMORY)"
         );
     }
 

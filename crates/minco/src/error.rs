@@ -1,12 +1,22 @@
 //! The crate's error type.
 
 use thiserror::Error;
+use trust_core::scale::Sci;
 
 /// Everything that can go wrong in `trust-minco`: invalid input (named field, index and value) and
 /// numerical breakdown of the banded solve (reported instead of producing inf/NaN).
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum MincoError {
+    /// More pieces than [`crate::minco::MAX_PIECES`] (the storage is allocated up front).
+    #[error("piece count: got {got}, expected at most {max} (scale policy, trust_core::scale)")]
+    TooManyPieces {
+        /// The piece count that was asked for.
+        got: usize,
+        /// The cap.
+        max: usize,
+    },
+
     /// A trajectory needs at least one piece.
     #[error("piece count: got {got}, expected at least 1")]
     NoPieces {
@@ -26,7 +36,7 @@ pub enum MincoError {
     },
 
     /// A scalar input is NaN or infinite.
-    #[error("{field}[{index}] = {value}: expected a finite number")]
+    #[error("{field}[{index}] = {}: expected a finite number", Sci(*.value))]
     NonFiniteScalar {
         /// Which input.
         field: &'static str,
@@ -37,7 +47,7 @@ pub enum MincoError {
     },
 
     /// A 3-vector input has a NaN or infinite component.
-    #[error("{field}[{index}] = ({}, {}, {}): expected finite components", value[0], value[1], value[2])]
+    #[error("{field}[{index}] = ({}, {}, {}): expected finite components", Sci(value[0]), Sci(value[1]), Sci(value[2]))]
     NonFiniteVector {
         /// Which input (e.g. `"waypoints"`, `"head"`, `"tail"`; for `head`/`tail` index 0, 1, 2 is
         /// position, velocity, acceleration).
@@ -49,7 +59,7 @@ pub enum MincoError {
     },
 
     /// A piece duration is not strictly positive (or not finite).
-    #[error("durations[{index}] = {value}: expected a finite duration > 0 s")]
+    #[error("durations[{index}] = {}: expected a finite duration > 0 s", Sci(*.value))]
     InvalidDuration {
         /// Index of the piece.
         index: usize,

@@ -149,14 +149,26 @@ pub struct MincoS3 {
     solved: bool,
 }
 
+/// Largest piece count of one MINCO problem: the trajectory piece cap of the scale policy
+/// (`trust_core::scale::MAX_VERTEX_COUNT`, 100 000), so that the up-front storage (about 1.5 kB
+/// per piece) stays bounded.
+pub const MAX_PIECES: usize = trust_core::scale::MAX_VERTEX_COUNT;
+
 impl MincoS3 {
     /// Storage for `pieces` pieces (unsolved: zero coefficients, unit durations).
     ///
     /// # Errors
-    /// [`MincoError::NoPieces`] if `pieces == 0`.
+    /// [`MincoError::NoPieces`] if `pieces == 0`, [`MincoError::TooManyPieces`] above
+    /// [`MAX_PIECES`].
     pub fn new(pieces: usize) -> Result<Self, MincoError> {
         if pieces == 0 {
             return Err(MincoError::NoPieces { got: pieces });
+        }
+        if pieces > MAX_PIECES {
+            return Err(MincoError::TooManyPieces {
+                got: pieces,
+                max: MAX_PIECES,
+            });
         }
         let rows = 6 * pieces;
         Ok(Self {

@@ -177,8 +177,16 @@ const CUTTING_PLANE_ITERATIONS: usize = 200;
 
 /// Parameters `(s, t) ∈ [0, 1]²` of the closest points `p0 + s·(p1 − p0)` and `q0 + t·(q1 − q0)` of
 /// the segments `[p0, p1]` and `[q0, q1]` (clamped projection; degenerate segments allowed).
+/// Coordinates beyond `trust_geometry::scale::QUERY_LIMIT` (or non-finite) give `(0, 0)`.
 #[inline]
 pub fn segment_segment_params(p0: &Vec3, p1: &Vec3, q0: &Vec3, q1: &Vec3) -> (f64, f64) {
+    if ![p0, p1, q0, q1]
+        .iter()
+        .all(|v| trust_geometry::scale::queryable(v.as_slice()))
+    {
+        // No meaningful closest points; the segments' start points, never NaN.
+        return (0.0, 0.0);
+    }
     let d1 = p1 - p0;
     let d2 = q1 - q0;
     let r = p0 - q0;

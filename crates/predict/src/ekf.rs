@@ -28,6 +28,7 @@ use trust_geometry::Vec3;
 
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec};
 use crate::{Forecast, ObstacleShape, PredictError};
+use trust_geometry::scale::{self, Quantity};
 
 /// Parameters of [`CvEkf`] and of the growth rate it reports.
 ///
@@ -90,11 +91,15 @@ impl EkfParams {
     /// # Errors
     /// The first invalid field, with its value.
     pub fn validate(&self) -> Result<(), PredictError> {
-        check_positive("ekf.meas_std", self.meas_std)?;
-        check_non_negative("ekf.accel_psd", self.accel_psd)?;
-        check_positive("ekf.init_vel_std", self.init_vel_std)?;
-        check_non_negative("ekf.sigma_scale", self.sigma_scale)?;
-        check_non_negative("ekf.mu_min", self.mu_min)?;
+        check_positive("ekf.meas_std", self.meas_std, Quantity::PositiveLength)?;
+        check_non_negative("ekf.accel_psd", self.accel_psd, Quantity::Length)?;
+        check_positive(
+            "ekf.init_vel_std",
+            self.init_vel_std,
+            Quantity::PositiveSpeed,
+        )?;
+        check_non_negative("ekf.sigma_scale", self.sigma_scale, Quantity::Length)?;
+        check_non_negative("ekf.mu_min", self.mu_min, Quantity::Rate)?;
         Ok(())
     }
 }
@@ -126,8 +131,8 @@ impl CvEkf {
     /// [`PredictError`] for invalid parameters or non-finite `t` / `z0`.
     pub fn new(t: f64, z0: Vec3, params: EkfParams) -> Result<Self, PredictError> {
         params.validate()?;
-        check_finite("t", t)?;
-        check_vec("measurement", &z0)?;
+        check_finite("t", t, Quantity::Time)?;
+        check_vec("measurement", &z0, Quantity::Position)?;
         let mut x = Vector6::zeros();
         x.fixed_rows_mut::<3>(0).copy_from(&z0);
         let sp = params.meas_std * params.meas_std;
@@ -187,7 +192,9 @@ impl CvEkf {
     /// [`PredictError`] if `dt` is non-finite, negative, or so large that the covariance
     /// overflows; the filter is unchanged on error.
     pub fn predict(&mut self, dt: f64) -> Result<(), PredictError> {
-        check_non_negative("dt", dt)?;
+        check_non_negative("dt", dt, Quantity::Duration)?;
+        // The filter time stays inside the scale policy, which bounds the covariance's growth.
+        scale::check("filter time + dt", self.t + dt, Quantity::Time)?;
         let mut f = Matrix6::identity();
         f.fixed_view_mut::<3, 3>(0, 3)
             .copy_from(&(Matrix3::identity() * dt));
@@ -204,10 +211,16 @@ impl CvEkf {
         let x = f * self.x;
         let cov = symmetrized(&(f * self.cov * f.transpose() + qm));
         if !(x.iter().all(|e| e.is_finite()) && cov.iter().all(|e| e.is_finite())) {
-            return Err(PredictError::OutOfRange {
-                field: "dt".into(),
-                value: dt,
-                expected: "a time step small enough that the state and covariance stay finite",
+            return Err(PredictError::Derived {
+                what: "predicted state or covariance".into(),
+                value: f64::INFINITY,
+                limit: f64::MAX,
+                cause: format!(
+                    "the estimate (velocity std {}, accel_psd {}) cannot be propagated by dt = {}",
+                    scale::Sci(self.velocity_std()),
+                    scale::Sci(self.params.accel_psd),
+                    scale::Sci(dt)
+                ),
             });
         }
         self.x = x;
@@ -222,7 +235,7 @@ impl CvEkf {
     /// [`PredictError`] naming the component if `z` is non-finite; the filter is unchanged on
     /// error.
     pub fn update(&mut self, z: &Vec3) -> Result<(), PredictError> {
-        check_vec("measurement", z)?;
+        check_vec("measurement", z, Quantity::Position)?;
         let r = Matrix3::identity() * (self.params.meas_std * self.params.meas_std);
         let s = self.cov.fixed_view::<3, 3>(0, 0) + r;
         let s_inv = s
@@ -260,7 +273,7 @@ impl CvEkf {
     /// [`CvEkf::predict`] / [`CvEkf::update`]. A non-finite measurement is rejected before the
     /// filter changes.
     pub fn step(&mut self, t: f64, z: Option<Vec3>) -> Result<(), PredictError> {
-        check_finite("t", t)?;
+        check_finite("t", t, Quantity::Time)?;
         if t < self.t {
             return Err(PredictError::TimeWentBackwards {
                 t,
@@ -268,7 +281,7 @@ impl CvEkf {
             });
         }
         if let Some(z) = &z {
-            check_vec("measurement", z)?;
+            check_vec("measurement", z, Quantity::Position)?;
         }
         let saved = self.clone();
         self.predict(t - self.t)?;
@@ -293,12 +306,72 @@ impl CvEkf {
         r_o: f64,
         r_safe: f64,
     ) -> Result<Forecast, PredictError> {
-        check_non_negative("forecast.r_safe", r_safe)?;
+        check_non_negative("forecast.r_safe", r_safe, Quantity::Length)?;
         let extra = if self.params.inflate_by_position_std {
             self.params.sigma_scale * self.position_std()
         } else {
             0.0
         };
+        // Name the filter's estimate, not the forecast's fields, when the estimate is what left
+        // the scale policy.
+        let p = self.position();
+        let v = self.velocity();
+        let derived = |what: &str, value: f64, limit: f64, cause: String| {
+            Err(PredictError::Derived {
+                what: what.into(),
+                value,
+                limit,
+                cause,
+            })
+        };
+        if !scale::position_in_scale(&p) {
+            return derived(
+                "estimated position (max |component|)",
+                p.amax(),
+                scale::MAX_COORD_M,
+                "the measurements fed to the filter (and its velocity times the elapsed time) \
+                 left the map scale"
+                    .into(),
+            );
+        }
+        if !v.iter().all(|c| Quantity::Velocity.accepts(*c)) {
+            return derived(
+                "estimated velocity (max |component|)",
+                v.amax(),
+                scale::MAX_SPEED_M_S,
+                "consecutive measurements imply an obstacle speed beyond the scale policy; \
+                 check the measurements and their times"
+                    .into(),
+            );
+        }
+        let mu = self.uncertainty_rate();
+        if !Quantity::Rate.accepts(mu) {
+            return derived(
+                "uncertainty rate mu = sigma_scale·velocity_std + mu_min",
+                mu,
+                scale::MAX_SPEED_M_S,
+                format!(
+                    "ekf.sigma_scale = {}, velocity std = {} m/s, ekf.mu_min = {}",
+                    scale::Sci(self.params.sigma_scale),
+                    scale::Sci(self.velocity_std()),
+                    scale::Sci(self.params.mu_min)
+                ),
+            );
+        }
+        if !Quantity::Length.accepts(r_safe + extra) {
+            return derived(
+                "r_safe + sigma_scale·position_std",
+                r_safe + extra,
+                scale::MAX_LENGTH_M,
+                format!(
+                    "r_safe = {}, ekf.sigma_scale = {}, position std = {} m (ekf.meas_std, \
+                     ekf.accel_psd and the time since the last measurement drive it)",
+                    scale::Sci(r_safe),
+                    scale::Sci(self.params.sigma_scale),
+                    scale::Sci(self.position_std())
+                ),
+            );
+        }
         Forecast::new(
             shape,
             self.position(),

@@ -1,6 +1,7 @@
 //! The crate's error type and input checks.
 
 use trust_geometry::Vec3;
+use trust_geometry::scale::{self, CountError, Quantity, ScaleError, Sci};
 
 /// Invalid input to trust-predict. Every message names the offending field, its value and what was
 /// expected.
@@ -16,7 +17,7 @@ pub enum PredictError {
         value: f64,
     },
     /// A number was outside its valid range.
-    #[error("{field} = {value} is out of range: expected {expected}")]
+    #[error("{field} = {} is out of range: expected {expected}", Sci(*.value))]
     OutOfRange {
         /// Name of the offending field.
         field: String,
@@ -27,7 +28,11 @@ pub enum PredictError {
     },
     /// A time window `[t_start, t_end]` was empty (`t_end < t_start`) or started before the
     /// forecast time.
-    #[error("invalid time window [{t_start}, {t_end}]: expected finite t_start <= t_end{hint}")]
+    #[error(
+        "invalid time window [{}, {}]: expected finite t_start <= t_end{hint}",
+        Sci(*.t_start),
+        Sci(*.t_end)
+    )]
     InvalidWindow {
         /// Start of the window (s).
         t_start: f64,
@@ -37,7 +42,11 @@ pub enum PredictError {
         hint: String,
     },
     /// A filter step went backwards in time.
-    #[error("time {t} is before the filter time {filter_t}: expected t >= filter time")]
+    #[error(
+        "time {} is before the filter time {}: expected t >= filter time",
+        Sci(*.t),
+        Sci(*.filter_t)
+    )]
     TimeWentBackwards {
         /// The requested time (s).
         t: f64,
@@ -50,10 +59,30 @@ pub enum PredictError {
         /// What failed.
         what: String,
     },
+    /// A number outside the scale policy (`trust_geometry::scale`).
+    #[error(transparent)]
+    Scale(#[from] ScaleError),
+    /// A count above its cap (`trust_geometry::scale`).
+    #[error(transparent)]
+    Count(#[from] CountError),
+    /// A quantity computed from valid inputs left the scale policy; `cause` names the inputs that
+    /// drove it.
+    #[error("{what} = {} exceeds {}: {cause}", Sci(*.value), Sci(*.limit))]
+    Derived {
+        /// The computed quantity.
+        what: String,
+        /// Its value.
+        value: f64,
+        /// The limit it exceeded.
+        limit: f64,
+        /// Which inputs drove it, and what to change.
+        cause: String,
+    },
 }
 
-pub(crate) fn check_finite(field: &str, value: f64) -> Result<(), PredictError> {
+pub(crate) fn check_finite(field: &str, value: f64, q: Quantity) -> Result<(), PredictError> {
     if value.is_finite() {
+        scale::check(field, value, q)?;
         Ok(())
     } else {
         Err(PredictError::NonFinite {
@@ -63,7 +92,7 @@ pub(crate) fn check_finite(field: &str, value: f64) -> Result<(), PredictError> 
     }
 }
 
-pub(crate) fn check_vec(field: &str, v: &Vec3) -> Result<(), PredictError> {
+pub(crate) fn check_vec(field: &str, v: &Vec3, q: Quantity) -> Result<(), PredictError> {
     for (i, axis) in ["x", "y", "z"].into_iter().enumerate() {
         if !v[i].is_finite() {
             return Err(PredictError::NonFinite {
@@ -72,12 +101,17 @@ pub(crate) fn check_vec(field: &str, v: &Vec3) -> Result<(), PredictError> {
             });
         }
     }
+    scale::check_vec(field, v, q)?;
     Ok(())
 }
 
-pub(crate) fn check_positive(field: &str, value: f64) -> Result<(), PredictError> {
-    check_finite(field, value)?;
+/// Finite and `> 0`, then within the range of `q`.
+pub(crate) fn check_positive(field: &str, value: f64, q: Quantity) -> Result<(), PredictError> {
+    if !value.is_finite() {
+        return check_finite(field, value, q);
+    }
     if value > 0.0 {
+        scale::check(field, value, q)?;
         Ok(())
     } else {
         Err(PredictError::OutOfRange {
@@ -88,9 +122,13 @@ pub(crate) fn check_positive(field: &str, value: f64) -> Result<(), PredictError
     }
 }
 
-pub(crate) fn check_non_negative(field: &str, value: f64) -> Result<(), PredictError> {
-    check_finite(field, value)?;
+/// Finite and `>= 0`, then within the range of `q`.
+pub(crate) fn check_non_negative(field: &str, value: f64, q: Quantity) -> Result<(), PredictError> {
+    if !value.is_finite() {
+        return check_finite(field, value, q);
+    }
     if value >= 0.0 {
+        scale::check(field, value, q)?;
         Ok(())
     } else {
         Err(PredictError::OutOfRange {

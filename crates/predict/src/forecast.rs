@@ -6,6 +6,7 @@ use trust_geometry::{Aabb, Vec3, cylinder_sdf_with_size_gradient, sphere_sdf};
 
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec};
 use crate::{Pdc, PredictError};
+use trust_geometry::scale::Quantity;
 
 /// Base shape of a moving obstacle.
 ///
@@ -111,19 +112,20 @@ impl Forecast {
     /// # Errors
     /// The first violated invariant, naming the field and value.
     pub fn validate(&self) -> Result<(), PredictError> {
-        check_vec("forecast.p0", &self.p0)?;
-        check_vec("forecast.v0", &self.v0)?;
-        check_finite("forecast.t0", self.t0)?;
-        check_positive("forecast.r_o", self.r_o)?;
-        check_non_negative("forecast.r_safe", self.r_safe)?;
-        check_non_negative("forecast.mu", self.mu)?;
+        check_vec("forecast.p0", &self.p0, Quantity::Position)?;
+        check_vec("forecast.v0", &self.v0, Quantity::Velocity)?;
+        check_finite("forecast.t0", self.t0, Quantity::Time)?;
+        check_positive("forecast.r_o", self.r_o, Quantity::Length)?;
+        check_non_negative("forecast.r_safe", self.r_safe, Quantity::Length)?;
+        check_non_negative("forecast.mu", self.mu, Quantity::Rate)?;
         if let ObstacleShape::Cylinder { half_height } = self.shape {
-            check_positive("forecast.shape.half_height", half_height)?;
+            check_positive("forecast.shape.half_height", half_height, Quantity::Length)?;
         }
         Ok(())
     }
 
-    /// Obstacle centre at time `t`: `p0 + v0·(t − t0)` (also for `t < t0`).
+    /// Obstacle centre at time `t`: `p0 + v0·(t − t0)` (also for `t < t0`). Finite for every `t`
+    /// inside the scale policy (`|t| ≤ 1e7` s); a NaN `t` gives NaN (no time, no place).
     #[inline]
     pub fn center(&self, t: f64) -> Vec3 {
         self.p0 + self.v0 * (t - self.t0)
@@ -183,12 +185,20 @@ impl Forecast {
     /// `p`, `∂d/∂t = −∂d/∂p · v0 + ∂d/∂size · radius_rate(t)` (paper eq. gradients-of-Io (b): centre
     /// motion plus size growth).
     ///
+    /// A non-finite `p` or `t`, or one beyond `trust_geometry::scale::QUERY_LIMIT` (`1e90` s for
+    /// `t`), gives `(-inf, 0, 0)`: "not free".
+    ///
     /// Where `d` is not differentiable (sphere centre, cylinder axis, medial surfaces, and `t = t0`
     /// where the radius rate jumps) the gradient is a documented element of the subdifferential
     /// (see `trust_geometry::shapes`; at `t = t0` the right derivative). Add the ego term
     /// `∂d/∂p · ṗ` yourself for eq. gradients-of-Io (a).
     #[inline]
     pub fn distance_and_gradients(&self, p: &Vec3, t: f64) -> (f64, Vec3, f64) {
+        // Beyond these magnitudes (or for non-finite input) the answer is "not free", with zero
+        // gradients, as for the static map's non-finite queries.
+        if !(trust_geometry::scale::queryable(&[p.x, p.y, p.z]) && t.abs() <= 1e90) {
+            return (f64::NEG_INFINITY, Vec3::zeros(), 0.0);
+        }
         let c = self.center(t);
         let rate = self.radius_rate(t);
         let (distance, d_p, d_size) = match self.shape {
@@ -221,8 +231,8 @@ impl Forecast {
     /// # Errors
     /// [`PredictError`] if a time is non-finite or `t_a > t_b`.
     pub fn aabb_over(&self, t_a: f64, t_b: f64) -> Result<Aabb, PredictError> {
-        check_finite("t_a", t_a)?;
-        check_finite("t_b", t_b)?;
+        check_finite("t_a", t_a, Quantity::Time)?;
+        check_finite("t_b", t_b, Quantity::Time)?;
         if t_a > t_b {
             return Err(PredictError::InvalidWindow {
                 t_start: t_a,

@@ -55,6 +55,7 @@ use crate::convex::{
 };
 use crate::error::{check_finite, check_non_negative};
 use crate::{Forecast, ObstacleShape, PredictError};
+use trust_geometry::scale::Quantity;
 
 mod samples;
 
@@ -95,7 +96,7 @@ impl Pdc {
     /// # Errors
     /// [`PredictError`] if the forecast is invalid or `horizon` is non-finite or negative.
     pub fn new(forecast: &Forecast, horizon: f64) -> Result<Self, PredictError> {
-        check_non_negative("horizon", horizon)?;
+        check_non_negative("horizon", horizon, Quantity::Duration)?;
         Self::over_window(forecast, forecast.t0, forecast.t0 + horizon)
     }
 
@@ -111,8 +112,8 @@ impl Pdc {
         t_end: f64,
     ) -> Result<Self, PredictError> {
         forecast.validate()?;
-        check_finite("t_start", t_start)?;
-        check_finite("t_end", t_end)?;
+        check_finite("t_start", t_start, Quantity::Time)?;
+        check_finite("t_end", t_end, Quantity::Time)?;
         if t_end < t_start {
             return Err(PredictError::InvalidWindow {
                 t_start,
@@ -205,9 +206,13 @@ impl Pdc {
     ///
     /// Spheres: exact outside; inside negative with magnitude at most the true depth. Cylinders:
     /// the square-rim distance of the module documentation (exact in the core and away from the
-    /// rims). `p` is assumed finite.
+    /// rims). A non-finite `p`, or one beyond `trust_geometry::scale::QUERY_LIMIT`, gives
+    /// `(-inf, 0)`: "not free".
     #[inline]
     pub fn distance_and_gradient(&self, p: &Vec3) -> (f64, Vec3) {
+        if !trust_geometry::scale::queryable(&[p.x, p.y, p.z]) {
+            return (f64::NEG_INFINITY, Vec3::zeros());
+        }
         if !self.cylinder {
             return round_cone_sdf(&self.a, &self.b, self.ra, self.rb, p);
         }
@@ -304,6 +309,12 @@ impl Pdc {
     /// tests); the start centre for `d = 0` or a non-finite `d`.
     #[inline]
     pub fn support(&self, d: &Vec3) -> Vec3 {
+        // Only the direction matters: rescale so that huge components cannot overflow the norm.
+        let m = d.amax();
+        if !(m.is_finite() && m > 0.0) {
+            return self.a;
+        }
+        let d = &(d / m);
         if !self.cylinder {
             let n = d.norm();
             if n.is_nan() || n <= 0.0 {
@@ -495,6 +506,9 @@ fn norm_affine_crossings(w: &Vec3, u: &Vec3, alpha: f64, beta: f64) -> impl Iter
 /// lateral surface, cap `b`).
 #[inline]
 pub fn round_cone_sdf(a: &Vec3, b: &Vec3, ra: f64, rb: f64, p: &Vec3) -> (f64, Vec3) {
+    if !trust_geometry::scale::queryable(&[a.x, a.y, a.z, b.x, b.y, b.z, ra, rb, p.x, p.y, p.z]) {
+        return (f64::NEG_INFINITY, Vec3::zeros());
+    }
     let ab = b - a;
     let len = ab.norm();
     // One ball contains the other (or the sweep is a point): a single sphere.

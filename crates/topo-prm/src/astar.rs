@@ -56,6 +56,9 @@ pub struct SparseAStarParams {
     pub shortcut: bool,
 }
 
+/// Largest accepted [`SparseAStarParams::turn_branches`].
+pub const MAX_TURN_BRANCHES: usize = 64;
+
 impl Default for SparseAStarParams {
     fn default() -> Self {
         SparseAStarParams {
@@ -95,8 +98,12 @@ impl SparseAStarParams {
                 "a number in [0, 90]",
             ));
         }
-        if self.turn_branches == 0 {
-            return Err(PlanError::invalid("sparse_astar.turn_branches", 0, ">= 1"));
+        if self.turn_branches == 0 || self.turn_branches > MAX_TURN_BRANCHES {
+            return Err(PlanError::invalid(
+                "sparse_astar.turn_branches",
+                self.turn_branches,
+                "an integer in [1, 64] (MAX_TURN_BRANCHES; each expansion tries this many headings)",
+            ));
         }
         if self.max_expansions == 0 {
             return Err(PlanError::invalid("sparse_astar.max_expansions", 0, ">= 1"));

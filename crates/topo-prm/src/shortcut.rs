@@ -13,23 +13,28 @@ use trust_core::{Aabb, Vec3};
 use crate::visibility::Obstacles;
 
 /// Points every `step` metres along `points` (ends and vertices' segments included; at least the
-/// two ends). Non-finite or non-positive steps give the vertices.
+/// two ends). Non-finite or non-positive steps give the vertices; at most
+/// `trust_core::scale::MAX_SAMPLE_COUNT` points in all, plus one per vertex.
 pub fn discretize(points: &[Vec3], step: f64, out: &mut Vec<Vec3>) {
     out.clear();
     let Some(&first) = points.first() else {
         return;
     };
     out.push(first);
+    // Total output capped at MAX_SAMPLE_COUNT points: later segments get their end vertex only.
+    let cap = trust_core::scale::MAX_SAMPLE_COUNT;
     for w in points.windows(2) {
         let len = (w[1] - w[0]).norm();
+        let room = cap.saturating_sub(out.len()).max(1);
         let pieces = if step.is_finite() && step > 0.0 && len.is_finite() {
-            ((len / step).ceil() as usize).clamp(1, 1 << 20)
+            ((len / step).ceil() as usize).clamp(1, room)
         } else {
             1
         };
-        for k in 1..=pieces {
+        for k in 1..pieces {
             out.push(w[0] + (w[1] - w[0]) * (k as f64 / pieces as f64));
         }
+        out.push(w[1]);
     }
 }
 

@@ -23,7 +23,7 @@ pub fn straight_end(
     reach: f64,
 ) -> trust_core::Vec3 {
     let d = (goal - start).norm();
-    if d.is_nan() || d <= reach || d <= 0.0 {
+    if !d.is_finite() || !reach.is_finite() || d <= reach || d <= 0.0 {
         *goal
     } else {
         start + (goal - start) * (reach / d)

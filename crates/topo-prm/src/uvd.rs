@@ -24,7 +24,46 @@ use crate::gjk::{Hull, separated_along};
 use crate::visibility::{Obstacles, forecast_cones};
 
 /// Upper bound on the resampled point count (guards against a tiny resolution on a huge curve).
-pub const MAX_POINTS: usize = 1 << 20;
+/// The validating entry points ([`equivalent`], [`Uvd`]'s [`HomotopyChecker::equivalent`]) reject
+/// curves that would need more ([`check_curves`]); the unchecked ones clamp to it.
+pub const MAX_POINTS: usize = 1 << 14;
+
+/// Checks two curves before a UVD comparison: both have points, finite lengths, and need at
+/// most [`MAX_POINTS`] matched points at `resolution`. Returns that point count.
+///
+/// # Errors
+/// [`PlanError::InvalidInput`] naming the empty or non-finite curve, [`PlanError::Count`] when the
+/// longer curve divided by `resolution` exceeds [`MAX_POINTS`] (a coarser resolution or a shorter
+/// curve is needed).
+pub fn check_curves(a: &dyn Curve, b: &dyn Curve, resolution: f64) -> Result<usize, PlanError> {
+    check_positive("uvd.resolution", resolution)?;
+    let mut probe = Vec::new();
+    for (name, c) in [("a", a), ("b", b)] {
+        c.resample_by_arc_length(2, &mut probe);
+        if probe.is_empty() {
+            return Err(PlanError::invalid(
+                format!("uvd curve {name}"),
+                "no points",
+                "a curve with at least one point",
+            ));
+        }
+        let len = c.length();
+        if !len.is_finite() || probe.iter().any(|p| !p.iter().all(|x| x.is_finite())) {
+            return Err(PlanError::invalid(
+                format!("uvd curve {name} length"),
+                len,
+                "a curve with finite points and length",
+            ));
+        }
+    }
+    let needed = (a.length().max(b.length()) / resolution).ceil() + 1.0;
+    trust_core::scale::check_count(
+        "uvd matched points (curve length / uvd.resolution)",
+        needed.min(1e30) as u128,
+        MAX_POINTS,
+    )?;
+    Ok(point_count(a.length(), b.length(), resolution))
+}
 
 /// A borrowed polyline, so that slices of points can be compared without building a
 /// [`trust_core::GuidePath`].
@@ -165,7 +204,7 @@ pub fn equivalent(
     resolution: f64,
     visible: impl FnMut(&Vec3, &Vec3) -> bool,
 ) -> Result<bool, PlanError> {
-    check_positive("uvd.resolution", resolution)?;
+    check_curves(a, b, resolution)?;
     Ok(equivalent_with(
         a,
         b,
@@ -772,6 +811,7 @@ impl HomotopyChecker for Uvd {
         scene: &Scene<'_>,
     ) -> Result<bool, PlanError> {
         self.params.validate()?;
+        check_curves(a, b, self.params.resolution)?;
         let obs = self.obstacles(a, b, scene)?;
         Ok(equivalent_among(
             &obs,

@@ -1,7 +1,7 @@
 //! Initial guesses: piece count, waypoints, terminal state and total duration from a guide path
 //! or from a previous trajectory (warm start).
 
-use trust_core::{GuidePath, InitialGuess, Limits, PolyTraj, State, Vec3};
+use trust_core::{GuidePath, InitialGuess, Limits, PlanError, PolyTraj, State, Vec3};
 
 use super::params::PieceParams;
 
@@ -19,6 +19,42 @@ pub struct InitialTrajectory {
 }
 
 impl InitialTrajectory {
+    /// Checks that the initial duration is inside the scale policy (`≤ 1e7` s) and otherwise
+    /// names what drove it: the guide's length over the speed and acceleration limits (or the
+    /// warm start's remaining time). Without this, tiny limits surfaced as an infinite cost at the
+    /// start point that named nothing.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] naming `limits.v_max` / `limits.a_max` and the guide length.
+    pub fn check_duration(
+        &self,
+        guess: &InitialGuess<'_>,
+        limits: &Limits,
+    ) -> Result<(), PlanError> {
+        let t = self.total_duration;
+        if t.is_finite() && t <= trust_core::scale::MAX_TIME_S {
+            return Ok(());
+        }
+        let sci = trust_core::scale::Sci;
+        Err(match guess {
+            InitialGuess::Guide(path) => PlanError::invalid(
+                "limits.v_max / limits.a_max",
+                format!("{} m/s, {} m/s²", sci(limits.v_max), sci(limits.a_max)),
+                format!(
+                    "limits under which the {} m guide takes at most {} s (it takes {} s)",
+                    sci(path.length()),
+                    sci(trust_core::scale::MAX_TIME_S),
+                    sci(t)
+                ),
+            ),
+            InitialGuess::WarmStart(_) => PlanError::invalid(
+                "request.initial (warm start) remaining duration",
+                sci(t).to_string(),
+                format!("at most {} s", sci(trust_core::scale::MAX_TIME_S)),
+            ),
+        })
+    }
+
     /// Number of pieces `n`.
     pub fn pieces(&self) -> usize {
         self.waypoints.len() + 1

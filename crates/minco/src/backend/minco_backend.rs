@@ -45,6 +45,7 @@ impl TrajectoryBackend for Minco {
         validate_request(req, scene)?;
         let p = &self.params;
         let init = initial_trajectory(&req.initial, &req.start, &req.limits, &p.pieces);
+        init.check_duration(&req.initial, &req.limits)?;
         let n = init.pieces();
         let mut f = MincoObjective::new(
             scene,

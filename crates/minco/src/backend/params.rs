@@ -60,6 +60,16 @@ impl PieceParams {
                 "an integer >= 1",
             ));
         }
+        if self.max_pieces > crate::minco::MAX_PIECES {
+            return Err(PlanError::invalid(
+                format!("{prefix}.max_pieces"),
+                self.max_pieces,
+                format!(
+                    "an integer <= {} (minco::MAX_PIECES)",
+                    crate::minco::MAX_PIECES
+                ),
+            ));
+        }
         if self.max_pieces < self.min_pieces {
             return Err(PlanError::invalid(
                 format!("{prefix}.max_pieces"),

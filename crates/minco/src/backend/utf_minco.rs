@@ -64,6 +64,7 @@ impl TrajectoryBackend for UtfMinco {
         validate_request(req, scene)?;
         let p = &self.params;
         let init = initial_trajectory(&req.initial, &req.start, &req.limits, &p.pieces);
+        init.check_duration(&req.initial, &req.limits)?;
         let mut f =
             UtfMincoObjective::new(scene, &req.start, req.goal, req.limits, p, init.pieces())?;
         if let Some(horizon) = req.horizon_s {

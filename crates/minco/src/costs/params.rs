@@ -120,11 +120,11 @@ impl Default for PenaltyParams {
 impl PenaltyParams {
     /// Checks every field; the error names `{prefix}.{field}`.
     pub fn validate(&self, prefix: &str) -> Result<(), PlanError> {
-        if self.samples_per_piece == 0 {
+        if self.samples_per_piece == 0 || self.samples_per_piece > 1024 {
             return Err(PlanError::invalid(
                 format!("{prefix}.samples_per_piece"),
                 self.samples_per_piece,
-                "an integer >= 1",
+                "an integer in [1, 1024] (node tables are allocated per piece)",
             ));
         }
         check_positive(&format!("{prefix}.smoothing"), self.smoothing)?;

@@ -65,14 +65,22 @@ fn check_energy_inputs(coeffs: &[Vector3<f64>], durations: &[f64]) -> Result<(),
 ///
 /// # Errors
 /// [`MincoError::LengthMismatch`] if `coeffs.len() != 6 · durations.len()`;
-/// [`MincoError::InvalidDuration`] / [`MincoError::NonFiniteVector`] on invalid numbers.
+/// [`MincoError::InvalidDuration`] / [`MincoError::NonFiniteVector`] on invalid numbers;
+/// [`MincoError::NonFiniteResult`] naming the first piece whose energy overflows f64.
 pub fn jerk_energy(coeffs: &[Vector3<f64>], durations: &[f64]) -> Result<f64, MincoError> {
     check_energy_inputs(coeffs, durations)?;
-    Ok(coeffs
-        .chunks_exact(6)
-        .zip(durations)
-        .map(|(c, &t)| piece_energy_pw(c, &powers(t)))
-        .sum())
+    let mut total = 0.0;
+    for (i, (c, &t)) in coeffs.chunks_exact(6).zip(durations).enumerate() {
+        total += piece_energy_pw(c, &powers(t));
+        if !total.is_finite() {
+            // Name the piece whose coefficients and duration overflowed the energy.
+            return Err(MincoError::NonFiniteResult {
+                field: "jerk energy (coeffs and durations of this piece)",
+                index: i,
+            });
+        }
+    }
+    Ok(total)
 }
 
 /// Adds `weight · ∂E/∂c` to `grad_c` (6 rows per piece) and `weight · ∂E/∂T_i` (explicit part,

@@ -50,7 +50,8 @@ impl EvalInput {
     /// Solves the problem and computes the energy and its gradients.
     ///
     /// # Errors
-    /// [`MincoError::NoPieces`] for empty `durations`, otherwise as [`MincoS3::solve`] and
+    /// [`MincoError::NoPieces`] for empty `durations`, [`MincoError::TooManyPieces`] for more than
+    /// [`crate::minco::MAX_PIECES`], otherwise as [`MincoS3::solve`] and
     /// [`MincoS3::energy_and_grad`].
     pub fn evaluate(&self) -> Result<EvalOutput, MincoError> {
         let n = self.durations.len();

@@ -5,6 +5,7 @@ use trust_geometry::{Aabb, Vec3};
 use super::{Pdc, frame_along};
 use crate::PredictError;
 use crate::error::check_non_negative;
+use trust_geometry::scale::{self, Quantity};
 
 impl Pdc {
     /// Obstacle-aware samples (paper Sec. III-B): points at signed distance `margin` outside the
@@ -57,15 +58,14 @@ impl Pdc {
         region: &Aabb,
         out: &mut Vec<Vec3>,
     ) -> Result<(), PredictError> {
-        check_non_negative("margin", margin)?;
-        let candidates_per_slice = per_slice
-            .checked_mul(4)
-            .and_then(|n| slices.checked_mul(per_slice).map(|_| n))
-            .ok_or(PredictError::OutOfRange {
-                field: "slices * per_slice".into(),
-                value: slices as f64 * per_slice as f64,
-                expected: "a number of candidates that fits in usize",
-            })?;
+        check_non_negative("margin", margin, Quantity::Length)?;
+        scale::check_count(
+            "slices * per_slice",
+            slices as u128 * per_slice as u128,
+            scale::MAX_SOLVED_SAMPLE_COUNT,
+        )?;
+        // At most 4 · MAX_SOLVED_SAMPLE_COUNT: no overflow.
+        let candidates_per_slice = per_slice * 4;
         if slices == 0 || per_slice == 0 {
             return Ok(());
         }

@@ -1,0 +1,275 @@
+//! `trust-fuzz`: throws random, adversarial and boundary inputs at every public entry point of the
+//! TRUST-Planner library crates and reports, per API, calls, typed errors, panics, non-finite
+//! outputs, wrong answers (oracle violations) and slow calls. Exits non-zero if anything but
+//! ordinary results and typed errors occurred. Run it through `cargo xtask fuzz`.
+//!
+//! Every call runs under `catch_unwind` on a worker thread; a watchdog on the main thread stops
+//! the run (exit code 3) when one call exceeds `--hang-ms`, printing the API and the case seed.
+//! Each case is reproducible alone: `trust-fuzz --only <api> --replay <case seed>`.
+
+mod apis;
+mod inputs;
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use anyhow::Result;
+use clap::Parser;
+
+use apis::{Api, Fixtures, Outcome};
+use inputs::Gen;
+
+#[derive(Parser, Debug)]
+#[command(about = "Adversarial-input fuzzing of every public TRUST-Planner API")]
+struct Args {
+    /// Total number of calls, shared among the APIs by weight.
+    #[arg(long, default_value_t = 1_000_000)]
+    cases: u64,
+    /// Seed of the whole run.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// A call slower than this is reported as slow (ms).
+    #[arg(long, default_value_t = 1000)]
+    slow_ms: u64,
+    /// A call slower than this stops the run as a hang (ms).
+    #[arg(long, default_value_t = 20_000)]
+    hang_ms: u64,
+    /// Only run APIs whose name contains this.
+    #[arg(long)]
+    only: Option<String>,
+    /// Replay one case seed (with --only) and print its outcome.
+    #[arg(long)]
+    replay: Option<u64>,
+    /// How many failing case seeds to print per API.
+    #[arg(long, default_value_t = 3)]
+    show: usize,
+}
+
+#[derive(Default, Clone)]
+struct Stats {
+    calls: u64,
+    errors: u64,
+    panics: u64,
+    non_finite: u64,
+    wrong: u64,
+    slow: u64,
+    max_ms: f64,
+    examples: Vec<String>,
+}
+
+/// What the watchdog sees: the running call's API index, case seed and start (µs since run start).
+struct Current {
+    api: AtomicUsize,
+    case: AtomicU64,
+    started_us: AtomicU64,
+    busy: AtomicBool,
+}
+
+fn case_seed(run_seed: u64, api: usize, k: u64) -> u64 {
+    // SplitMix64 of the triple: independent, reproducible case seeds.
+    let mut z = run_seed
+        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        .wrapping_add((api as u64) << 40)
+        .wrapping_add(k);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+fn run_one(api: &Api, fx: &Fixtures, seed: u64) -> (std::thread::Result<Outcome>, f64) {
+    let mut g = Gen::new(seed);
+    let t0 = Instant::now();
+    let out = catch_unwind(AssertUnwindSafe(|| (api.run)(&mut g, fx)));
+    (out, t0.elapsed().as_secs_f64() * 1e3)
+}
+
+fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = p.downcast_ref::<&str>() {
+        (*s).to_owned()
+    } else if let Some(s) = p.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "non-string panic payload".to_owned()
+    }
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse();
+    // Panics are counted, not printed one by one.
+    std::panic::set_hook(Box::new(|_| {}));
+    let fx = Fixtures::new()?;
+    let apis: Vec<Api> = apis::all()
+        .into_iter()
+        .filter(|a| {
+            args.only
+                .as_ref()
+                .is_none_or(|o| a.name.contains(o.as_str()))
+        })
+        .collect();
+    anyhow::ensure!(!apis.is_empty(), "no API matches --only");
+
+    if let Some(seed) = args.replay {
+        for api in &apis {
+            let (out, ms) = run_one(api, &fx, seed);
+            match out {
+                Ok(o) => println!("{}: {o:?} in {ms:.3} ms", api.name),
+                Err(p) => println!("{}: PANIC {} in {ms:.3} ms", api.name, panic_message(&*p)),
+            }
+        }
+        return Ok(());
+    }
+
+    let total_weight: u64 = apis.iter().map(|a| u64::from(a.weight)).sum();
+    let calls_per_api: Vec<u64> = apis
+        .iter()
+        .map(|a| (args.cases * u64::from(a.weight) / total_weight).max(1))
+        .collect();
+    let names: Vec<&'static str> = apis.iter().map(|a| a.name).collect();
+    let current = Arc::new(Current {
+        api: AtomicUsize::new(0),
+        case: AtomicU64::new(0),
+        started_us: AtomicU64::new(0),
+        busy: AtomicBool::new(false),
+    });
+    let stats = Arc::new(Mutex::new(vec![Stats::default(); apis.len()]));
+    let run_start = Instant::now();
+    let done = Arc::new(AtomicBool::new(false));
+
+    let worker = {
+        let current = Arc::clone(&current);
+        let stats = Arc::clone(&stats);
+        let done = Arc::clone(&done);
+        let (seed, slow_ms, show) = (args.seed, args.slow_ms as f64, args.show);
+        std::thread::Builder::new()
+            .name("fuzz-worker".into())
+            .stack_size(64 << 20)
+            .spawn(move || {
+                for (i, api) in apis.iter().enumerate() {
+                    let mut s = Stats::default();
+                    for k in 0..calls_per_api[i] {
+                        let cs = case_seed(seed, i, k);
+                        current.api.store(i, Ordering::SeqCst);
+                        current.case.store(cs, Ordering::SeqCst);
+                        current
+                            .started_us
+                            .store(run_start.elapsed().as_micros() as u64, Ordering::SeqCst);
+                        current.busy.store(true, Ordering::SeqCst);
+                        let (out, ms) = run_one(api, &fx, cs);
+                        current.busy.store(false, Ordering::SeqCst);
+                        s.calls += 1;
+                        s.max_ms = s.max_ms.max(ms);
+                        let note = |s: &mut Stats, what: String| {
+                            if s.examples.len() < show {
+                                s.examples.push(format!("case {cs}: {what}"));
+                            }
+                        };
+                        if ms > slow_ms {
+                            s.slow += 1;
+                            note(&mut s, format!("slow ({ms:.0} ms)"));
+                        }
+                        match out {
+                            Ok(Outcome::Ok) => {}
+                            Ok(Outcome::Err) => s.errors += 1,
+                            Ok(Outcome::NonFinite(m)) => {
+                                s.non_finite += 1;
+                                note(&mut s, format!("non-finite: {m}"));
+                            }
+                            Ok(Outcome::Wrong(m)) => {
+                                s.wrong += 1;
+                                note(&mut s, format!("wrong: {m}"));
+                            }
+                            Err(p) => {
+                                s.panics += 1;
+                                note(&mut s, format!("panic: {}", panic_message(&*p)));
+                            }
+                        }
+                    }
+                    stats.lock().map(|mut v| v[i] = s).ok();
+                }
+                done.store(true, Ordering::SeqCst);
+            })?
+    };
+
+    // Watchdog.
+    let hang_us = args.hang_ms * 1000;
+    while !done.load(Ordering::SeqCst) {
+        std::thread::sleep(Duration::from_millis(100));
+        if current.busy.load(Ordering::SeqCst) {
+            let started = current.started_us.load(Ordering::SeqCst);
+            let now = run_start.elapsed().as_micros() as u64;
+            if now.saturating_sub(started) > hang_us && current.busy.load(Ordering::SeqCst) {
+                let api = names[current.api.load(Ordering::SeqCst)];
+                let case = current.case.load(Ordering::SeqCst);
+                println!(
+                    "HANG: {api} case {case} has run for more than {} ms \
+                     (replay: trust-fuzz --only '{api}' --replay {case})",
+                    args.hang_ms
+                );
+                if let Ok(stats) = stats.lock() {
+                    print_table(&names, &stats, args.seed, run_start);
+                }
+                std::process::exit(3);
+            }
+        }
+    }
+    worker
+        .join()
+        .map_err(|_| anyhow::anyhow!("worker thread died"))?;
+
+    let stats = stats.lock().map_err(|_| anyhow::anyhow!("poisoned"))?;
+    let bad = print_table(&names, &stats, args.seed, run_start);
+    if bad > 0 {
+        println!("FAIL: {bad} calls panicked, returned non-finite or wrong output, or were slow");
+        std::process::exit(1);
+    }
+    println!("OK: 0 panics, 0 hangs, 0 non-finite outputs, 0 wrong answers, 0 slow calls");
+    Ok(())
+}
+
+/// Prints the per-API table and the failing examples; returns the number of bad calls.
+fn print_table(names: &[&str], stats: &[Stats], seed: u64, run_start: Instant) -> u64 {
+    println!(
+        "{:<38} {:>9} {:>9} {:>7} {:>10} {:>6} {:>6} {:>9}",
+        "api", "calls", "errors", "panics", "non-finite", "wrong", "slow", "max ms"
+    );
+    let mut bad = 0u64;
+    let mut total = Stats::default();
+    for (name, s) in names.iter().zip(stats.iter()) {
+        println!(
+            "{:<38} {:>9} {:>9} {:>7} {:>10} {:>6} {:>6} {:>9.1}",
+            name, s.calls, s.errors, s.panics, s.non_finite, s.wrong, s.slow, s.max_ms
+        );
+        total.calls += s.calls;
+        total.errors += s.errors;
+        total.panics += s.panics;
+        total.non_finite += s.non_finite;
+        total.wrong += s.wrong;
+        total.slow += s.slow;
+        total.max_ms = total.max_ms.max(s.max_ms);
+        bad += s.panics + s.non_finite + s.wrong + s.slow;
+    }
+    println!(
+        "{:<38} {:>9} {:>9} {:>7} {:>10} {:>6} {:>6} {:>9.1}",
+        "TOTAL",
+        total.calls,
+        total.errors,
+        total.panics,
+        total.non_finite,
+        total.wrong,
+        total.slow,
+        total.max_ms
+    );
+    println!(
+        "seed {}, {:.1} s wall",
+        seed,
+        run_start.elapsed().as_secs_f64()
+    );
+    for (name, s) in names.iter().zip(stats.iter()) {
+        for e in &s.examples {
+            println!("  {name}: {e}");
+        }
+    }
+    bad
+}
