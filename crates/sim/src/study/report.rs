@@ -25,10 +25,10 @@ pub struct PaperNumbers {
     pub cpu_ms_per_trajectory: Option<f64>,
 }
 
-/// What the paper's text says about `planner` in E4.
-pub fn paper_numbers(planner: &str) -> PaperNumbers {
-    match planner {
-        "trust" => PaperNumbers {
+/// What the paper's text says about `planner` in `scenario` (only E4 has paper numbers).
+pub fn paper_numbers(scenario: &str, planner: &str) -> PaperNumbers {
+    match (scenario, planner) {
+        ("e4", "trust") => PaperNumbers {
             success_rate: Some(0.96),
             flight_time_s: Some(29.4),
             cpu_ms_per_trajectory: Some(10.0),
@@ -92,8 +92,8 @@ pub struct StudySummary {
     pub planners: Vec<PlannerSummary>,
 }
 
-/// Summarizes the rows of one planner.
-pub fn summarize(planner: &str, rows: &[&RunRow]) -> PlannerSummary {
+/// Summarizes the rows of one planner in a study of `scenario`.
+pub fn summarize(scenario: &str, planner: &str, rows: &[&RunRow]) -> PlannerSummary {
     let count = |status: &str| rows.iter().filter(|r| r.status == status).count();
     let arrived: Vec<&&RunRow> = rows.iter().filter(|r| r.status == "arrived").collect();
     let collided = count("collided");
@@ -125,7 +125,7 @@ pub fn summarize(planner: &str, rows: &[&RunRow]) -> PlannerSummary {
         ),
         cycle_ms_median: median(&rows.iter().map(|r| r.cycle_ms_median).collect::<Vec<_>>()),
         cycle_ms_p99: median(&rows.iter().map(|r| r.cycle_ms_p99).collect::<Vec<_>>()),
-        paper: paper_numbers(planner),
+        paper: paper_numbers(scenario, planner),
     }
 }
 
@@ -136,7 +136,7 @@ pub fn summary(config: &StudyConfig, rows: &[RunRow], out: &Path) -> StudySummar
         .iter()
         .map(|p| {
             let mine: Vec<&RunRow> = rows.iter().filter(|r| r.planner == p.name()).collect();
-            summarize(p.name(), &mine)
+            summarize(&config.scenario_name, p.name(), &mine)
         })
         .collect();
     let ideal = rows
@@ -224,7 +224,8 @@ pub fn report_md(s: &StudySummary) -> String {
             p.paper.cpu_ms_per_trajectory,
         ) {
             (Some(r), Some(t), Some(c)) => format!("{}, {t} s, ~{c} ms", pct(r)),
-            _ => "below ours (figure only)".to_string(),
+            _ if c.scenario_name == "e4" => "below ours (figure only)".to_string(),
+            _ => "–".to_string(),
         };
         let _ = writeln!(
             md,

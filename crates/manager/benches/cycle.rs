@@ -1,0 +1,182 @@
+//! One full warm planning cycle of TRUST-Planner (DEV-PRM + UTF-MINCO + TVD, N = 5) on an
+//! E4-like snapshot: a 250 × 75 × 20 m slice with 320 analytic static obstacles (pillars and
+//! blocks; the study's point-cloud ESDF is measured by `trust-sim ablate` instead) and 100 moving
+//! obstacles (spheres and cylinders, 0.5–2.5 m/s).
+//!
+//! The manager flies along its own plan: each iteration is the next cycle, 0.1 s later, with the
+//! forecasts re-based to that time; every 150 cycles (15 s of flight) it starts over from a reset,
+//! so one iteration in 150 is a cold cycle. Before measuring, the bench prints the mean split of
+//! a cycle into frontend / backend / checker time over 150 cycles (the backend time is summed over
+//! the parallel solves, so the three can exceed the wall time).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use rand::{Rng as _, SeedableRng};
+use trust_core::{Aabb, Forecast, Limits, ObstacleShape, Rng, Scene, State, StaticMap, Vec3};
+use trust_geometry::{AaBox, Cylinder, Shape};
+use trust_manager::{Manager, ManagerParams};
+use trust_minco::UtfMinco;
+use trust_topo_prm::{DevPrm, DevPrmParams, Tvd};
+
+struct Obstacle {
+    p0: Vec3,
+    v: Vec3,
+    shape: ObstacleShape,
+    r: f64,
+}
+
+fn world(seed: u64) -> (StaticMap, Vec<Obstacle>) {
+    let mut rng = Rng::seed_from_u64(seed);
+    let bounds = Aabb::new(Vec3::zeros(), Vec3::new(250.0, 75.0, 20.0)).expect("bounds");
+    let mut shapes = Vec::new();
+    for _ in 0..280 {
+        let (x, y): (f64, f64) = (rng.random_range(15.0..235.0), rng.random_range(0.0..75.0));
+        let r = rng.random_range(0.4..1.2);
+        shapes.push(Shape::Cylinder(
+            Cylinder::new(Vec3::new(x, y, 10.0), r, 10.0).expect("cylinder"),
+        ));
+    }
+    for _ in 0..40 {
+        let (x, y) = (rng.random_range(15.0..235.0), rng.random_range(0.0..72.0));
+        let (w, l, h) = (
+            rng.random_range(1.0..4.0),
+            rng.random_range(1.0..4.0),
+            rng.random_range(3.0..12.0),
+        );
+        shapes.push(Shape::AaBox(
+            AaBox::new(Vec3::new(x, y, 0.0), Vec3::new(x + w, y + l, h)).expect("box"),
+        ));
+    }
+    let map = StaticMap::from_shapes(bounds, shapes).expect("map");
+    let obstacles = (0..100)
+        .map(|_| {
+            let dir = rng.random_range(0.0..std::f64::consts::TAU);
+            let speed = rng.random_range(0.5..2.5);
+            let cylinder = rng.random_bool(0.5);
+            Obstacle {
+                p0: Vec3::new(
+                    rng.random_range(15.0..235.0),
+                    rng.random_range(0.0..75.0),
+                    rng.random_range(2.0..10.0),
+                ),
+                v: Vec3::new(dir.cos() * speed, dir.sin() * speed, 0.0),
+                shape: if cylinder {
+                    ObstacleShape::Cylinder { half_height: 1.5 }
+                } else {
+                    ObstacleShape::Sphere
+                },
+                r: rng.random_range(0.3..1.0),
+            }
+        })
+        .collect();
+    (map, obstacles)
+}
+
+fn forecasts(obstacles: &[Obstacle], t: f64) -> Vec<Forecast> {
+    obstacles
+        .iter()
+        .map(|o| Forecast::new(o.shape, o.p0 + o.v * t, o.v, t, o.r, 0.4, 0.1).expect("forecast"))
+        .collect()
+}
+
+type Planner = Manager<DevPrm, UtfMinco, Tvd>;
+
+fn planner() -> Planner {
+    let mut params = ManagerParams::trust();
+    params.enforce_budget = false;
+    let mut backend = trust_minco::UtfMincoParams::default();
+    backend.penalty.static_clearance_m = 0.5;
+    params.safety.static_clearance_m = 0.3;
+    Manager::new(
+        DevPrm::new(DevPrmParams {
+            clearance: 0.3,
+            ..DevPrmParams::default()
+        })
+        .expect("devprm"),
+        UtfMinco::new(backend).expect("utf-minco"),
+        Tvd::default(),
+        Limits::new(10.0, 15.0).expect("limits"),
+        params,
+    )
+    .expect("manager")
+}
+
+/// The flying snapshot: one `cycle()` is the next planning cycle.
+struct Flight {
+    manager: Planner,
+    map: StaticMap,
+    obstacles: Vec<Obstacle>,
+    state: State,
+    cycles: usize,
+}
+
+impl Flight {
+    fn new() -> Self {
+        let (map, obstacles) = world(3);
+        Flight {
+            manager: planner(),
+            map,
+            obstacles,
+            state: State::at_rest(0.0, Vec3::new(2.0, 37.5, 5.0)),
+            cycles: 0,
+        }
+    }
+
+    /// One cycle; returns (frontend, backend, checker) ms.
+    fn cycle(&mut self) -> (f64, f64, f64) {
+        if self.cycles == 150 {
+            self.manager.reset();
+            self.state = State::at_rest(0.0, Vec3::new(2.0, 37.5, 5.0));
+            self.cycles = 0;
+        }
+        let t = self.state.t;
+        let f = forecasts(&self.obstacles, t);
+        let scene = Scene::new(&self.map, &f, t).expect("scene");
+        let goal = Vec3::new(248.0, 37.5, 5.0);
+        let report = self
+            .manager
+            .step(t, &self.state, &goal, &scene)
+            .expect("step");
+        let next = t + 0.1;
+        self.state = match self.manager.plan() {
+            Some(plan) => {
+                let mut s = plan.state(next.min(plan.t_end()));
+                s.t = next;
+                s
+            }
+            None => State::at_rest(next, self.state.p),
+        };
+        self.cycles += 1;
+        let timing = &report.timing;
+        (timing.frontend_ms, timing.backend_ms, timing.checker_ms)
+    }
+}
+
+fn bench_cycle(c: &mut Criterion) {
+    let mut flight = Flight::new();
+    let (mut f, mut b, mut k) = (0.0, 0.0, 0.0);
+    let n = 150;
+    for _ in 0..n {
+        let (a, bb, cc) = flight.cycle();
+        f += a;
+        b += bb;
+        k += cc;
+    }
+    let n = n as f64;
+    eprintln!(
+        "E4-like warm cycle, mean over {n} cycles: frontend {:.3} ms, backend {:.3} ms (summed over \
+         parallel solves), checker {:.3} ms",
+        f / n,
+        b / n,
+        k / n
+    );
+    c.bench_function("manager_cycle_e4_like_n5", |bench| {
+        bench.iter(|| flight.cycle())
+    });
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(30);
+    targets = bench_cycle
+}
+criterion_main!(benches);
