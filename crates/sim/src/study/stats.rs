@@ -44,8 +44,17 @@ pub fn wilson(k: usize, n: usize) -> Rate {
         k,
         n,
         rate: p,
-        ci95_low: (center - half).max(0.0),
-        ci95_high: (center + half).min(1.0),
+        // Exact at the ends (the formula gives 0 and 1 there up to rounding).
+        ci95_low: if k == 0 {
+            0.0
+        } else {
+            (center - half).max(0.0)
+        },
+        ci95_high: if k >= n {
+            1.0
+        } else {
+            (center + half).min(1.0)
+        },
     }
 }
 
