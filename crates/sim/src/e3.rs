@@ -17,7 +17,7 @@ use trust_core::{Scene, State};
 use crate::error::SimError;
 use crate::flight_plots::PLANNER_COLORS;
 use crate::planner;
-use crate::plot::{Bounds, Color, Figure, ForecastRings, MapView, Marker, Plane, Polyline};
+use crate::plot::{Figure, ForecastRings, Marker, Plane, Polyline};
 use crate::scenario::Scenario;
 use crate::study::{create_dir, write_json, write_text};
 use crate::world::World;
@@ -128,24 +128,15 @@ pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, SimError> {
 
     // Top view: the static shapes, the forecasts over the horizon, the branches.
     let plane = Plane::Xy;
-    let b = world.bounds();
-    let mut view = MapView::new(
-        format!(
+    let mut view = crate::flight_plots::base_view(
+        &crate::run::header(&world, &resolved.label, None),
+        plane,
+        &format!(
             "E3 (seed {}): {} branches of one cold cycle over the forecasts",
             summary.seed,
             summary.branches.len()
         ),
-        Bounds::new(plane.project(&b.min), plane.project(&b.max)),
-    )
-    .plane(plane)
-    .axis_labels("x [m]", "y [m]")
-    .shapes(
-        crate::run::header(&world, &resolved.label, None)
-            .static_shapes
-            .iter()
-            .map(|s| crate::flight_plots::static_shape(plane, s)),
-    )
-    .shape_style(Color::rgb(150, 150, 150), "static obstacles");
+    );
     let horizon = manager.params().horizon_s;
     for f in &forecasts {
         let rings: Vec<(Point2<f64>, f64)> = (0..=4)

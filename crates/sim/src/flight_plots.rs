@@ -62,6 +62,18 @@ pub fn static_shape(plane: Plane, s: &StaticShape) -> Shape {
     }
 }
 
+/// The map of a run log's world on `plane`: bounds, axis labels and the true static shapes.
+pub(crate) fn base_view(header: &Header, plane: Plane, title: &str) -> MapView {
+    let lo = plane.project(&p3(&header.bounds.min));
+    let hi = plane.project(&p3(&header.bounds.max));
+    let (xl, yl) = plane.axis_labels();
+    MapView::new(title, Bounds::new(lo, hi))
+        .plane(plane)
+        .axis_labels(xl, yl)
+        .shapes(header.static_shapes.iter().map(|s| static_shape(plane, s)))
+        .shape_style(Color::rgb(150, 150, 150), "static obstacles")
+}
+
 fn view(
     header: &Header,
     record: &FlightRecord,
@@ -69,14 +81,7 @@ fn view(
     plane: Plane,
     title: &str,
 ) -> MapView {
-    let lo = plane.project(&p3(&header.bounds.min));
-    let hi = plane.project(&p3(&header.bounds.max));
-    let (xl, yl) = plane.axis_labels();
-    let mut v = MapView::new(title, Bounds::new(lo, hi))
-        .plane(plane)
-        .axis_labels(xl, yl)
-        .shapes(header.static_shapes.iter().map(|s| static_shape(plane, s)))
-        .shape_style(Color::rgb(150, 150, 150), "static obstacles");
+    let mut v = base_view(header, plane, title);
     if let Some(points) = cloud {
         let stride = points.len().div_ceil(MAX_CLOUD_POINTS).max(1);
         let pts = points
@@ -246,14 +251,7 @@ pub fn write_comparison_view(
     flights: &[(String, &[StateRecord])],
 ) -> Result<Written, PlotError> {
     let plane = Plane::Xy;
-    let lo = plane.project(&p3(&header.bounds.min));
-    let hi = plane.project(&p3(&header.bounds.max));
-    let (xl, yl) = plane.axis_labels();
-    let mut v = MapView::new(title, Bounds::new(lo, hi))
-        .plane(plane)
-        .axis_labels(xl, yl)
-        .shapes(header.static_shapes.iter().map(|s| static_shape(plane, s)))
-        .shape_style(Color::rgb(150, 150, 150), "static obstacles");
+    let mut v = base_view(header, plane, title);
     if let Some((_, states)) = flights.first() {
         let n = header.obstacles.len();
         if n > 0 {
