@@ -418,9 +418,10 @@ impl Esdf {
         }
     }
 
-    /// Interpolated signed distance at `p`; see [`Esdf::distance_and_gradient`].
+    /// Interpolated signed distance at `p`; see [`Esdf::distance_and_gradient`]. The same value,
+    /// without computing the gradient (line-of-sight tests call this in their inner loop).
     pub fn signed_distance(&self, p: &Vec3) -> f64 {
-        self.distance_and_gradient(p).0
+        self.interpolate::<false>(p).0
     }
 
     /// Trilinearly interpolated signed distance at `p` and the exact gradient of the interpolant.
@@ -438,6 +439,12 @@ impl Esdf {
     /// A non-finite `p` gives `(-inf, 0)` (treated as in collision); a point so far away that its
     /// offset overflows gives `(+inf, 0)` when outside the obstacles.
     pub fn distance_and_gradient(&self, p: &Vec3) -> (f64, Vec3) {
+        self.interpolate::<true>(p)
+    }
+
+    /// [`Esdf::distance_and_gradient`]; with `GRAD = false` the gradient is not computed (zero).
+    #[inline(always)]
+    fn interpolate<const GRAD: bool>(&self, p: &Vec3) -> (f64, Vec3) {
         if !p.iter().all(|c| c.is_finite()) {
             return (f64::NEG_INFINITY, Vec3::zeros());
         }
@@ -485,6 +492,18 @@ impl Esdf {
         let c0 = c00 + ty * (c10 - c00);
         let c1 = c01 + ty * (c11 - c01);
         let value = c0 + tz * (c1 - c0);
+        if !GRAD {
+            let o = offset.norm();
+            return if o == 0.0 {
+                (value, Vec3::zeros())
+            } else if !o.is_finite() {
+                (f64::INFINITY, Vec3::zeros())
+            } else if value >= 0.0 {
+                (o.hypot(value), Vec3::zeros())
+            } else {
+                (value + o, Vec3::zeros())
+            };
+        }
         let dx = (1.0 - ty) * (1.0 - tz) * (c100 - c000)
             + ty * (1.0 - tz) * (c110 - c010)
             + (1.0 - ty) * tz * (c101 - c001)
@@ -683,6 +702,25 @@ mod tests {
                 prop_assert!(lb <= esdf.lower_bound(&p));
             }
             prop_assert_eq!(esdf.lower_bound(&Vec3::new(f64::NAN, 0.0, 0.0)), f64::NEG_INFINITY);
+        }
+
+        /// `signed_distance` (no gradient) gives exactly the value of `distance_and_gradient`,
+        /// inside the grid, outside it and for non-finite points.
+        #[test]
+        fn signed_distance_is_the_value_of_distance_and_gradient(
+            seed in any::<u64>(),
+            u in (-0.5f64..1.5, -0.5f64..1.5, -0.5f64..1.5),
+            fill in 0.0f64..1.0,
+        ) {
+            let dims = [6, 5, 7];
+            let occ = random_occupancy(dims, fill, seed);
+            let esdf = Esdf::from_occupancy(Vec3::new(-1.0, 0.5, 2.0), 0.3, dims, &occ).unwrap();
+            let p = Vec3::new(-1.0 + u.0 * 1.8, 0.5 + u.1 * 1.5, 2.0 + u.2 * 2.1);
+            for q in [p, Vec3::new(f64::NAN, 0.0, 0.0), p * 1e300] {
+                let a = esdf.signed_distance(&q);
+                let b = esdf.distance_and_gradient(&q).0;
+                prop_assert!(a == b || (a.is_nan() && b.is_nan()), "{a} vs {b} at {q:?}");
+            }
         }
 
         /// Gradient of the trilinear interpolant against central differences, away from cell faces.

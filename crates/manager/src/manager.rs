@@ -356,6 +356,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                     events.push(Event::DroppedCollision {
                         id: Some(id),
                         violation: verdict.violation,
+                        braking_tail: verdict.braking_tail_violated,
                     });
                     rejected.push(("branch", solution.traj));
                     true
@@ -391,6 +392,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                     events.push(Event::DroppedCollision {
                         id: None,
                         violation: verdict.violation,
+                        braking_tail: verdict.braking_tail_violated,
                     });
                     rejected.push(("candidate", solution.traj));
                 }

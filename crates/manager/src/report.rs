@@ -100,6 +100,9 @@ pub enum Event {
         id: Option<BranchId>,
         /// The first violation (`None` when only the limits were exceeded).
         violation: Option<Violation>,
+        /// The trajectory itself was clear; braking straight after its end was not
+        /// ([`crate::SafetyParams::braking_tail`]).
+        braking_tail: bool,
     },
     /// A branch fell off the end of the queue (more than `N`).
     DroppedPopBack {

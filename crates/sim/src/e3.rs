@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use nalgebra::Point2;
 use serde::{Deserialize, Serialize};
-use trust_core::{Scene, State};
+use trust_core::{Scene, SearchStats, State};
 
 use crate::error::SimError;
 use crate::flight_plots::PLANNER_COLORS;
@@ -52,6 +52,19 @@ pub struct E3Branch {
     pub min_margin_m: f64,
 }
 
+/// One forecast of the cycle, as the planner saw it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct E3Forecast {
+    /// Centre at the cycle time (m).
+    pub p0: [f64; 3],
+    /// Predicted velocity (m/s).
+    pub v0: [f64; 3],
+    /// Radius at the cycle time, `r_o + r_safe` (m).
+    pub radius_m: f64,
+    /// Radius at the end of the manager's horizon (m).
+    pub radius_at_horizon_m: f64,
+}
+
 /// `summary.json` of E3.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct E3Summary {
@@ -65,6 +78,10 @@ pub struct E3Summary {
     pub frontend_paths: usize,
     /// Frontend time (ms).
     pub frontend_ms: f64,
+    /// The frontend's counters (samples, roadmap nodes, raw paths, why sampling stopped).
+    pub frontend_stats: Option<SearchStats>,
+    /// The forecasts the cycle planned against.
+    pub forecasts: Vec<E3Forecast>,
     /// Wall time of the whole cycle (ms).
     pub cycle_ms: f64,
     /// The kept branches, best first.
@@ -117,6 +134,16 @@ pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, SimError> {
         planner: resolved.label.clone(),
         frontend_paths: report.frontend.as_ref().map_or(0, |f| f.path_count),
         frontend_ms: report.timing.frontend_ms,
+        frontend_stats: report.frontend.as_ref().map(|f| f.stats),
+        forecasts: forecasts
+            .iter()
+            .map(|f| E3Forecast {
+                p0: f.p0.into(),
+                v0: f.v0.into(),
+                radius_m: f.radius(0.0),
+                radius_at_horizon_m: f.radius(manager.params().horizon_s),
+            })
+            .collect(),
         cycle_ms,
         branches,
         ranking_weights: [weights.lambda_t, weights.lambda_s, weights.lambda_e],
@@ -168,6 +195,14 @@ pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, SimError> {
     Ok(summary)
 }
 
+fn min_of(it: impl Iterator<Item = f64>) -> f64 {
+    it.fold(f64::INFINITY, f64::min)
+}
+
+fn max_of(it: impl Iterator<Item = f64>) -> f64 {
+    it.fold(f64::NEG_INFINITY, f64::max)
+}
+
 /// `report.md` of E3: ours beside the paper's Table Sim-B-1.
 pub fn report_md(s: &E3Summary) -> String {
     let mut md = String::new();
@@ -188,6 +223,26 @@ pub fn report_md(s: &E3Summary) -> String {
         s.ranking_weights[1],
         s.ranking_weights[2]
     );
+    if let Some(st) = &s.frontend_stats {
+        let _ = writeln!(
+            md,
+            "Frontend: {} samples, {} roadmap nodes, {} raw paths{}. {} forecast(s); their radii \
+             grow from {:.2}–{:.2} m now to {:.2}–{:.2} m at the end of the horizon.\n",
+            st.sample_count,
+            st.node_count,
+            st.raw_path_count,
+            if st.stalled {
+                ", sampling stopped when the roadmap stalled"
+            } else {
+                ""
+            },
+            s.forecasts.len(),
+            min_of(s.forecasts.iter().map(|f| f.radius_m)),
+            max_of(s.forecasts.iter().map(|f| f.radius_m)),
+            min_of(s.forecasts.iter().map(|f| f.radius_at_horizon_m)),
+            max_of(s.forecasts.iter().map(|f| f.radius_at_horizon_m)),
+        );
+    }
     let _ = writeln!(
         md,
         "| τ | H_t s | H_s | I_e | J | CPU ms | evaluations | paper H_t | paper H_s | paper I_e | paper J | paper CPU ms |"
@@ -214,7 +269,14 @@ pub fn report_md(s: &E3Summary) -> String {
         "\nThe paper's scene differs in detail (its obstacle layout is not published); compare \
          the shape: several distinct branches within a few tenths of a second of flight time, the \
          lowest `J` as main, millisecond solves. `H_s` here is the distance term toward the goal \
-         guidance surface plus the goal term (paper eq. design-of-Hs), `I_e` the jerk energy."
+         guidance surface plus the goal term (paper eq. design-of-Hs), `I_e` the jerk energy. \
+         Candidates that are not kept appear in the events below: `DiscardedEquivalent` (the \
+         optimized trajectory is TVD-equivalent to a better one), `DroppedCollision` (it fails \
+         the safety check; `braking_tail: true` when only stopping after its end would collide)."
     );
+    let _ = writeln!(md, "\n## Events\n");
+    for e in &s.events {
+        let _ = writeln!(md, "- `{e}`");
+    }
     md
 }

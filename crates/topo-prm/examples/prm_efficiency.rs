@@ -239,17 +239,20 @@ fn run(args: &Args) -> Result<serde_json::Value, PlanError> {
         horizon_s: args.horizon_s,
         ..scenes::SceneParams::default()
     };
-    let vprm = Vprm::new(VprmParams {
-        budget_ms: args.budget_ms,
-        max_samples: args.vprm_max_samples,
-        ..VprmParams::default()
-    })?;
     let devprm_params: DevPrmParams = serde_json::from_str(&args.devprm_params).map_err(|e| {
         PlanError::invalid(
             "--devprm-params",
             &args.devprm_params,
             format!("a JSON object of DevPrmParams fields ({e})"),
         )
+    })?;
+    // Both planners sample the same box, so that the comparison measures the PDC enhancements
+    // and not the region.
+    let vprm = Vprm::new(VprmParams {
+        budget_ms: args.budget_ms,
+        max_samples: args.vprm_max_samples,
+        inflate: devprm_params.inflate,
+        ..VprmParams::default()
     })?;
     let devprm = DevPrm::new(DevPrmParams {
         budget_ms: args.budget_ms,

@@ -77,14 +77,15 @@ pub(crate) fn check_or_trivial_answer(
 }
 
 /// How the moving obstacles enter the roadmap's visibility test.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum ConeMode {
     /// Ignored.
     Ignore,
     /// Frozen where they are at the query time (an occupancy-map snapshot).
     Frozen,
-    /// Predictive directional cones over the query horizon.
-    Predictive,
+    /// Predictive directional cones over the query horizon, capped at `max_horizon_s` (s;
+    /// `f64::INFINITY` for no cap).
+    Predictive { max_horizon_s: f64 },
 }
 
 /// Graph search of the pipeline.
@@ -301,7 +302,9 @@ pub(crate) fn run(
     let cones = match setup.cones {
         ConeMode::Ignore => Vec::new(),
         ConeMode::Frozen => forecast_cones(scene.forecasts, t_query, 0.0)?,
-        ConeMode::Predictive => forecast_cones(scene.forecasts, t_query, query.horizon_s)?,
+        ConeMode::Predictive { max_horizon_s } => {
+            forecast_cones(scene.forecasts, t_query, query.horizon_s.min(max_horizon_s))?
+        }
     };
     let mut obstacles =
         Obstacles::with_cones(scene.map, cones).restricted_to(&region.inflated(REGION_MARGIN_M));

@@ -412,3 +412,60 @@ fn point_cloud_maps_work() {
         }
     }
 }
+
+#[test]
+fn the_pdc_horizon_caps_how_far_ahead_the_cones_reach() {
+    // A full-height wall-like cylinder sweeps across the corridor at 5 m/s: over the query's 4 s
+    // horizon its cone closes the whole width at x ≈ 10 m, over 2 s it leaves y > 11.5 m open.
+    let map = box_map(vec![]);
+    let wall = Forecast::new(
+        ObstacleShape::Cylinder { half_height: 5.0 },
+        Vec3::new(10.0, 0.5, 5.0),
+        Vec3::new(0.0, 5.0, 0.0),
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+    )
+    .unwrap();
+    let mut q = query(Vec3::new(1.0, 10.0, 5.0), Vec3::new(19.0, 10.0, 5.0));
+    q.horizon_s = 4.0;
+    let planner = |pdc_horizon_s| {
+        DevPrm::new(DevPrmParams {
+            budget_ms: 10_000.0,
+            max_samples: 1500,
+            pdc_horizon_s,
+            ..DevPrmParams::default()
+        })
+        .unwrap()
+    };
+    let full = run(&planner(None), &map, &[wall], &q).unwrap();
+    assert!(
+        full.is_empty(),
+        "{} paths through a closed wall",
+        full.len()
+    );
+    let capped = run(&planner(Some(2.0)), &map, &[wall], &q).unwrap();
+    assert!(!capped.is_empty());
+    for p in &capped {
+        // Each path passes the wall's line x = 10 m beyond the 2 s cone (y > 11.5 m).
+        let crossing = p
+            .points
+            .windows(2)
+            .find(|w| (w[0].x - 10.0) * (w[1].x - 10.0) <= 0.0)
+            .expect("the path crosses x = 10 m");
+        let s = (10.0 - crossing[0].x) / (crossing[1].x - crossing[0].x);
+        let y = crossing[0].y + s * (crossing[1].y - crossing[0].y);
+        assert!(y > 11.5, "crossed at y = {y}");
+    }
+    for bad in [-1.0, f64::NAN, f64::INFINITY] {
+        let e = DevPrmParams {
+            pdc_horizon_s: Some(bad),
+            ..DevPrmParams::default()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("devprm.pdc_horizon_s"), "{e}");
+    }
+}
