@@ -544,7 +544,13 @@ fn cycle_record(report: &StepReport, effective_t: f64, zero_timing: bool) -> Cyc
 fn dropped(report: &StepReport) -> Dropped {
     let mut out = Dropped::default();
     for event in &report.events {
-        if let Event::DroppedCollision { violation, .. } = event {
+        if let Event::DroppedCollision {
+            violation,
+            braking_tail,
+            ..
+        } = event
+        {
+            out.braking_tail += usize::from(*braking_tail);
             match violation.map(|v| v.with) {
                 Some(Hit::Static) => out.static_map += 1,
                 Some(Hit::Obstacle(_)) => out.moving += 1,

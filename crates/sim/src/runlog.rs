@@ -204,6 +204,10 @@ pub struct Dropped {
     pub bounds: usize,
     /// Only the speed or acceleration limit was exceeded.
     pub limits: usize,
+    /// Of the above, those whose trajectory was clear and only the braking after its end was
+    /// not (`trust_manager::SafetyParams::braking_tail`).
+    #[serde(default)]
+    pub braking_tail: usize,
 }
 
 impl Dropped {
