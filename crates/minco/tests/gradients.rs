@@ -463,12 +463,19 @@ fn check_utf_with_surface(
     prop_assert!(f.eval(&x, &mut g).is_finite());
     let traj = f.trajectory().expect("solved");
     let (map, forecasts) = if obstacles {
-        let times: Vec<(Vec3, f64)> = (0..4)
+        let mut times: Vec<(Vec3, f64)> = (0..4)
             .map(|_| {
                 let t = traj.t_start() + rng.random_range(0.05..0.95) * traj.duration();
                 (traj.position(t), t)
             })
             .collect();
+        // One more on the braking manoeuvre after the end (the tail term of the objective).
+        let speed = prob.end_velocity.norm();
+        let sigma = rng.random_range(0.2..0.9);
+        times.push((
+            prob.end + prob.end_velocity * (speed / limits.a_max * (sigma - 0.5 * sigma * sigma)),
+            traj.t_end() + sigma * speed / limits.a_max,
+        ));
         (
             penetrated_map(&mut rng, &traj),
             penetrating_forecasts(&mut rng, &times, prob.start.t - 0.3),

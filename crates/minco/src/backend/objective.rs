@@ -7,7 +7,7 @@ use trust_core::{CostBreakdown, Limits, PlanError, PolyTraj, Scene, State, Vec3}
 use super::params::PieceParams;
 use super::time_map::{positive_time, positive_time_inverse};
 use crate::costs::{
-    CostWeights, PenaltyIntegrand, PenaltyParams, PiecewiseView, TerminalCost, TrapezoidIntegrator,
+    BrakingTail, CostWeights, PenaltyIntegrand, PenaltyParams, PiecewiseView, TerminalCost, TrapezoidIntegrator,
 };
 use crate::error::MincoError;
 use crate::minco::{BoundaryState, MincoGrad, MincoS3};
@@ -217,6 +217,11 @@ pub struct UtfMincoObjective<'a> {
     min_total: f64,
     /// `∂H_s/∂p_f`, `∂H_s/∂v_f` and `dT/dτ` at the last cost evaluation.
     terminal_grad: (Vec3, Vec3, f64),
+    /// The braking tail's samples, deceleration (`a_max`) and per-sample weight
+    /// (`v_max / a_max / samples`, the quadrature weight of a stop from full speed).
+    tail_setup: (usize, f64, f64),
+    /// The braking tail at the last cost evaluation.
+    tail: BrakingTail,
 }
 
 impl<'a> UtfMincoObjective<'a> {
@@ -246,6 +251,11 @@ impl<'a> UtfMincoObjective<'a> {
             terminal: TerminalCost::new(goal, &start.p, &params.penalty),
             min_total: min_total(&params.pieces, pieces),
             terminal_grad: (Vec3::zeros(), Vec3::zeros(), 0.0),
+            tail_setup: {
+                let k = params.penalty.braking_tail_samples;
+                (k, limits.a_max, limits.v_max / limits.a_max / k.max(1) as f64)
+            },
+            tail: BrakingTail::default(),
         })
     }
 
@@ -354,7 +364,17 @@ impl<'a> UtfMincoObjective<'a> {
             Ok(Partial::Above(partial)) => return partial,
             Err(_) => return f64::INFINITY,
         };
-        let cost = w_time * total + w_terminal * hs_objective + integral;
+        let (samples, decel, weight) = self.tail_setup;
+        self.tail = self.core.penalties.braking_tail(
+            &p_f,
+            &v_f,
+            self.core.t_start + total,
+            decel,
+            samples,
+            weight,
+        );
+        let cost = w_time * total + w_terminal * hs_objective + integral + self.tail.cost;
+        let terms = [terms[0] + self.tail.integral, terms[1], terms[2]];
         self.terminal_grad = (hs_p, hs_v, dt_dtau);
         // The breakdown reports the paper's H_s (toward the goal itself) for branch ranking.
         let hs = if self.terminal.surface_radius > 0.0 {
@@ -384,9 +404,10 @@ impl<'a> UtfMincoObjective<'a> {
         for (i, gw) in grad.waypoints.iter().enumerate() {
             put(g, i, gw);
         }
-        put(g, n - 1, &(grad.tail[0] + hs_p * w.terminal));
-        put(g, n, &(grad.tail[1] + hs_v * w.terminal));
-        g[3 * n + 3] = (w.time + grad.uniform_total_duration()) * dt_dtau;
+        let tail = &self.tail;
+        put(g, n - 1, &(grad.tail[0] + hs_p * w.terminal + tail.grad_p));
+        put(g, n, &(grad.tail[1] + hs_v * w.terminal + tail.grad_v));
+        g[3 * n + 3] = (w.time + grad.uniform_total_duration() + tail.grad_t) * dt_dtau;
         check_gradient(g)
     }
 

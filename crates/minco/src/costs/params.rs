@@ -87,6 +87,13 @@ pub struct PenaltyParams {
     /// goal guidance surface when the request has a planning horizon
     /// ([`crate::costs::TerminalCost::eval_objective`]).
     pub guidance_smoothing_m: f64,
+    /// Samples of the obstacle penalty along the straight braking manoeuvre (at `a_max`) that
+    /// follows a free terminal reached in motion (UTF-MINCO only; 0 switches it off): the
+    /// manager's safety check requires that manoeuvre to be clear
+    /// (`trust_manager::SafetyParams::braking_tail`), and an optimizer that does not see it
+    /// ends trajectories at speed just in front of obstacles. Ours: 8 (see
+    /// [`crate::costs::PenaltyIntegrand::braking_tail`]).
+    pub braking_tail_samples: usize,
 }
 
 impl Default for PenaltyParams {
@@ -113,6 +120,7 @@ impl Default for PenaltyParams {
             terminal_velocity_gains: Vec3::new(1.0, 1.0, 1.0),
             terminal_norm_epsilon: 1e-2,
             guidance_smoothing_m: 1.0,
+            braking_tail_samples: 8,
         }
     }
 }
