@@ -241,3 +241,33 @@ fn a_sharded_study_merges_into_the_single_run_and_jobs_do_not_matter() {
     assert!(e.contains("missing") && e.contains("#1"), "{e}");
     let _ = std::fs::remove_dir_all(&root);
 }
+
+#[test]
+fn e3_keeps_several_ranked_distinct_branches_and_writes_its_report() {
+    let base = Scenario::load(&scenarios_dir().join("e3.toml")).expect("e3 loads");
+    let dir = temp_dir("e3");
+    // Seeds whose cold cycle keeps several branches (scenarios/e3.toml, measured: 4 each).
+    for seed in [6, 8] {
+        let out = dir.join(format!("seed-{seed}"));
+        let s = trust_sim::e3::run_e3(&base.clone().with_seed(seed), &out).unwrap();
+        assert!(s.frontend_paths >= 2, "seed {seed}: {s:?}");
+        assert!((2..=5).contains(&s.branches.len()), "seed {seed}: {s:?}");
+        assert!(
+            s.branches.windows(2).all(|w| w[0].j <= w[1].j),
+            "ranked by J"
+        );
+        for b in &s.branches {
+            assert!(
+                b.ht > 0.0 && b.ie.is_finite() && b.min_margin_m >= 0.0,
+                "{b:?}"
+            );
+        }
+        assert_eq!(s.forecasts.len(), 10);
+        assert!(s.frontend_stats.is_some_and(|st| st.node_count >= 2));
+        for file in ["summary.json", "report.md", "top.svg", "top.png"] {
+            assert!(out.join(file).is_file(), "{file}");
+        }
+        let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+        assert!(md.contains("paper H_t") && md.contains("## Events"), "{md}");
+    }
+}

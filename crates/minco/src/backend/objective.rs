@@ -7,7 +7,8 @@ use trust_core::{CostBreakdown, Limits, PlanError, PolyTraj, Scene, State, Vec3}
 use super::params::PieceParams;
 use super::time_map::{positive_time, positive_time_inverse};
 use crate::costs::{
-    BrakingTail, CostWeights, PenaltyIntegrand, PenaltyParams, PiecewiseView, TerminalCost, TrapezoidIntegrator,
+    BrakingTail, CostWeights, PenaltyIntegrand, PenaltyParams, PiecewiseView, TerminalCost,
+    TrapezoidIntegrator,
 };
 use crate::error::MincoError;
 use crate::minco::{BoundaryState, MincoGrad, MincoS3};
@@ -253,7 +254,11 @@ impl<'a> UtfMincoObjective<'a> {
             terminal_grad: (Vec3::zeros(), Vec3::zeros(), 0.0),
             tail_setup: {
                 let k = params.penalty.braking_tail_samples;
-                (k, limits.a_max, limits.v_max / limits.a_max / k.max(1) as f64)
+                (
+                    k,
+                    limits.a_max,
+                    limits.v_max / limits.a_max / k.max(1) as f64,
+                )
             },
             tail: BrakingTail::default(),
         })

@@ -221,7 +221,8 @@ impl PenaltyIntegrand<'_> {
     ) -> BrakingTail {
         let speed = v_f.norm();
         let mut out = BrakingTail::default();
-        if samples == 0 || !(decel > 0.0) || !(speed > 1e-9) || !speed.is_finite() {
+        let usable = decel > 0.0 && speed > 1e-9 && speed.is_finite();
+        if samples == 0 || !usable {
             return out;
         }
         let stop_time = speed / decel;
