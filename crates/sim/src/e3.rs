@@ -15,9 +15,8 @@ use serde::{Deserialize, Serialize};
 use trust_core::{Scene, SearchStats, State};
 
 use crate::error::SimError;
-use crate::flight_plots::PLANNER_COLORS;
 use crate::planner;
-use crate::plot::{Figure, ForecastRings, Marker, Plane, Polyline};
+use crate::plot::{Color, Figure, ForecastRings, Marker, Plane, Polyline};
 use crate::scenario::Scenario;
 use crate::study::{create_dir, write_json, write_text};
 use crate::world::World;
@@ -184,7 +183,7 @@ pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, SimError> {
         view = view.polyline(
             Polyline::new(pts)
                 .label(format!("τ{k}{}", if k == 0 { " (main)" } else { "" }))
-                .color(PLANNER_COLORS[k % PLANNER_COLORS.len()])
+                .color(Color::palette(k))
                 .width_px(if k == 0 { 3 } else { 2 }),
         );
     }

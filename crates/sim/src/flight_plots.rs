@@ -227,16 +227,6 @@ pub fn write_flight_plots(
     Ok(written)
 }
 
-/// Colours of the planners in comparison figures, in the order given.
-pub const PLANNER_COLORS: [Color; 6] = [
-    Color::rgb(20, 20, 120),
-    Color::rgb(200, 60, 40),
-    Color::rgb(40, 150, 60),
-    Color::rgb(160, 90, 200),
-    Color::rgb(230, 160, 20),
-    Color::rgb(60, 160, 200),
-];
-
 /// A top view of one world with several flights over it (the static obstacles of `header`, the
 /// first flight's true obstacle tracks, and each flight's path in its own colour): the
 /// representative trial of a study. `flights` holds `(label, states)` pairs.
@@ -272,7 +262,7 @@ pub fn write_comparison_view(
         v = v.polyline(
             Polyline::new(pts)
                 .label(label.clone())
-                .color(PLANNER_COLORS[k % PLANNER_COLORS.len()])
+                .color(Color::palette(k))
                 .width_px(2),
         );
     }
