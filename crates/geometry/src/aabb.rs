@@ -145,6 +145,11 @@ impl Aabb {
         (0..3).all(|i| p[i] >= self.min[i] && p[i] <= self.max[i])
     }
 
+    /// True if `other` lies inside this closed box (false if either has a NaN coordinate).
+    pub fn contains_box(&self, other: &Aabb) -> bool {
+        (0..3).all(|i| self.min[i] <= other.min[i] && other.max[i] <= self.max[i])
+    }
+
     /// True if the closed boxes overlap (touching counts).
     pub fn intersects(&self, other: &Aabb) -> bool {
         (0..3).all(|i| self.min[i] <= other.max[i] && other.min[i] <= self.max[i])

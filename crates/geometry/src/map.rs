@@ -6,7 +6,7 @@ use crate::Vec3;
 use crate::aabb::Aabb;
 use crate::error::{GeometryError, check_positive};
 use crate::esdf::Esdf;
-use crate::parry_conv::{segment_shape_distance, to_p_aabb};
+use crate::parry_conv::{segment_blocked, to_p_aabb};
 use crate::shapes::Shape;
 
 /// Step length reported by [`StaticMap::resolution`] for maps without a voxel grid, in metres:
@@ -345,8 +345,7 @@ impl StaticMap {
             let Some((p, q)) = shape.aabb().inflated(pad).clip_segment(a, b) else {
                 return false;
             };
-            let d = segment_shape_distance(shape, &p, &q);
-            !(d > 0.0 && d >= clearance)
+            segment_blocked(shape, &p, &q, clearance)
         })
     }
 

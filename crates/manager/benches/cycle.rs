@@ -13,7 +13,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use rand::{Rng as _, SeedableRng};
 use trust_core::{Aabb, Forecast, Limits, ObstacleShape, Rng, Scene, State, StaticMap, Vec3};
 use trust_geometry::{AaBox, Cylinder, Shape};
-use trust_manager::{Manager, ManagerParams};
+use trust_manager::{CycleTiming, Manager, ManagerParams};
 use trust_minco::UtfMinco;
 use trust_topo_prm::{DevPrm, DevPrmParams, Tvd};
 
@@ -121,8 +121,8 @@ impl Flight {
         }
     }
 
-    /// One cycle; returns (frontend, backend, checker) ms.
-    fn cycle(&mut self) -> (f64, f64, f64) {
+    /// One cycle; returns its timing.
+    fn cycle(&mut self) -> CycleTiming {
         if self.cycles == 150 {
             self.manager.reset();
             self.state = State::at_rest(0.0, Vec3::new(2.0, 37.5, 5.0));
@@ -146,28 +146,30 @@ impl Flight {
             None => State::at_rest(next, self.state.p),
         };
         self.cycles += 1;
-        let timing = &report.timing;
-        (timing.frontend_ms, timing.backend_ms, timing.checker_ms)
+        report.timing
     }
 }
 
 fn bench_cycle(c: &mut Criterion) {
     let mut flight = Flight::new();
-    let (mut f, mut b, mut k) = (0.0, 0.0, 0.0);
     let n = 150;
-    for _ in 0..n {
-        let (a, bb, cc) = flight.cycle();
-        f += a;
-        b += bb;
-        k += cc;
-    }
-    let n = n as f64;
+    let timings: Vec<CycleTiming> = (0..n).map(|_| flight.cycle()).collect();
+    let mean = |f: &dyn Fn(&CycleTiming) -> f64| timings.iter().map(f).sum::<f64>() / n as f64;
+    let mut wall: Vec<f64> = timings.iter().map(|t| t.wall_ms).collect();
+    wall.sort_by(f64::total_cmp);
     eprintln!(
-        "E4-like warm cycle, mean over {n} cycles: frontend {:.3} ms, backend {:.3} ms (summed over \
-         parallel solves), checker {:.3} ms",
-        f / n,
-        b / n,
-        k / n
+        "E4-like cycle, {n} cycles: wall median {:.2} ms, p99 {:.2} ms; mean split: frontend {:.2} \
+         ms, warm solves {:.2} ms ({:.1} per cycle), cold solves {:.2} ms ({:.1} per cycle), \
+         {:.0} evaluations (solve times summed over the parallel solves), checker {:.2} ms",
+        wall[n / 2],
+        wall[(n * 99) / 100],
+        mean(&|t| t.frontend_ms),
+        mean(&|t| t.backend_ms - t.cold_backend_ms),
+        mean(&|t| (t.solve_count - t.cold_solve_count) as f64),
+        mean(&|t| t.cold_backend_ms),
+        mean(&|t| t.cold_solve_count as f64),
+        mean(&|t| t.evaluations as f64),
+        mean(&|t| t.checker_ms),
     );
     c.bench_function("manager_cycle_e4_like_n5", |bench| {
         bench.iter(|| flight.cycle())

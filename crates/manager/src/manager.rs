@@ -332,7 +332,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         // Kept branches, re-solved.
         let mut kept: Vec<Branch> = Vec::new();
         for ((id, origin, _), cand) in warm.into_iter().zip(warm_out) {
-            timing.add(&cand);
+            timing.add(&cand, false);
             let failed = match cand.result {
                 Err(e) => {
                     events.push(Event::SolveFailed {
@@ -382,7 +382,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         // AddNewBranch for each explored trajectory.
         let incumbent = if history { self.main } else { None };
         for cand in cold_out {
-            timing.add(&cand);
+            timing.add(&cand, true);
             match cand.result {
                 Err(e) => events.push(Event::SolveFailed {
                     id: None,
@@ -764,11 +764,17 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
 }
 
 impl CycleTiming {
-    fn add(&mut self, cand: &Candidate) {
+    fn add(&mut self, cand: &Candidate, cold: bool) {
         self.checker_ms += ms(cand.check_time);
         if let Ok((s, _)) = &cand.result {
-            self.backend_ms += ms(s.stats.elapsed);
+            let solve = ms(s.stats.elapsed);
+            self.backend_ms += solve;
             self.solve_count += 1;
+            self.evaluations += s.stats.evaluation_count;
+            if cold {
+                self.cold_backend_ms += solve;
+                self.cold_solve_count += 1;
+            }
         }
     }
 }

@@ -194,6 +194,16 @@ pub struct CycleTiming {
     pub checker_ms: f64,
     /// Trajectories optimized this cycle.
     pub solve_count: usize,
+    /// The part of `backend_ms` spent on cold solves from frontend paths (FwdExplore); the rest
+    /// went to warm re-solves of kept branches (FwdMarch, BwdReplan).
+    #[serde(default)]
+    pub cold_backend_ms: f64,
+    /// The part of `solve_count` that were cold solves.
+    #[serde(default)]
+    pub cold_solve_count: usize,
+    /// Objective evaluations (cost and gradient) summed over every solve of the cycle.
+    #[serde(default)]
+    pub evaluations: usize,
 }
 
 impl CycleTiming {

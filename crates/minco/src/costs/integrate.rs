@@ -242,7 +242,12 @@ impl TrapezoidIntegrator {
         for (c, &duration) in traj.coeffs.chunks_exact(6).zip(traj.durations) {
             let scaled = ScaledPiece::new(c, duration);
             let b = rule.piece_box(self.scaled.len(), &scaled, &self.u_powers);
-            all = points_box(&[all.min, all.max, b.min, b.max]);
+            // Union of the piece boxes (a `points_box` of the corners would take the initial
+            // ±∞ corners as points and span everything).
+            all = Aabb {
+                min: all.min.inf(&b.min),
+                max: all.max.sup(&b.max),
+            };
             self.boxes.push(b);
             self.scaled.push(scaled);
         }
@@ -738,6 +743,53 @@ mod tests {
         // ∂I/∂T_i = 1 for a constant integrand.
         assert_relative_eq!(gt[0], 1.0, epsilon = 1e-12);
         assert_relative_eq!(gt[1], 1.0, epsilon = 1e-12);
+    }
+
+    /// The box `begin_trajectory` receives is the tight box of the samples (it once spanned all
+    /// of space, which switched the moving-obstacle term's per-trajectory broad phase off).
+    #[test]
+    fn the_trajectory_box_is_the_box_of_the_samples() {
+        struct Recorder {
+            trajectory_box: Option<Aabb>,
+            samples: Vec<Vec3>,
+        }
+        impl Integrand for Recorder {
+            fn begin_trajectory(&mut self, _: f64, _: f64, samples_box: &Aabb) {
+                self.trajectory_box = Some(*samples_box);
+            }
+            fn sample(&mut self, s: &SampleState, _: &mut SampleGrad) -> f64 {
+                self.samples.push(s.p);
+                0.0
+            }
+        }
+        let mut coeffs = vec![Vec3::zeros(); 12];
+        coeffs[0] = Vec3::new(1.0, 2.0, 3.0);
+        coeffs[1] = Vec3::new(1.0, -1.0, 0.5);
+        coeffs[6] = Vec3::new(2.0, 1.0, 3.5);
+        coeffs[7] = Vec3::new(0.0, 2.0, 0.0);
+        let durations = [1.0, 0.5];
+        let view = PiecewiseView {
+            t_start: 0.0,
+            coeffs: &coeffs,
+            durations: &durations,
+        };
+        let mut rec = Recorder {
+            trajectory_box: None,
+            samples: Vec::new(),
+        };
+        let (mut gc, mut gt) = (vec![Vec3::zeros(); 12], vec![0.0; 2]);
+        TrapezoidIntegrator::new(8)
+            .integrate(&view, &mut rec, &mut gc, &mut gt)
+            .unwrap();
+        let b = rec.trajectory_box.expect("begin_trajectory was called");
+        let tight = Aabb::from_points(&rec.samples).unwrap();
+        for k in 0..3 {
+            assert!(b.min[k] <= tight.min[k] + 1e-12 && tight.max[k] <= b.max[k] + 1e-12);
+            assert!(
+                b.min[k] >= tight.min[k] - 1e-9 && b.max[k] <= tight.max[k] + 1e-9,
+                "{b:?}"
+            );
+        }
     }
 
     #[test]
