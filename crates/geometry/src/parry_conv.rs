@@ -130,7 +130,7 @@ fn cylinder_verdict(
         let (t0, t1) = ((z0 - p.z) / dz, (z1 - p.z) / dz);
         let (t0, t1) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
         let (lo, hi) = (t0.max(0.0), t1.min(1.0));
-        if !(lo <= hi) {
+        if lo.is_nan() || hi.is_nan() || lo > hi {
             return None;
         }
         (lo, hi)

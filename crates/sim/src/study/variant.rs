@@ -42,12 +42,17 @@ pub enum Variant {
     /// `fault=X`: obstacles maneuver with `1 + X` times their stated bounds
     /// (`traffic.fault_level`), beyond what the forecasts expect.
     Fault(f64),
+    /// `explore=K`: the multi-branch managers with history run FwdExplore (the frontend and the
+    /// cold solves) every `K`-th cycle and whenever fewer than two branches are kept
+    /// (`manager.explore_period_cycles`); `K = 1` is the paper's Algorithm 1.
+    Explore(usize),
 }
 
 impl Variant {
     /// Every variant name, for help texts.
     pub const NAMES: &'static str = "none, vprm, minco, uvd, no-pdc, no-ggs, no-history, \
-                                     no-hysteresis, perfect, quadrotor, mu=X, fault=X";
+                                     no-hysteresis, perfect, quadrotor, mu=X, fault=X, \
+                                     explore=K";
 
     /// Applies the variant to `scenario` (whose planner preset is already chosen): replaces the
     /// preset's part it concerns, or the scenario section it sweeps.
@@ -114,6 +119,11 @@ impl Variant {
             Variant::Quadrotor => scenario.vehicle.model = VehicleModel::Quadrotor,
             Variant::Mu(x) => scenario.sensing.ekf.sigma_scale *= x,
             Variant::Fault(x) => scenario.traffic.fault_level = x,
+            Variant::Explore(k) => set_manager(
+                planner,
+                "explore_period_cycles",
+                toml::Value::Integer(i64::try_from(k).unwrap_or(i64::MAX)),
+            ),
         }
         Ok(())
     }
@@ -141,6 +151,7 @@ impl fmt::Display for Variant {
             Variant::Quadrotor => f.write_str("quadrotor"),
             Variant::Mu(x) => write!(f, "mu={x}"),
             Variant::Fault(x) => write!(f, "fault={x}"),
+            Variant::Explore(k) => write!(f, "explore={k}"),
         }
     }
 }
@@ -173,6 +184,16 @@ impl FromStr for Variant {
             t => match t.split_once('=') {
                 Some(("mu", v)) => Variant::Mu(number(v, "mu")?),
                 Some(("fault", v)) => Variant::Fault(number(v, "fault")?),
+                Some(("explore", v)) => match v.parse::<usize>() {
+                    Ok(k) if k >= 1 => Variant::Explore(k),
+                    _ => {
+                        return Err(SimError::input(
+                            "--variant",
+                            text,
+                            "explore=K with K an integer >= 1",
+                        ));
+                    }
+                },
                 _ => {
                     return Err(SimError::input(
                         "--variant",
@@ -226,11 +247,19 @@ mod tests {
             "quadrotor",
             "mu=2",
             "fault=0.5",
+            "explore=3",
         ] {
             let v: Variant = name.parse().unwrap();
             assert_eq!(v.to_string(), name);
         }
-        for bad in ["vrpm", "mu=-1", "fault=x", "mu=inf"] {
+        for bad in [
+            "vrpm",
+            "mu=-1",
+            "fault=x",
+            "mu=inf",
+            "explore=0",
+            "explore=1.5",
+        ] {
             let e = bad.parse::<Variant>().unwrap_err().to_string();
             assert!(e.contains("--variant") && e.contains(bad), "{e}");
         }
@@ -262,6 +291,8 @@ mod tests {
         assert!(!r.manager.history);
         let (r, _) = resolved(Variant::NoHysteresis);
         assert_eq!(r.manager.hysteresis, 1.0);
+        let (r, _) = resolved(Variant::Explore(3));
+        assert_eq!(r.manager.explore_period_cycles, 3);
         let (_, s) = resolved(Variant::Fault(0.5));
         assert_eq!(s.traffic.fault_level, 0.5);
         let (_, s) = resolved(Variant::Mu(2.0));
