@@ -61,6 +61,25 @@ impl Branch {
 struct Candidate {
     result: Result<(Solution, SafetyVerdict), PlanError>,
     check_time: Duration,
+    /// A first solve that failed the safety check narrowly and was repaired by this one
+    /// ([`ManagerParams::repair_margin_m`]): its solve time, evaluations and check time.
+    repaired_from: Option<(Duration, usize, Duration)>,
+}
+
+impl Candidate {
+    /// Whether it was solved and failed the safety check narrowly ([`narrowly_unsafe`]).
+    fn narrowly_unsafe(&self, margin: f64) -> bool {
+        matches!(&self.result, Ok((_, v)) if narrowly_unsafe(v, margin))
+    }
+}
+
+/// Whether `v` failed by at most `margin` (m) of clearance, or only on the limits.
+fn narrowly_unsafe(v: &SafetyVerdict, margin: f64) -> bool {
+    !v.safe
+        && match &v.violation {
+            Some(x) => x.margin_m >= -margin,
+            None => true,
+        }
 }
 
 /// The multi-branch spatio-temporal trajectory manager (paper Sec. III-A, Algorithm 1), generic
@@ -274,7 +293,9 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             },
             || {
                 warm.par_iter()
-                    .map(|(_, _, traj)| solver.solve(InitialGuess::WarmStart(traj)))
+                    .map(|(_, _, traj)| {
+                        solver.repaired(solver.solve(InitialGuess::WarmStart(traj)))
+                    })
                     .collect::<Vec<_>>()
             },
         );
@@ -320,7 +341,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         }
         let cold_out: Vec<Candidate> = paths
             .par_iter()
-            .map(|p: &GuidePath| solver.solve(InitialGuess::Guide(p)))
+            .map(|p: &GuidePath| solver.repaired(solver.solve(InitialGuess::Guide(p))))
             .collect();
 
         let mut timing = CycleTiming {
@@ -333,6 +354,9 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let mut kept: Vec<Branch> = Vec::new();
         for ((id, origin, _), cand) in warm.into_iter().zip(warm_out) {
             timing.add(&cand, false);
+            if cand.repaired_from.is_some() {
+                events.push(Event::Repaired { id: Some(id) });
+            }
             let failed = match cand.result {
                 Err(e) => {
                     events.push(Event::SolveFailed {
@@ -383,6 +407,9 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let incumbent = if history { self.main } else { None };
         for cand in cold_out {
             timing.add(&cand, true);
+            if cand.repaired_from.is_some() {
+                events.push(Event::Repaired { id: None });
+            }
             match cand.result {
                 Err(e) => events.push(Event::SolveFailed {
                     id: None,
@@ -725,6 +752,30 @@ struct Solver<'s, 'a, B> {
 }
 
 impl<B: TrajectoryBackend> Solver<'_, '_, B> {
+    /// `cand` again, warm-started from its own trajectory, if it failed the safety check by at
+    /// most `repair_margin_m` and the re-solve passes; otherwise `cand` unchanged.
+    fn repaired(&self, cand: Candidate) -> Candidate {
+        let margin = self.params.repair_margin_m;
+        if margin <= 0.0 || !cand.narrowly_unsafe(margin) {
+            return cand;
+        }
+        let Ok((first, _)) = &cand.result else {
+            return cand;
+        };
+        let again = self.solve(InitialGuess::WarmStart(&first.traj));
+        match &again.result {
+            Ok((_, verdict)) if verdict.safe => Candidate {
+                repaired_from: Some((
+                    first.stats.elapsed,
+                    first.stats.evaluation_count,
+                    cand.check_time,
+                )),
+                ..again
+            },
+            _ => cand,
+        }
+    }
+
     fn solve(&self, initial: InitialGuess<'_>) -> Candidate {
         let req = TrajRequest {
             start: self.start,
@@ -742,6 +793,7 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
             Err(e) => Candidate {
                 result: Err(e),
                 check_time: Duration::ZERO,
+                repaired_from: None,
             },
             Ok(solution) => {
                 let t = Instant::now();
@@ -757,6 +809,7 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
                 Candidate {
                     check_time: t.elapsed(),
                     result: Ok((solution, verdict)),
+                    repaired_from: None,
                 }
             }
         }
@@ -766,6 +819,17 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
 impl CycleTiming {
     fn add(&mut self, cand: &Candidate, cold: bool) {
         self.checker_ms += ms(cand.check_time);
+        if let Some((solve, evaluations, check)) = cand.repaired_from {
+            self.checker_ms += ms(check);
+            self.backend_ms += ms(solve);
+            self.evaluations += evaluations;
+            self.solve_count += 1;
+            self.repair_count += 1;
+            if cold {
+                self.cold_backend_ms += ms(solve);
+                self.cold_solve_count += 1;
+            }
+        }
         if let Ok((s, _)) = &cand.result {
             let solve = ms(s.stats.elapsed);
             self.backend_ms += solve;
@@ -842,6 +906,31 @@ fn ms(d: Duration) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn only_narrow_failures_are_repaired() {
+        let verdict = |safe: bool, margin: Option<f64>| SafetyVerdict {
+            safe,
+            min_static_margin_m: f64::INFINITY,
+            min_dynamic_margin_m: margin.unwrap_or(f64::INFINITY),
+            violation: margin.map(|m| crate::safety::Violation {
+                t: 1.0,
+                with: crate::safety::Hit::Bounds,
+                margin_m: m,
+            }),
+            escaping: false,
+            max_speed: 1.0,
+            max_accel: 1.0,
+            over_limits: margin.is_none() && !safe,
+            braking_tail_violated: false,
+            sample_count: 10,
+        };
+        assert!(!narrowly_unsafe(&verdict(true, None), 0.05));
+        assert!(narrowly_unsafe(&verdict(false, Some(-0.004)), 0.05));
+        assert!(!narrowly_unsafe(&verdict(false, Some(-0.2)), 0.05));
+        assert!(narrowly_unsafe(&verdict(false, None), 0.05), "limits only");
+        assert!(!narrowly_unsafe(&verdict(false, Some(f64::NAN)), 0.05));
+    }
 
     #[test]
     fn hysteresis_keeps_the_incumbent_unless_clearly_beaten() {

@@ -45,6 +45,12 @@ pub struct ManagerParams {
     /// cycle, while the median cycle fell from ~97 ms to ~8 ms (the frontend on E4's point-cloud
     /// ESDF is most of an exploring cycle). With history off every cycle explores.
     pub explore_period_cycles: usize,
+    /// A trajectory (kept branch or new candidate) that fails the safety check by at most this
+    /// much (m) — or only on the speed and acceleration limits — is re-solved once, warm-started
+    /// from itself; the re-solve replaces it if it passes (the "dropped or repaired").
+    /// The penalties are soft and a solve may stop on its budget, so a few millimetres of
+    /// violation are common in cold solves (E3). `0` switches repairs off. Default 0.05 m.
+    pub repair_margin_m: f64,
     /// Weights of the ranking cost `J = λ_t·H_t + λ_s·H_s + λ_e·I_e`; `None` uses the paper's rule
     /// (Table Sim-B-1: `λ_t = 1`, `λ_s = 1/v_max`, `λ_e = 1e-4`) with the vehicle's `v_max`.
     pub ranking: Option<RankingWeights>,
@@ -98,6 +104,7 @@ impl ManagerParams {
             warm_max_evaluations: Some(100),
             cold_max_evaluations: None,
             explore_period_cycles: 3,
+            repair_margin_m: 0.05,
             ranking: None,
             horizon_s: 4.0,
             cycle_budget_ms: 50.0,
@@ -177,6 +184,7 @@ impl ManagerParams {
                 "an integer >= 1",
             ));
         }
+        check_non_negative("manager.repair_margin_m", self.repair_margin_m)?;
         if let Some(w) = &self.ranking {
             check_non_negative("manager.ranking.lambda_t", w.lambda_t)?;
             check_non_negative("manager.ranking.lambda_s", w.lambda_s)?;
@@ -329,6 +337,10 @@ mod tests {
         p.latency_s = Some(f64::NAN);
         let e = p.validate().unwrap_err().to_string();
         assert!(e.contains("manager.latency_s"), "{e}");
+        p.latency_s = None;
+        p.repair_margin_m = -0.1;
+        let e = p.validate().unwrap_err().to_string();
+        assert!(e.contains("manager.repair_margin_m"), "{e}");
     }
 
     #[test]

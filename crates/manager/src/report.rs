@@ -104,6 +104,12 @@ pub enum Event {
         /// ([`crate::SafetyParams::braking_tail`]).
         braking_tail: bool,
     },
+    /// A trajectory failed the safety check narrowly and passed after one more warm re-solve
+    /// ([`crate::ManagerParams::repair_margin_m`]).
+    Repaired {
+        /// The branch, or `None` for a candidate from the frontend.
+        id: Option<BranchId>,
+    },
     /// A branch fell off the end of the queue (more than `N`).
     DroppedPopBack {
         /// The branch.
@@ -158,6 +164,7 @@ impl Event {
             Event::DiscardedEquivalent { .. } => "discarded_equivalent",
             Event::MergedEquivalent { .. } => "merged_equivalent",
             Event::DroppedCollision { .. } => "dropped_collision",
+            Event::Repaired { .. } => "repaired",
             Event::DroppedPopBack { .. } => "dropped_popback",
             Event::SolveFailed { .. } => "solve_failed",
             Event::FrontendFailed { .. } => "frontend_failed",
@@ -204,6 +211,10 @@ pub struct CycleTiming {
     /// Objective evaluations (cost and gradient) summed over every solve of the cycle.
     #[serde(default)]
     pub evaluations: usize,
+    /// Solves that failed the safety check narrowly and passed after one more warm re-solve
+    /// ([`crate::ManagerParams::repair_margin_m`]); both solves are in `solve_count`.
+    #[serde(default)]
+    pub repair_count: usize,
 }
 
 impl CycleTiming {

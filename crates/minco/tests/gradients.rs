@@ -474,9 +474,11 @@ fn check_utf_with_surface(
         // One more on the braking manoeuvre after the end (the tail term of the objective).
         let speed = prob.end_velocity.norm();
         let sigma = rng.random_range(0.2..0.9);
+        let decel = params.penalty.braking_tail_decel_fraction * limits.a_max;
+        let delay = params.penalty.braking_tail_delay_s;
         times.push((
-            prob.end + prob.end_velocity * (speed / limits.a_max * (sigma - 0.5 * sigma * sigma)),
-            traj.t_end() + sigma * speed / limits.a_max,
+            prob.end + prob.end_velocity * (delay + speed / decel * (sigma - 0.5 * sigma * sigma)),
+            traj.t_end() + delay + sigma * speed / decel,
         ));
         (
             penetrated_map(&mut rng, &traj),

@@ -220,7 +220,7 @@ pub struct UtfMincoObjective<'a> {
     terminal_grad: (Vec3, Vec3, f64),
     /// The braking tail's samples, deceleration (`a_max`) and per-sample weight
     /// (`v_max / a_max / samples`, the quadrature weight of a stop from full speed).
-    tail_setup: (usize, f64, f64),
+    tail_setup: (usize, f64, f64, f64),
     /// The braking tail at the last cost evaluation.
     tail: BrakingTail,
 }
@@ -254,10 +254,12 @@ impl<'a> UtfMincoObjective<'a> {
             terminal_grad: (Vec3::zeros(), Vec3::zeros(), 0.0),
             tail_setup: {
                 let k = params.penalty.braking_tail_samples;
+                let decel = params.penalty.braking_tail_decel_fraction * limits.a_max;
                 (
                     k,
-                    limits.a_max,
-                    limits.v_max / limits.a_max / k.max(1) as f64,
+                    decel,
+                    params.penalty.braking_tail_delay_s,
+                    limits.v_max / decel / k.max(1) as f64,
                 )
             },
             tail: BrakingTail::default(),
@@ -369,12 +371,13 @@ impl<'a> UtfMincoObjective<'a> {
             Ok(Partial::Above(partial)) => return partial,
             Err(_) => return f64::INFINITY,
         };
-        let (samples, decel, weight) = self.tail_setup;
+        let (samples, decel, delay, weight) = self.tail_setup;
         self.tail = self.core.penalties.braking_tail(
             &p_f,
             &v_f,
             self.core.t_start + total,
             decel,
+            delay,
             samples,
             weight,
         );

@@ -87,13 +87,25 @@ pub struct PenaltyParams {
     /// goal guidance surface when the request has a planning horizon
     /// ([`crate::costs::TerminalCost::eval_objective`]).
     pub guidance_smoothing_m: f64,
-    /// Samples of the obstacle penalty along the straight braking manoeuvre (at `a_max`) that
+    /// Samples of the obstacle penalty along the straight braking manoeuvre that
     /// follows a free terminal reached in motion (UTF-MINCO only; 0 switches it off): the
     /// manager's safety check requires that manoeuvre to be clear
     /// (`trust_manager::SafetyParams::braking_tail`), and an optimizer that does not see it
     /// ends trajectories at speed just in front of obstacles. Ours: 8 (see
     /// [`crate::costs::PenaltyIntegrand::braking_tail`]).
     pub braking_tail_samples: usize,
+    /// The braking tail's model: the vehicle keeps its terminal velocity for
+    /// `braking_tail_delay_s`, then decelerates at `braking_tail_decel_fraction · a_max` to rest.
+    /// Defaults 0.9 and 0.1 s: the manager's braking manoeuvre
+    /// (`trust_manager::brake_straight`) aims for 0.9 `a_max` and ramps the deceleration in over
+    /// 0.2 s, which loses the distance of 0.1 s at full deceleration; it stops after 0.34 / 1.42 /
+    /// 4.70 m from 2 / 5 / 10 m/s, this model after 0.35 / 1.43 / 4.70 m (the manager's test
+    /// `the_backends_braking_tail_model_matches_the_braking_manoeuvre` keeps them together). With
+    /// a straight stop at `a_max` (3.33 m from 10 m/s) the check found the tail of E3's and E4's
+    /// candidates blocked 1.4 m beyond what the penalty had cleared.
+    pub braking_tail_decel_fraction: f64,
+    /// See [`PenaltyParams::braking_tail_decel_fraction`].
+    pub braking_tail_delay_s: f64,
 }
 
 impl Default for PenaltyParams {
@@ -121,6 +133,8 @@ impl Default for PenaltyParams {
             terminal_norm_epsilon: 1e-2,
             guidance_smoothing_m: 1.0,
             braking_tail_samples: 8,
+            braking_tail_decel_fraction: 0.9,
+            braking_tail_delay_s: 0.1,
         }
     }
 }
@@ -160,6 +174,18 @@ impl PenaltyParams {
         check_positive(
             &format!("{prefix}.guidance_smoothing_m"),
             self.guidance_smoothing_m,
+        )?;
+        let fraction = self.braking_tail_decel_fraction;
+        if !(fraction > 0.0 && fraction <= 1.0) {
+            return Err(PlanError::invalid(
+                format!("{prefix}.braking_tail_decel_fraction"),
+                fraction,
+                "a fraction of a_max in (0, 1]",
+            ));
+        }
+        check_non_negative(
+            &format!("{prefix}.braking_tail_delay_s"),
+            self.braking_tail_delay_s,
         )?;
         Ok(())
     }

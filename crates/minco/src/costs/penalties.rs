@@ -204,51 +204,56 @@ pub struct BrakingTail {
 impl PenaltyIntegrand<'_> {
     /// The obstacle penalty (moving obstacles and static map) along the straight braking
     /// manoeuvre after a trajectory that ends at `p_f` with velocity `v_f` at time `t_end`:
-    /// decelerating at `decel` along `v_f`, the vehicle is at
-    /// `q(σ) = p_f + v_f·(|v_f|/decel)·(σ − σ²/2)` at time `t(σ) = t_end + σ·|v_f|/decel`,
-    /// `σ ∈ [0, 1]`, and stops at `σ = 1`. Samples `σ_k = k/samples`, `k = 1…samples` (the
-    /// trajectory's own last node is `σ = 0`), each with quadrature weight `weight`. Zero for a
-    /// terminal at rest, `samples == 0` or a non-positive `decel`. Leaves the obstacle broad
-    /// phase set for the tail (the next integration sets its own).
+    /// keeping `v_f` for `delay` seconds and then decelerating at `decel` along `v_f`, the
+    /// vehicle is at `q(σ) = p_f + v_f·(delay + (|v_f|/decel)·(σ − σ²/2))` at time
+    /// `t(σ) = t_end + delay + σ·|v_f|/decel`, `σ ∈ [0, 1]`, and stops at `σ = 1`. Samples
+    /// `σ_k = k/samples`, `k = 1…samples`, and `σ = 0` when `delay > 0` (the trajectory's own
+    /// last node is `p_f`), each with quadrature weight `weight`. Zero for a terminal at rest,
+    /// `samples == 0` or a non-positive `decel`. Leaves the obstacle broad phase set for the tail
+    /// (the next integration sets its own).
+    #[allow(clippy::too_many_arguments)]
     pub fn braking_tail(
         &mut self,
         p_f: &Vec3,
         v_f: &Vec3,
         t_end: f64,
         decel: f64,
+        delay: f64,
         samples: usize,
         weight: f64,
     ) -> BrakingTail {
         let speed = v_f.norm();
         let mut out = BrakingTail::default();
-        let usable = decel > 0.0 && speed > 1e-9 && speed.is_finite();
+        let usable = decel > 0.0 && speed > 1e-9 && speed.is_finite() && delay >= 0.0;
         if samples == 0 || !usable {
             return out;
         }
         let stop_time = speed / decel;
-        let stop = p_f + v_f * (0.5 * stop_time);
+        let stop = p_f + v_f * (delay + 0.5 * stop_time);
         let Some(bbox) = Aabb::from_points(&[*p_f, stop]) else {
             return out;
         };
-        self.begin_trajectory_obstacles(t_end, t_end + stop_time, &bbox);
-        if !self.begin_piece_obstacles(t_end, t_end + stop_time, &bbox) {
+        let t_stop = t_end + delay + stop_time;
+        self.begin_trajectory_obstacles(t_end, t_stop, &bbox);
+        if !self.begin_piece_obstacles(t_end, t_stop, &bbox) {
             return out;
         }
         let unit = v_f / speed;
-        for k in 1..=samples {
+        let first = if delay > 0.0 { 0 } else { 1 };
+        for k in first..=samples {
             let sigma = k as f64 / samples as f64;
             let c = (sigma - 0.5 * sigma * sigma) / decel;
-            let q = p_f + v_f * (speed * c);
-            let t = t_end + sigma * stop_time;
+            let q = p_f + v_f * (delay + speed * c);
+            let t = t_end + delay + sigma * stop_time;
             let (mut gp, mut gt) = (Vec3::zeros(), 0.0);
             let before = self.integrals.obstacle();
             let value = self.obstacles_at(&q, t, weight, &mut gp, &mut gt);
             out.integral += self.integrals.obstacle() - before;
             out.cost += weight * value;
             let (gp, gt) = (gp * weight, gt * weight);
-            // q = p_f + c·|v|·v, t = t_end + σ·|v|/decel.
+            // q = p_f + (delay + c·|v|)·v, t = t_end + delay + σ·|v|/decel.
             out.grad_p += gp;
-            out.grad_v += gp * (speed * c) + unit * (c * v_f.dot(&gp) + gt * sigma / decel);
+            out.grad_v += gp * (delay + speed * c) + unit * (c * v_f.dot(&gp) + gt * sigma / decel);
             out.grad_t += gt;
         }
         out
