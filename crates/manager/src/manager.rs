@@ -762,7 +762,11 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
         let Ok((first, _)) = &cand.result else {
             return cand;
         };
-        let again = self.solve(InitialGuess::WarmStart(&first.traj));
+        // With the cold budget: a repair is rare and its first solve stopped short of clean.
+        let again = self.solve_with(
+            InitialGuess::WarmStart(&first.traj),
+            self.params.cold_max_evaluations,
+        );
         match &again.result {
             Ok((_, verdict)) if verdict.safe => Candidate {
                 repaired_from: Some((
@@ -777,6 +781,14 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
     }
 
     fn solve(&self, initial: InitialGuess<'_>) -> Candidate {
+        let budget = match initial {
+            InitialGuess::WarmStart(_) => self.params.warm_max_evaluations,
+            InitialGuess::Guide(_) => self.params.cold_max_evaluations,
+        };
+        self.solve_with(initial, budget)
+    }
+
+    fn solve_with(&self, initial: InitialGuess<'_>, max_evaluations: Option<usize>) -> Candidate {
         let req = TrajRequest {
             start: self.start,
             goal: self.goal,
@@ -784,10 +796,7 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
             initial,
             deadline: self.deadline,
             horizon_s: Some(self.horizon_s),
-            max_evaluations: match initial {
-                InitialGuess::WarmStart(_) => self.params.warm_max_evaluations,
-                InitialGuess::Guide(_) => self.params.cold_max_evaluations,
-            },
+            max_evaluations,
         };
         match self.backend.optimize(&req, self.scene) {
             Err(e) => Candidate {

@@ -47,7 +47,8 @@ pub struct ManagerParams {
     pub explore_period_cycles: usize,
     /// A trajectory (kept branch or new candidate) that fails the safety check by at most this
     /// much (m) — or only on the speed and acceleration limits — is re-solved once, warm-started
-    /// from itself; the re-solve replaces it if it passes (the "dropped or repaired").
+    /// from itself with the cold budget ([`ManagerParams::cold_max_evaluations`]); the re-solve
+    /// replaces it if it passes (the "dropped or repaired").
     /// The penalties are soft and a solve may stop on its budget, so a few millimetres of
     /// violation are common in cold solves (E3). `0` switches repairs off. Default 0.05 m.
     pub repair_margin_m: f64,
