@@ -92,7 +92,10 @@ fn planner(paper: bool) -> Planner {
         params.explore_period_cycles = 1;
         params.warm_max_evaluations = None;
     }
+    // As the simulator's presets fly it (`trust_sim::planner::closed_loop_backend`).
     let mut backend = trust_minco::UtfMincoParams::default();
+    backend.weights.time = 60.0;
+    backend.weights.terminal = 60.0;
     backend.penalty.static_clearance_m = 0.5;
     params.safety.static_clearance_m = 0.3;
     Manager::new(
