@@ -72,12 +72,11 @@ pub fn swept_box(forecast: &Forecast, t_a: f64, t_b: f64, margin: f64) -> Aabb {
 ///
 /// The per-trajectory test runs at every evaluation of an optimization, over every forecast.
 /// Between evaluations the trajectory moves little, so the term keeps a *superset*: the
-/// forecasts whose swept box over a wider window ([`SUPERSET_MARGIN_S`] later) meets a wider
-/// region ([`SUPERSET_MARGIN_M`] around the samples). While later trajectories stay inside that
+/// forecasts whose swept box over a wider window (1.5 s later, `SUPERSET_MARGIN_S`) meets a wider
+/// region (4 m around the samples, `SUPERSET_MARGIN_M`). While later trajectories stay inside that
 /// window and region, only the superset is tested — with the same result, because a forecast's
 /// swept box over a sub-window lies inside its box over the window (linear motion, radius
-/// non-decreasing in time). With 100 forecasts in an E4-like scene this cuts the broad phase by
-/// about 5× per evaluation.
+/// non-decreasing in time).
 #[derive(Debug, Clone)]
 pub struct DynamicObstacleTerm<'a> {
     forecasts: &'a [Forecast],
