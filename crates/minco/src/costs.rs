@@ -34,7 +34,7 @@ pub use dynamic::{DynamicObstacleTerm, ddf_violation, swept_box};
 pub use feasibility::{FeasibilityTerm, norm_violation};
 pub use integrate::{Integrand, PiecewiseView, SampleGrad, SampleState, TrapezoidIntegrator};
 pub use params::{CostWeights, PenaltyParams};
-pub use penalties::{BrakingTail, PenaltyIntegrals, PenaltyIntegrand};
+pub use penalties::{BrakingTail, PenaltyIntegrals, PenaltyIntegrand, TAIL_RAMP_MPS};
 pub use smooth::{SmoothedL1, smoothed_l1};
 pub use static_map::StaticObstacleTerm;
 pub use terminal::{TerminalCost, smoothed_weighted_norm, terminal_velocity_weight, time_cost};
