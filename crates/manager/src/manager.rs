@@ -61,9 +61,12 @@ impl Branch {
 struct Candidate {
     result: Result<(Solution, SafetyVerdict), PlanError>,
     check_time: Duration,
-    /// A first solve that failed the safety check narrowly and was repaired by this one
-    /// ([`ManagerParams::repair_margin_m`]): its solve time, evaluations and check time.
-    repaired_from: Option<(Duration, usize, Duration)>,
+    /// The other solve of a repair attempt ([`ManagerParams::repair_margin_m`]): the narrowly
+    /// unsafe first solve when the re-solve passed and replaced it, the failed re-solve when it
+    /// did not. Its solve time, evaluations and check time count in the cycle's timing.
+    other_solve: Option<(Duration, usize, Duration)>,
+    /// The re-solve of a repair attempt passed and is this candidate.
+    repaired: bool,
 }
 
 impl Candidate {
@@ -354,7 +357,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let mut kept: Vec<Branch> = Vec::new();
         for ((id, origin, _), cand) in warm.into_iter().zip(warm_out) {
             timing.add(&cand, false);
-            if cand.repaired_from.is_some() {
+            if cand.repaired {
                 events.push(Event::Repaired { id: Some(id) });
             }
             let failed = match cand.result {
@@ -407,7 +410,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let incumbent = if history { self.main } else { None };
         for cand in cold_out {
             timing.add(&cand, true);
-            if cand.repaired_from.is_some() {
+            if cand.repaired {
                 events.push(Event::Repaired { id: None });
             }
             match cand.result {
@@ -767,16 +770,22 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
             InitialGuess::WarmStart(&first.traj),
             self.params.cold_max_evaluations,
         );
+        let spent = |c: &Candidate| {
+            c.result
+                .as_ref()
+                .ok()
+                .map(|(s, _)| (s.stats.elapsed, s.stats.evaluation_count, c.check_time))
+        };
         match &again.result {
             Ok((_, verdict)) if verdict.safe => Candidate {
-                repaired_from: Some((
-                    first.stats.elapsed,
-                    first.stats.evaluation_count,
-                    cand.check_time,
-                )),
+                other_solve: spent(&cand),
+                repaired: true,
                 ..again
             },
-            _ => cand,
+            _ => Candidate {
+                other_solve: spent(&again),
+                ..cand
+            },
         }
     }
 
@@ -802,7 +811,8 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
             Err(e) => Candidate {
                 result: Err(e),
                 check_time: Duration::ZERO,
-                repaired_from: None,
+                other_solve: None,
+                repaired: false,
             },
             Ok(solution) => {
                 let t = Instant::now();
@@ -818,7 +828,8 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
                 Candidate {
                     check_time: t.elapsed(),
                     result: Ok((solution, verdict)),
-                    repaired_from: None,
+                    other_solve: None,
+                    repaired: false,
                 }
             }
         }
@@ -828,12 +839,14 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
 impl CycleTiming {
     fn add(&mut self, cand: &Candidate, cold: bool) {
         self.checker_ms += ms(cand.check_time);
-        if let Some((solve, evaluations, check)) = cand.repaired_from {
+        if cand.repaired {
+            self.repair_count += 1;
+        }
+        if let Some((solve, evaluations, check)) = cand.other_solve {
             self.checker_ms += ms(check);
             self.backend_ms += ms(solve);
             self.evaluations += evaluations;
             self.solve_count += 1;
-            self.repair_count += 1;
             if cold {
                 self.cold_backend_ms += ms(solve);
                 self.cold_solve_count += 1;

@@ -212,7 +212,8 @@ pub struct CycleTiming {
     #[serde(default)]
     pub evaluations: usize,
     /// Solves that failed the safety check narrowly and passed after one more warm re-solve
-    /// ([`crate::ManagerParams::repair_margin_m`]); both solves are in `solve_count`.
+    /// ([`crate::ManagerParams::repair_margin_m`]). Every repair attempt's re-solve, passed or
+    /// not, is in `solve_count` and the times.
     #[serde(default)]
     pub repair_count: usize,
 }
