@@ -147,10 +147,7 @@ fn cylinder_verdict(
 fn box_verdict(bx: &crate::shapes::AaBox, a: &Vec3, b: &Vec3, clearance: f64) -> Option<bool> {
     let tol = 1e-9 * (1.0 + (bx.max - bx.min).amax() + clearance);
     let grow = (clearance - tol).max(0.0);
-    let base = crate::Aabb {
-        min: bx.min,
-        max: bx.max,
-    };
+    let base = bx.aabb();
     if base.clip_segment(a, b).is_some() {
         return Some(true);
     }

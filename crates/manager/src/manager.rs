@@ -69,13 +69,6 @@ struct Candidate {
     repaired: bool,
 }
 
-impl Candidate {
-    /// Whether it was solved and failed the safety check narrowly ([`narrowly_unsafe`]).
-    fn narrowly_unsafe(&self, margin: f64) -> bool {
-        matches!(&self.result, Ok((_, v)) if narrowly_unsafe(v, margin))
-    }
-}
-
 /// Whether `v` failed by at most `margin` (m) of clearance, or only on the limits.
 fn narrowly_unsafe(v: &SafetyVerdict, margin: f64) -> bool {
     !v.safe
@@ -759,11 +752,9 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
     /// most `repair_margin_m` and the re-solve passes; otherwise `cand` unchanged.
     fn repaired(&self, cand: Candidate) -> Candidate {
         let margin = self.params.repair_margin_m;
-        if margin <= 0.0 || !cand.narrowly_unsafe(margin) {
-            return cand;
-        }
-        let Ok((first, _)) = &cand.result else {
-            return cand;
+        let first = match &cand.result {
+            Ok((first, verdict)) if margin > 0.0 && narrowly_unsafe(verdict, margin) => first,
+            _ => return cand,
         };
         // With the cold budget: a repair is rare and its first solve stopped short of clean.
         let again = self.solve_with(

@@ -244,10 +244,7 @@ impl TrapezoidIntegrator {
             let b = rule.piece_box(self.scaled.len(), &scaled, &self.u_powers);
             // Union of the piece boxes (a `points_box` of the corners would take the initial
             // ±∞ corners as points and span everything).
-            all = Aabb {
-                min: all.min.inf(&b.min),
-                max: all.max.sup(&b.max),
-            };
+            all = all.union(&b);
             self.boxes.push(b);
             self.scaled.push(scaled);
         }
