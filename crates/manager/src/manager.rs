@@ -289,8 +289,13 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             },
             || {
                 warm.par_iter()
-                    .map(|(_, _, traj)| {
-                        solver.repaired(solver.solve(InitialGuess::WarmStart(traj)))
+                    .map(|(_, origin, traj)| {
+                        let budget = match origin {
+                            Origin::Replanned => solver.params.sub_branch_max_evaluations,
+                            _ => None,
+                        }
+                        .or(solver.params.warm_max_evaluations);
+                        solver.repaired(solver.solve_with(InitialGuess::WarmStart(traj), budget))
                     })
                     .collect::<Vec<_>>()
             },

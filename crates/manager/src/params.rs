@@ -34,6 +34,16 @@ pub struct ManagerParams {
     /// flights took 29.5 / 32.2 / 30.4 s with it and 29.4 / 31.2 / 30.8 s without, at a median
     /// cycle of 3.9 instead of 8.4 ms; a budget of 50 cost 10–20 % of flight time (34–37 s).
     pub warm_max_evaluations: Option<usize>,
+    /// Evaluation budget of a sub-branch's re-solve (BwdReplan); `None`: the same as
+    /// [`ManagerParams::warm_max_evaluations`]. A sub-branch is refined again every cycle and only
+    /// needs to be good enough to challenge the main branch, so it can take a smaller share of
+    /// the cycle than the main branch's FwdMarch, which the vehicle flies.
+    /// Default 50 (beyond the paper): the cycle bench's median fell from 2.26 to 1.44 ms. It
+    /// costs a little flight time: E4 seeds 0–7 (single flights, reproducible mode) took 28.99 s
+    /// on average against 28.60 s with 100 (per seed 28.77 / 29.21 / 28.17 / 28.19 / 29.66 /
+    /// 32.65 / 27.89 / 27.39 s against 27.70 / 28.80 / 28.70 / 27.60 / 28.40 / 32.50 / 27.90 /
+    /// 27.40 s); 70 gave 29.08 s, and 50 with a main-branch budget of 150 29.34 s.
+    pub sub_branch_max_evaluations: Option<usize>,
     /// Evaluation budget of a cold solve from a frontend path (FwdExplore); `None`: the backend's
     /// own.
     pub cold_max_evaluations: Option<usize>,
@@ -93,9 +103,11 @@ impl Default for ManagerParams {
 
 impl ManagerParams {
     /// TRUST-Planner: five branches with history (Algorithm 1), exploring every third cycle
-    /// with warm re-solves capped at 100 evaluations (our defaults, see the fields). Algorithm 1
-    /// exactly as written: `explore_period_cycles = 1`, `warm_max_evaluations = None`
-    /// (`trust-sim ablate --variant explore=1` for the exploration period).
+    /// with warm re-solves capped at 100 evaluations for the main branch and 50 for each
+    /// sub-branch (our defaults, see the fields). Algorithm 1 exactly as written:
+    /// `explore_period_cycles = 1`, `warm_max_evaluations = None`,
+    /// `sub_branch_max_evaluations = None` (`trust-sim ablate --variant explore=1` for the
+    /// exploration period).
     pub fn trust() -> Self {
         ManagerParams {
             max_branches: 5,
@@ -103,6 +115,7 @@ impl ManagerParams {
             max_explored_paths: 5,
             straight_guide_when_empty: true,
             warm_max_evaluations: Some(100),
+            sub_branch_max_evaluations: Some(50),
             cold_max_evaluations: None,
             explore_period_cycles: 3,
             repair_margin_m: 0.05,
@@ -168,6 +181,10 @@ impl ManagerParams {
         }
         for (field, v) in [
             ("manager.warm_max_evaluations", self.warm_max_evaluations),
+            (
+                "manager.sub_branch_max_evaluations",
+                self.sub_branch_max_evaluations,
+            ),
             ("manager.cold_max_evaluations", self.cold_max_evaluations),
         ] {
             if v == Some(0) {
@@ -342,6 +359,10 @@ mod tests {
         p.repair_margin_m = -0.1;
         let e = p.validate().unwrap_err().to_string();
         assert!(e.contains("manager.repair_margin_m"), "{e}");
+        p.repair_margin_m = 0.05;
+        p.sub_branch_max_evaluations = Some(0);
+        let e = p.validate().unwrap_err().to_string();
+        assert!(e.contains("manager.sub_branch_max_evaluations"), "{e}");
     }
 
     #[test]

@@ -8,7 +8,7 @@ use trust_core::{
     StaticMap, TrajRequest, TrajectoryBackend, Vec3,
 };
 use trust_geometry::{AaBox, Shape};
-use trust_manager::{Event, Manager, ManagerParams, StepReport, check_trajectory};
+use trust_manager::{Event, Manager, ManagerParams, Origin, StepReport, check_trajectory};
 use trust_minco::UtfMinco;
 use trust_topo_prm::scenes::{SceneParams, random_dynamic_scene};
 use trust_topo_prm::{DevPrm, DevPrmParams, StraightLine, Tvd};
@@ -178,6 +178,43 @@ fn consecutive_plans_join_continuously() {
         state = plan.state(t + 0.1);
         previous = Some(plan);
     }
+}
+
+#[test]
+fn re_solves_respect_their_evaluation_budgets() {
+    // The main branch's FwdMarch gets `warm_max_evaluations`, each sub-branch's BwdReplan the
+    // smaller `sub_branch_max_evaluations` (repairs off: a repair re-solves with the cold budget).
+    // The backend counts one more evaluation than the solver's: the one that packages the result.
+    let map = two_gap_corridor();
+    let mut m = planner(ManagerParams {
+        warm_max_evaluations: Some(40),
+        sub_branch_max_evaluations: Some(9),
+        repair_margin_m: 0.0,
+        ..ManagerParams::trust()
+    });
+    let reports = fly(&mut m, &map, GOAL, State::at_rest(0.0, START), 8, |_| {
+        Vec::new()
+    });
+    let mut seen = (0, 0);
+    for r in &reports {
+        for b in &r.branches {
+            match b.origin {
+                Origin::Marched => {
+                    assert!(b.evaluation_count <= 41, "main branch: {b:?}");
+                    seen.0 += 1;
+                }
+                Origin::Replanned => {
+                    assert!(b.evaluation_count <= 10, "sub-branch: {b:?}");
+                    seen.1 += 1;
+                }
+                _ => {}
+            }
+        }
+    }
+    assert!(
+        seen.0 > 0 && seen.1 > 0,
+        "marched / replanned seen: {seen:?}"
+    );
 }
 
 fn summary(reports: &[StepReport]) -> Vec<String> {
