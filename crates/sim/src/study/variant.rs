@@ -44,7 +44,8 @@ pub enum Variant {
     Fault(f64),
     /// `explore=K`: the multi-branch managers with history run FwdExplore (the frontend and the
     /// cold solves) every `K`-th cycle and whenever fewer than two branches are kept
-    /// (`manager.explore_period_cycles`); `K = 1` is the paper's Algorithm 1.
+    /// (`manager.explore_period_cycles`); `K = 1` explores every cycle as the paper's Algorithm 1
+    /// does (the warm re-solve budgets stay).
     Explore(usize),
 }
 
