@@ -95,25 +95,29 @@ impl CorrectionMemory {
         if self.is_empty() {
             return;
         }
+        let n = self.dimension;
         let newest = self.slot_back(1);
-        // Newest to oldest.
-        for back in 1..=self.len {
-            let j = self.slot_back(back);
-            let col = self.column(j);
-            let alpha = dot(&self.s[col.clone()], d) / self.ys[j];
+        let oldest = self.slot_back(self.len);
+        // Newest to oldest (slots step down through the ring, without a modulo per pair).
+        let mut j = newest;
+        for _ in 0..self.len {
+            let (s, y) = (&self.s[j * n..(j + 1) * n], &self.y[j * n..(j + 1) * n]);
+            let alpha = dot(s, d) / self.ys[j];
             self.alpha[j] = alpha;
-            axpy(-alpha, &self.y[col], d);
+            axpy(-alpha, y, d);
+            j = if j == 0 { self.capacity - 1 } else { j - 1 };
         }
         let gamma = self.ys[newest] / self.yy[newest];
         for di in d.iter_mut() {
             *di *= gamma;
         }
         // Oldest to newest.
-        for back in (1..=self.len).rev() {
-            let j = self.slot_back(back);
-            let col = self.column(j);
-            let beta = dot(&self.y[col.clone()], d) / self.ys[j];
-            axpy(self.alpha[j] - beta, &self.s[col], d);
+        let mut j = oldest;
+        for _ in 0..self.len {
+            let (s, y) = (&self.s[j * n..(j + 1) * n], &self.y[j * n..(j + 1) * n]);
+            let beta = dot(y, d) / self.ys[j];
+            axpy(self.alpha[j] - beta, s, d);
+            j = if j + 1 == self.capacity { 0 } else { j + 1 };
         }
     }
 
@@ -131,6 +135,48 @@ impl CorrectionMemory {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// After the ring has wrapped, the recursion uses the newest `capacity` pairs in order: it
+    /// matches a plain two-loop recursion over a list of those pairs.
+    #[test]
+    fn a_wrapped_ring_matches_the_two_loop_over_the_newest_pairs() {
+        let (n, capacity, pushes) = (4, 3, 7);
+        let mut memory = CorrectionMemory::new(n, capacity);
+        let mut pairs: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
+        let zero = vec![0.0; n];
+        for k in 0..pushes {
+            // Positive curvature: y = diag(1 + i + k)·s with s varying by pair.
+            let s: Vec<f64> = (0..n).map(|i| ((k * 7 + i * 3) % 5) as f64 - 1.5).collect();
+            let y: Vec<f64> = (0..n).map(|i| (1.0 + (i + k) as f64) * s[i]).collect();
+            assert!(memory.push_if_cautious(&s, &zero, &y, &zero, 0.0));
+            pairs.push((s, y));
+        }
+        let newest = &pairs[pushes - capacity..];
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let d0: Vec<f64> = (0..n).map(|i| 0.7 - 0.4 * i as f64).collect();
+        let mut expected = d0.clone();
+        let mut alphas = vec![0.0; capacity];
+        for (j, (s, y)) in newest.iter().enumerate().rev() {
+            alphas[j] = dot(s, &expected) / dot(y, s);
+            for i in 0..n {
+                expected[i] -= alphas[j] * y[i];
+            }
+        }
+        let (s, y) = newest.last().unwrap();
+        let gamma = dot(y, s) / dot(y, y);
+        expected.iter_mut().for_each(|e| *e *= gamma);
+        for (j, (s, y)) in newest.iter().enumerate() {
+            let beta = dot(y, &expected) / dot(y, s);
+            for i in 0..n {
+                expected[i] += (alphas[j] - beta) * s[i];
+            }
+        }
+        let mut d = d0;
+        memory.apply_inverse_hessian(&mut d);
+        for i in 0..n {
+            approx::assert_relative_eq!(d[i], expected[i], max_relative = 1e-12);
+        }
+    }
 
     /// With one pair from a quadratic with Hessian `diag(a)`, the result must satisfy the secant
     /// equation `H·y = s`.
