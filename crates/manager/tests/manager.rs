@@ -296,6 +296,106 @@ fn never_more_than_n_branches() {
     assert_eq!(reports.last().unwrap().branches.len(), 2);
 }
 
+#[test]
+fn flies_out_of_a_dead_end_around_it_to_the_goal() {
+    // A cul-de-sac straight ahead: a 4 m wide, 14 m long corridor closed at its far end, with the
+    // goal behind the closed end. The straight line to the goal leads into it; the vehicle must
+    // go around its walls (they span the full height), and it must not touch them.
+    let bounds = Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(40.0, 10.0, 6.0)).unwrap();
+    let block = |min: [f64; 3], max: [f64; 3]| {
+        Shape::AaBox(AaBox::new(Vec3::from(min), Vec3::from(max)).unwrap())
+    };
+    let map = StaticMap::from_shapes(
+        bounds,
+        vec![
+            block([6.0, 2.0, 0.0], [20.0, 2.5, 6.0]),
+            block([6.0, -2.5, 0.0], [20.0, -2.0, 6.0]),
+            block([20.0, -2.5, 0.0], [20.5, 2.5, 6.0]),
+        ],
+    )
+    .unwrap();
+    let goal = Vec3::new(36.0, 0.0, 3.0);
+    let mut m = planner(ManagerParams::trust());
+    let mut state = State::at_rest(0.0, START);
+    let mut went_around = false;
+    for k in 0..150 {
+        let t = 0.1 * k as f64;
+        let scene = Scene::new(&map, &[], t).unwrap();
+        let report = m.step(t, &state, &goal, &scene).expect("valid input");
+        assert!(report.fallback.is_none(), "cycle {k}: braking fallback");
+        let plan = m.plan().expect("a plan");
+        let verdict = check_trajectory(plan, &scene, t, t + 0.1, &Limits::default(), &{
+            let mut s = trust_manager::SafetyParams::default();
+            s.static_clearance_m = 0.0;
+            s.braking_tail = false;
+            s
+        });
+        assert!(
+            verdict.safe,
+            "cycle {k}: the flown part collides: {verdict:?}"
+        );
+        state = plan.state(t + 0.1);
+        went_around |= state.p.x > 21.0 && state.p.y.abs() > 2.5;
+        if (state.p - goal).norm() < 0.5 {
+            break;
+        }
+    }
+    assert!(went_around, "never passed beside the dead end");
+    assert!(
+        (state.p - goal).norm() < 0.5,
+        "did not reach the goal in 15 s: {:?}",
+        state.p
+    );
+}
+
+#[test]
+fn an_enclosed_goal_is_approached_without_collision_and_never_reached() {
+    // The goal lies in a closed room (walls over the full height): no trajectory reaches it.
+    // The manager must keep the vehicle safe — stop short of the walls — not crash or loop.
+    let bounds = Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(40.0, 10.0, 6.0)).unwrap();
+    let block = |min: [f64; 3], max: [f64; 3]| {
+        Shape::AaBox(AaBox::new(Vec3::from(min), Vec3::from(max)).unwrap())
+    };
+    let map = StaticMap::from_shapes(
+        bounds,
+        vec![
+            block([25.0, -5.0, 0.0], [25.5, 5.0, 6.0]),
+            block([34.5, -5.0, 0.0], [35.0, 5.0, 6.0]),
+            block([25.0, 4.5, 0.0], [35.0, 5.0, 6.0]),
+            block([25.0, -5.0, 0.0], [35.0, -4.5, 6.0]),
+        ],
+    )
+    .unwrap();
+    let goal = Vec3::new(30.0, 0.0, 3.0);
+    let mut m = planner(ManagerParams::trust());
+    let mut state = State::at_rest(0.0, START);
+    let check = {
+        let mut s = trust_manager::SafetyParams::default();
+        s.static_clearance_m = 0.0;
+        s.braking_tail = false;
+        s
+    };
+    for k in 0..100 {
+        let t = 0.1 * k as f64;
+        let scene = Scene::new(&map, &[], t).unwrap();
+        m.step(t, &state, &goal, &scene).expect("valid input");
+        let plan = m.plan().expect("a plan");
+        let verdict = check_trajectory(plan, &scene, t, t + 0.1, &Limits::default(), &check);
+        assert!(
+            verdict.safe,
+            "cycle {k}: the flown part collides: {verdict:?}"
+        );
+        state = plan.state(t + 0.1);
+        assert!(state.p.iter().all(|c| c.is_finite()));
+        let inside = (25.0..35.0).contains(&state.p.x) && (-5.0..5.0).contains(&state.p.y);
+        assert!(
+            !inside,
+            "cycle {k}: inside the closed room at {:?}",
+            state.p
+        );
+    }
+}
+
 /// A backend that ignores obstacles: it continues the start state for 4 s (constant
 /// acceleration), so every trajectory drives into whatever is ahead.
 struct Blind;
