@@ -296,6 +296,15 @@ fn never_more_than_n_branches() {
     assert_eq!(reports.last().unwrap().branches.len(), 2);
 }
 
+/// A safety check for contact only: no clearance, no braking tail.
+fn contact_only() -> trust_manager::SafetyParams {
+    trust_manager::SafetyParams {
+        static_clearance_m: 0.0,
+        braking_tail: false,
+        ..Default::default()
+    }
+}
+
 #[test]
 fn flies_out_of_a_dead_end_around_it_to_the_goal() {
     // A cul-de-sac straight ahead: a 4 m wide, 14 m long corridor closed at its far end, with the
@@ -324,12 +333,14 @@ fn flies_out_of_a_dead_end_around_it_to_the_goal() {
         let report = m.step(t, &state, &goal, &scene).expect("valid input");
         assert!(report.fallback.is_none(), "cycle {k}: braking fallback");
         let plan = m.plan().expect("a plan");
-        let verdict = check_trajectory(plan, &scene, t, t + 0.1, &Limits::default(), &{
-            let mut s = trust_manager::SafetyParams::default();
-            s.static_clearance_m = 0.0;
-            s.braking_tail = false;
-            s
-        });
+        let verdict = check_trajectory(
+            plan,
+            &scene,
+            t,
+            t + 0.1,
+            &Limits::default(),
+            &contact_only(),
+        );
         assert!(
             verdict.safe,
             "cycle {k}: the flown part collides: {verdict:?}"
@@ -369,18 +380,19 @@ fn an_enclosed_goal_is_approached_without_collision_and_never_reached() {
     let goal = Vec3::new(30.0, 0.0, 3.0);
     let mut m = planner(ManagerParams::trust());
     let mut state = State::at_rest(0.0, START);
-    let check = {
-        let mut s = trust_manager::SafetyParams::default();
-        s.static_clearance_m = 0.0;
-        s.braking_tail = false;
-        s
-    };
     for k in 0..100 {
         let t = 0.1 * k as f64;
         let scene = Scene::new(&map, &[], t).unwrap();
         m.step(t, &state, &goal, &scene).expect("valid input");
         let plan = m.plan().expect("a plan");
-        let verdict = check_trajectory(plan, &scene, t, t + 0.1, &Limits::default(), &check);
+        let verdict = check_trajectory(
+            plan,
+            &scene,
+            t,
+            t + 0.1,
+            &Limits::default(),
+            &contact_only(),
+        );
         assert!(
             verdict.safe,
             "cycle {k}: the flown part collides: {verdict:?}"
