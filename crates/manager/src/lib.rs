@@ -67,6 +67,7 @@ pub use brake::{brake_along, brake_straight, hermite_quintic};
 pub use manager::{Branch, MainDecision, Manager, choose_main};
 pub use params::{ManagerParams, ReanchorParams, SafetyParams};
 pub use report::{
-    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, Origin, StepReport,
+    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
+    Origin, StepReport,
 };
 pub use safety::{Hit, SafetyVerdict, Violation, assess_trajectory, check_trajectory};

@@ -13,7 +13,8 @@ use trust_core::{
 use crate::ManagerParams;
 use crate::brake::{brake_along, brake_straight};
 use crate::report::{
-    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, Origin, StepReport,
+    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
+    Origin, StepReport,
 };
 use crate::safety::{SafetyVerdict, assess_trajectory, check_trajectory, window_bounds};
 
@@ -378,11 +379,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                     false
                 }
                 Ok((solution, verdict)) => {
-                    events.push(Event::DroppedCollision {
-                        id: Some(id),
-                        violation: verdict.violation,
-                        braking_tail: verdict.braking_tail_violated,
-                    });
+                    events.push(dropped_collision(Some(id), &verdict, &self.limits));
                     rejected.push(("branch", solution.traj));
                     true
                 }
@@ -417,11 +414,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                     error: e.to_string(),
                 }),
                 Ok((solution, verdict)) if !verdict.safe => {
-                    events.push(Event::DroppedCollision {
-                        id: None,
-                        violation: verdict.violation,
-                        braking_tail: verdict.braking_tail_violated,
-                    });
+                    events.push(dropped_collision(None, &verdict, &self.limits));
                     rejected.push(("candidate", solution.traj));
                 }
                 Ok((solution, verdict)) => {
@@ -737,6 +730,21 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             min_margin_m: verdict.min_margin_m(),
             stop_time,
         })
+    }
+}
+
+/// The event of a trajectory dropped by the safety check with `verdict`.
+fn dropped_collision(id: Option<BranchId>, verdict: &SafetyVerdict, limits: &Limits) -> Event {
+    Event::DroppedCollision {
+        id,
+        violation: verdict.violation,
+        braking_tail: verdict.braking_tail_violated,
+        over_limits: verdict.over_limits.then_some(LimitExcess {
+            max_speed_mps: verdict.max_speed,
+            v_max: limits.v_max,
+            max_accel_mps2: verdict.max_accel,
+            a_max: limits.a_max,
+        }),
     }
 }
 

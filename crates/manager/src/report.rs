@@ -103,6 +103,10 @@ pub enum Event {
         /// The trajectory itself was clear; braking straight after its end was not
         /// ([`crate::SafetyParams::braking_tail`]).
         braking_tail: bool,
+        /// Its largest speed and acceleration, when they exceeded the vehicle's limits by more
+        /// than [`crate::SafetyParams::limit_tolerance`] (`None` otherwise).
+        #[serde(default)]
+        over_limits: Option<LimitExcess>,
     },
     /// A trajectory failed the safety check narrowly and passed after one more warm re-solve
     /// ([`crate::ManagerParams::repair_margin_m`]).
@@ -173,6 +177,20 @@ impl Event {
             Event::Fallback { .. } => "fallback",
         }
     }
+}
+
+/// How far a dropped trajectory went beyond the vehicle's limits: the values reached and the
+/// limits they were checked against.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LimitExcess {
+    /// Largest speed along the trajectory (m/s).
+    pub max_speed_mps: f64,
+    /// The speed limit `v_max` (m/s).
+    pub v_max: f64,
+    /// Largest acceleration along the trajectory (m/s²).
+    pub max_accel_mps2: f64,
+    /// The acceleration limit `a_max` (m/s²).
+    pub a_max: f64,
 }
 
 /// The frontend's part of a cycle.

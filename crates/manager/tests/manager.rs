@@ -445,6 +445,48 @@ impl TrajectoryBackend for Blind {
 }
 
 #[test]
+fn a_trajectory_beyond_the_limits_is_dropped_with_the_values_reached() {
+    // The blind backend keeps the measured 13 m/s, 30 % above `v_max`: its plan is clear of
+    // everything but infeasible, and the drop says by how much.
+    let bounds = Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(100.0, 10.0, 10.0)).unwrap();
+    let map = StaticMap::empty(bounds).unwrap();
+    let mut m = Manager::new(
+        StraightLine,
+        Blind,
+        Tvd::default(),
+        Limits::default(),
+        reproducible(ManagerParams::single_branch()),
+    )
+    .unwrap();
+    let start = State {
+        t: 0.0,
+        p: Vec3::new(5.0, 0.0, 5.0),
+        v: Vec3::new(13.0, 0.0, 0.0),
+        a: Vec3::zeros(),
+    };
+    let scene = Scene::new(&map, &[], 0.0).unwrap();
+    let r = m
+        .step(0.0, &start, &Vec3::new(95.0, 0.0, 5.0), &scene)
+        .unwrap();
+    let excess = r
+        .events
+        .iter()
+        .find_map(|e| match e {
+            Event::DroppedCollision {
+                violation: None,
+                over_limits,
+                ..
+            } => *over_limits,
+            _ => None,
+        })
+        .expect("a drop on the limits alone");
+    assert!((excess.max_speed_mps - 13.0).abs() < 1e-6, "{excess:?}");
+    assert_eq!(excess.v_max, Limits::default().v_max);
+    assert_eq!(excess.a_max, Limits::default().a_max);
+    assert!(r.main.is_none() && r.fallback.is_some());
+}
+
+#[test]
 fn braking_fallback_when_every_branch_collides() {
     let bounds = Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(100.0, 10.0, 10.0)).unwrap();
     let map = StaticMap::empty(bounds).unwrap();

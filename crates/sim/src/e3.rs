@@ -271,7 +271,9 @@ pub fn report_md(s: &E3Summary) -> String {
          guidance surface plus the goal term (paper eq. design-of-Hs), `I_e` the jerk energy. \
          Candidates that are not kept appear in the events below: `DiscardedEquivalent` (the \
          optimized trajectory is TVD-equivalent to a better one), `DroppedCollision` (it fails \
-         the safety check; `braking_tail: true` when only stopping after its end would collide)."
+         the safety check; `braking_tail: true` when only stopping after its end would collide, \
+         `over_limits` with the speed and acceleration reached when it exceeds the vehicle's \
+         limits by more than the tolerance — a class the vehicle cannot fly in time)."
     );
     let _ = writeln!(md, "\n## Events\n");
     for e in &s.events {
