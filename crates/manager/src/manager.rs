@@ -343,7 +343,11 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         }
         let cold_out: Vec<Candidate> = paths
             .par_iter()
-            .map(|p: &GuidePath| solver.repaired(solver.solve(InitialGuess::Guide(p))))
+            .map(|p: &GuidePath| {
+                solver.repaired(
+                    solver.solve_with(InitialGuess::Guide(p), self.params.cold_max_evaluations),
+                )
+            })
             .collect();
 
         let mut timing = CycleTiming {
@@ -791,14 +795,6 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
                 ..cand
             },
         }
-    }
-
-    fn solve(&self, initial: InitialGuess<'_>) -> Candidate {
-        let budget = match initial {
-            InitialGuess::WarmStart(_) => self.params.warm_max_evaluations,
-            InitialGuess::Guide(_) => self.params.cold_max_evaluations,
-        };
-        self.solve_with(initial, budget)
     }
 
     fn solve_with(&self, initial: InitialGuess<'_>, max_evaluations: Option<usize>) -> Candidate {

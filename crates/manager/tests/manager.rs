@@ -296,6 +296,11 @@ fn never_more_than_n_branches() {
     assert_eq!(reports.last().unwrap().branches.len(), 2);
 }
 
+/// The axis-aligned box from `min` to `max`.
+fn block(min: [f64; 3], max: [f64; 3]) -> Shape {
+    Shape::AaBox(AaBox::new(Vec3::from(min), Vec3::from(max)).unwrap())
+}
+
 /// A safety check for contact only: no clearance, no braking tail.
 fn contact_only() -> trust_manager::SafetyParams {
     trust_manager::SafetyParams {
@@ -310,12 +315,8 @@ fn flies_out_of_a_dead_end_around_it_to_the_goal() {
     // A cul-de-sac straight ahead: a 4 m wide, 14 m long corridor closed at its far end, with the
     // goal behind the closed end. The straight line to the goal leads into it; the vehicle must
     // go around its walls (they span the full height), and it must not touch them.
-    let bounds = Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(40.0, 10.0, 6.0)).unwrap();
-    let block = |min: [f64; 3], max: [f64; 3]| {
-        Shape::AaBox(AaBox::new(Vec3::from(min), Vec3::from(max)).unwrap())
-    };
     let map = StaticMap::from_shapes(
-        bounds,
+        Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(40.0, 10.0, 6.0)).unwrap(),
         vec![
             block([6.0, 2.0, 0.0], [20.0, 2.5, 6.0]),
             block([6.0, -2.5, 0.0], [20.0, -2.0, 6.0]),
@@ -363,12 +364,8 @@ fn flies_out_of_a_dead_end_around_it_to_the_goal() {
 fn an_enclosed_goal_is_approached_without_collision_and_never_reached() {
     // The goal lies in a closed room (walls over the full height): no trajectory reaches it.
     // The manager must keep the vehicle safe — stop short of the walls — not crash or loop.
-    let bounds = Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(40.0, 10.0, 6.0)).unwrap();
-    let block = |min: [f64; 3], max: [f64; 3]| {
-        Shape::AaBox(AaBox::new(Vec3::from(min), Vec3::from(max)).unwrap())
-    };
     let map = StaticMap::from_shapes(
-        bounds,
+        Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(40.0, 10.0, 6.0)).unwrap(),
         vec![
             block([25.0, -5.0, 0.0], [25.5, 5.0, 6.0]),
             block([34.5, -5.0, 0.0], [35.0, 5.0, 6.0]),
@@ -444,26 +441,41 @@ impl TrajectoryBackend for Blind {
     }
 }
 
-#[test]
-fn a_trajectory_beyond_the_limits_is_dropped_with_the_values_reached() {
-    // The blind backend keeps the measured 13 m/s, 30 % above `v_max`: its plan is clear of
-    // everything but infeasible, and the drop says by how much.
-    let bounds = Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(100.0, 10.0, 10.0)).unwrap();
-    let map = StaticMap::empty(bounds).unwrap();
-    let mut m = Manager::new(
+/// A 100 × 20 × 10 m box without obstacles.
+fn open_air() -> StaticMap {
+    StaticMap::empty(Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(100.0, 10.0, 10.0)).unwrap())
+        .unwrap()
+}
+
+/// One branch from the straight line, optimized by [`Blind`].
+fn blind_single_branch() -> Manager<StraightLine, Blind, Tvd> {
+    Manager::new(
         StraightLine,
         Blind,
         Tvd::default(),
         Limits::default(),
         reproducible(ManagerParams::single_branch()),
     )
-    .unwrap();
-    let start = State {
+    .unwrap()
+}
+
+/// At (5, 0, 5) at time 0, flying along x at `speed` m/s.
+fn cruising(speed: f64) -> State {
+    State {
         t: 0.0,
         p: Vec3::new(5.0, 0.0, 5.0),
-        v: Vec3::new(13.0, 0.0, 0.0),
+        v: Vec3::new(speed, 0.0, 0.0),
         a: Vec3::zeros(),
-    };
+    }
+}
+
+#[test]
+fn a_trajectory_beyond_the_limits_is_dropped_with_the_values_reached() {
+    // The blind backend keeps the measured 13 m/s, 30 % above `v_max`: its plan is clear of
+    // everything but infeasible, and the drop says by how much.
+    let map = open_air();
+    let mut m = blind_single_branch();
+    let start = cruising(13.0);
     let scene = Scene::new(&map, &[], 0.0).unwrap();
     let r = m
         .step(0.0, &start, &Vec3::new(95.0, 0.0, 5.0), &scene)
@@ -488,23 +500,10 @@ fn a_trajectory_beyond_the_limits_is_dropped_with_the_values_reached() {
 
 #[test]
 fn braking_fallback_when_every_branch_collides() {
-    let bounds = Aabb::new(Vec3::new(0.0, -10.0, 0.0), Vec3::new(100.0, 10.0, 10.0)).unwrap();
-    let map = StaticMap::empty(bounds).unwrap();
-    let mut m = Manager::new(
-        StraightLine,
-        Blind,
-        Tvd::default(),
-        Limits::default(),
-        reproducible(ManagerParams::single_branch()),
-    )
-    .unwrap();
+    let map = open_air();
+    let mut m = blind_single_branch();
     // Flying at 8 m/s along x with a clear scene: the blind plan is fine.
-    let start = State {
-        t: 0.0,
-        p: Vec3::new(5.0, 0.0, 5.0),
-        v: Vec3::new(8.0, 0.0, 0.0),
-        a: Vec3::zeros(),
-    };
+    let start = cruising(8.0);
     let goal = Vec3::new(95.0, 0.0, 5.0);
     let scene = Scene::new(&map, &[], 0.0).unwrap();
     let r = m.step(0.0, &start, &goal, &scene).unwrap();
