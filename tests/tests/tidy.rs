@@ -67,6 +67,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
         ("trust-predict", &["trust-geometry"][..]),
         ("trust-core", &["trust-geometry", "trust-predict"][..]),
         ("trust-lbfgs", &[][..]),
+        ("trust-route", &["trust-geometry", "trust-core"][..]),
         (
             "trust-minco",
             &[
