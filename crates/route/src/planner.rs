@@ -221,6 +221,7 @@ impl<'a> Search<'a> {
         max_expansions: usize,
         deadline: Option<Instant>,
         clearance: f64,
+        weight: f64,
     ) -> Result<(Vec<usize>, usize), RouteError> {
         let h = self.grid.h;
         let tc = self.grid.coords(t);
@@ -236,7 +237,7 @@ impl<'a> Search<'a> {
         self.g[s] = 0.0;
         self.state[s] |= SEEN;
         open.push(Open {
-            f: octile(self.grid.coords(s), tc, h),
+            f: weight * octile(self.grid.coords(s), tc, h),
             g: 0.0,
             cell: s as u32,
         });
@@ -282,7 +283,7 @@ impl<'a> Search<'a> {
                     self.g[j] = gj;
                     self.parent[j] = cell + 1;
                     open.push(Open {
-                        f: gj + octile(self.grid.coords(j), tc, h),
+                        f: gj + weight * octile(self.grid.coords(j), tc, h),
                         g: gj,
                         cell: j as u32,
                     });
@@ -453,7 +454,14 @@ impl RoutePlanner {
         };
         let s = end_cell(&mut search, Endpoint::Start, start, start_free)?;
         let t = end_cell(&mut search, Endpoint::Goal, goal, goal_free)?;
-        let (cells, expanded) = search.astar(s, t, p.max_expansions, deadline, clearance)?;
+        let (cells, expanded) = search.astar(
+            s,
+            t,
+            p.max_expansions,
+            deadline,
+            clearance,
+            p.heuristic_weight,
+        )?;
 
         let mut points = Vec::with_capacity(cells.len() + 2);
         points.push(start);

@@ -353,7 +353,7 @@ fn random_map(seed: u64, size: [f64; 3], count: usize, r: f64) -> (StaticMap, Ve
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(
-        std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(32)
+        std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(16)
     ))]
 
     /// Any seed, room or E4-like scale: the route keeps its clearance (shortcut included), is
