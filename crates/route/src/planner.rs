@@ -43,7 +43,7 @@ impl Grid {
         let ext = bounds.extent();
         let count = |h: f64| -> [usize; 3] {
             // Capped far above any admissible count so the product stays in u128.
-            let n = |e: f64| ((e / h).floor().max(1.0)).min(1.0e12) as usize;
+            let n = |e: f64| (e / h).floor().clamp(1.0, 1.0e12) as usize;
             [n(ext.x), n(ext.y), n(ext.z)]
         };
         let cells = |d: [usize; 3]| d.iter().map(|&n| n as u128).product::<u128>();
