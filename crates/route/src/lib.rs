@@ -65,6 +65,29 @@
 //! left out and the route ends at the free cell ([`GlobalRoute::goal_gap_m`]). An exhausted
 //! search is [`RouteError::Unreachable`].
 //!
+//! # Use from a mission manager
+//!
+//! ```
+//! use trust_geometry::{AaBox, Aabb, StaticMap, Vec3};
+//! use trust_route::{RouteParams, RoutePlanner};
+//!
+//! let bounds = Aabb::new(Vec3::zeros(), Vec3::new(60.0, 40.0, 10.0))?;
+//! let wall = AaBox::new(Vec3::new(20.0, 5.0, 0.0), Vec3::new(21.0, 35.0, 10.0))?;
+//! let map = StaticMap::from_shapes(bounds, vec![wall.into()])?;
+//! let (start, goal) = (Vec3::new(2.0, 20.0, 3.0), Vec3::new(58.0, 20.0, 3.0));
+//! // Before the first cycle (and again after a stall or a blocked route):
+//! let route = RoutePlanner::new(RouteParams::default())?.plan(&map, &start, &goal, 0.3)?;
+//! // Every cycle: progress that never goes back, and the point to aim at.
+//! let mut s = 0.0;
+//! let position = start;
+//! s = route.project_after(&position, s)?.s;
+//! let aim = route.local_goal_from(s, 10.0)?; // horizon = v_max · horizon_s, say
+//! assert!((aim.point - route.point_at(s)).norm() <= 10.0 + 1e-9);
+//! // When the map changes: re-route if what lies ahead is blocked.
+//! assert!(!route.is_blocked(&map, route.clearance_m() * 0.99, s)?);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! Determinism: no clock is read unless a deadline is given, ties in the open list break by
 //! cost then cell index, and no hash map is iterated: same input, same route.
 #![warn(missing_docs)]
