@@ -59,6 +59,10 @@
 //! search stops with [`RouteError::ExpansionCap`] past `max_expansions` and with
 //! [`RouteError::Deadline`] past an optional deadline ([`RoutePlanner::plan_until`]).
 //!
+//! Cost (`cargo bench -p trust-route`, medians on a shared 2-core machine): an E4-like world
+//! with 400 obstacles, 246 m start to goal, 25 ms; the same with a 30 m full-height wall across
+//! the line, 238 ms; an 8 × 6 × 3 m room with thin pillars and a wall, radius 0.1 m, 165 ms.
+//!
 //! Ends: a start or goal inside the inflated obstacles joins the nearest free cell within
 //! `snap_radius_factor · c` ([`RouteError::NoFreeCell`] otherwise); such a start makes the first
 //! segment exempt from the clearance ([`GlobalRoute::start_inside_clearance`]), such a goal is
