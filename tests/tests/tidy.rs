@@ -60,13 +60,15 @@ fn members() -> Vec<Member> {
 
 /// The allowed internal dependencies of each library crate (design.md §2):
 /// `geometry ← predict ← core ← {lbfgs, minco, topo-prm} ← manager ← sim ← xtask`.
-/// `lbfgs` depends on nothing of ours; `minco` and `topo-prm` never depend on each other.
+/// `lbfgs` depends on nothing of ours; `minco` and `topo-prm` never depend on each other; `route`
+/// (the global route, issue 19) sits beside them on `geometry` (and may use `core`).
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
     BTreeMap::from([
         ("trust-geometry", &[][..]),
         ("trust-predict", &["trust-geometry"][..]),
         ("trust-core", &["trust-geometry", "trust-predict"][..]),
         ("trust-lbfgs", &[][..]),
+        ("trust-route", &["trust-geometry", "trust-core"][..]),
         (
             "trust-minco",
             &[

@@ -1,0 +1,405 @@
+//! Public API of `trust-route`: routes around walls and traps, degenerate inputs, caps, and the
+//! properties of the route and its queries on random maps.
+
+use approx::assert_relative_eq;
+use proptest::prelude::*;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use trust_geometry::{AaBox, Aabb, Cylinder, Shape, StaticMap, Vec3};
+use trust_route::{Endpoint, GlobalRoute, RouteError, RouteParams, RoutePlanner};
+
+fn planner() -> RoutePlanner {
+    RoutePlanner::new(RouteParams::default()).unwrap()
+}
+
+fn bounds(max: [f64; 3]) -> Aabb {
+    Aabb::new(Vec3::zeros(), Vec3::new(max[0], max[1], max[2])).unwrap()
+}
+
+fn aabox(min: [f64; 3], max: [f64; 3]) -> Shape {
+    AaBox::new(
+        Vec3::new(min[0], min[1], min[2]),
+        Vec3::new(max[0], max[1], max[2]),
+    )
+    .unwrap()
+    .into()
+}
+
+/// Every segment of `route` is clear at its clearance (less a rounding tolerance), except the
+/// first when the start was inside the inflation.
+fn assert_clear(map: &StaticMap, route: &GlobalRoute) {
+    let c = route.clearance_m() * (1.0 - 1e-9);
+    let skip = usize::from(route.start_inside_clearance());
+    for (i, w) in route.points().windows(2).enumerate().skip(skip) {
+        assert!(
+            map.segment_clear(&w[0], &w[1], c),
+            "segment {i} {} -> {} closer than {c}",
+            w[0],
+            w[1]
+        );
+    }
+}
+
+/// A 30 m full-height wall 25 m ahead in a 120 × 60 × 20 m world.
+fn wide_wall() -> StaticMap {
+    StaticMap::from_shapes(
+        bounds([120.0, 60.0, 20.0]),
+        vec![aabox([25.0, 15.0, 0.0], [26.0, 45.0, 20.0])],
+    )
+    .unwrap()
+}
+
+#[test]
+fn a_wide_wall_ahead_is_gone_around() {
+    let map = wide_wall();
+    let (s, g) = (Vec3::new(2.0, 30.0, 5.0), Vec3::new(100.0, 30.0, 5.0));
+    assert!(
+        !map.segment_clear(&s, &g, 0.0),
+        "the straight line must be blocked"
+    );
+    let route = planner().plan(&map, &s, &g, 0.3).unwrap();
+    assert_clear(&map, &route);
+    assert_eq!(route.points()[0], s);
+    assert_eq!(*route.points().last().unwrap(), g);
+    // Around an edge (y < 15 or y > 45) or over the top is impossible (full height).
+    assert!(
+        route.points().iter().any(|p| p.y < 15.0 || p.y > 45.0),
+        "{:?}",
+        route.points()
+    );
+    // Near-shortest: the detour around an end of the wall, with some slack for the grid.
+    let detour = (Vec3::new(25.0, 15.0 - 0.45, 5.0) - s).norm()
+        + (g - Vec3::new(26.0, 15.0 - 0.45, 5.0)).norm()
+        + 1.0;
+    assert!(
+        route.length() < 1.05 * detour,
+        "{} vs {detour}",
+        route.length()
+    );
+    assert!(route.points().len() <= 6, "shortcut: {:?}", route.points());
+}
+
+#[test]
+fn a_cul_de_sac_opening_toward_the_start_is_left_by_its_mouth() {
+    // A U of full-height walls around the straight line, open toward the start (x = 20).
+    let map = StaticMap::from_shapes(
+        bounds([100.0, 60.0, 10.0]),
+        vec![
+            aabox([40.0, 20.0, 0.0], [41.0, 40.0, 10.0]), // back
+            aabox([20.0, 20.0, 0.0], [41.0, 21.0, 10.0]), // side
+            aabox([20.0, 39.0, 0.0], [41.0, 40.0, 10.0]), // side
+        ],
+    )
+    .unwrap();
+    let (s, g) = (Vec3::new(2.0, 30.0, 5.0), Vec3::new(90.0, 30.0, 5.0));
+    let route = planner().plan(&map, &s, &g, 0.3).unwrap();
+    assert_clear(&map, &route);
+    assert!(
+        route
+            .points()
+            .iter()
+            .all(|p| !(p.x > 20.0 && p.x < 41.0 && p.y > 21.0 && p.y < 39.0)),
+        "no vertex inside the trap: {:?}",
+        route.points()
+    );
+    assert!(route.points().iter().any(|p| p.y < 20.0 || p.y > 40.0));
+}
+
+/// An 8 × 6 × 3 m room with four 5 cm pillars and a wall across most of the middle.
+fn crazyflie_room() -> StaticMap {
+    let mut shapes: Vec<Shape> = [(2.5, 2.0), (2.5, 4.0), (5.5, 2.0), (5.5, 4.0)]
+        .iter()
+        .map(|&(x, y)| {
+            Cylinder::new(Vec3::new(x, y, 1.5), 0.05, 1.5)
+                .unwrap()
+                .into()
+        })
+        .collect();
+    shapes.push(aabox([3.9, 0.0, 0.0], [4.1, 4.5, 3.0]));
+    StaticMap::from_shapes(bounds([8.0, 6.0, 3.0]), shapes).unwrap()
+}
+
+#[test]
+fn a_crazyflie_room_with_thin_pillars_is_crossed_with_clearance() {
+    let map = crazyflie_room();
+    let (s, g) = (Vec3::new(1.0, 1.0, 1.0), Vec3::new(7.0, 1.0, 1.5));
+    let route = planner().plan(&map, &s, &g, 0.1).unwrap();
+    assert_relative_eq!(route.clearance_m(), 0.15);
+    assert!(route.cell_m().unwrap() <= 0.1, "{:?}", route.cell_m());
+    assert_clear(&map, &route);
+    // Through the gap between the wall's end (y = 4.5) and the far side (y = 6).
+    assert!(route.points().iter().any(|p| p.y > 4.5));
+    // A pillar straight between two points is avoided too.
+    let (s2, g2) = (Vec3::new(1.0, 2.0, 1.0), Vec3::new(3.5, 2.0, 1.0));
+    let r2 = planner().plan(&map, &s2, &g2, 0.1).unwrap();
+    assert!(r2.points().len() >= 3);
+    assert_clear(&map, &r2);
+}
+
+#[test]
+fn open_space_gives_the_straight_line_and_start_equal_goal_a_point() {
+    let map = StaticMap::empty(bounds([10.0, 10.0, 3.0])).unwrap();
+    let (s, g) = (Vec3::new(1.0, 1.0, 1.0), Vec3::new(9.0, 8.0, 2.0));
+    let r = planner().plan(&map, &s, &g, 0.2).unwrap();
+    assert_eq!(r.points(), &[s, g]);
+    assert_eq!(r.cell_m(), None);
+    assert_relative_eq!(r.length(), (g - s).norm());
+    let p = planner().plan(&map, &s, &s, 0.2).unwrap();
+    assert_eq!(p.points(), &[s]);
+    assert_eq!(p.length(), 0.0);
+    assert_eq!(p.point_at(3.0), s);
+    assert_eq!(p.progress(&g).unwrap(), 0.0);
+    assert_eq!(p.local_goal(&g, 1.0).unwrap().point, s);
+    assert_eq!(p.remaining_length(&g).unwrap(), 0.0);
+    // Zero radius in open space is fine (no grid needed).
+    assert!(planner().plan(&map, &s, &g, 0.0).is_ok());
+}
+
+#[test]
+fn bad_inputs_are_typed_errors() {
+    let map = wide_wall();
+    let p = planner();
+    let ok = Vec3::new(2.0, 30.0, 5.0);
+    let e = p
+        .plan(&map, &Vec3::new(f64::NAN, 0.0, 0.0), &ok, 0.3)
+        .unwrap_err();
+    assert!(matches!(e, RouteError::NonFinitePoint { ref field, .. } if field == "start"));
+    let e = p
+        .plan(&map, &ok, &Vec3::new(500.0, 30.0, 5.0), 0.3)
+        .unwrap_err();
+    assert!(matches!(
+        e,
+        RouteError::OutsideBounds {
+            which: Endpoint::Goal,
+            ..
+        }
+    ));
+    for r in [-1.0, f64::NAN, f64::INFINITY] {
+        let e = p.plan(&map, &ok, &ok, r).unwrap_err();
+        assert!(matches!(e, RouteError::InvalidParam { ref field, .. } if field == "radius_m"));
+    }
+    let bad = RouteParams {
+        max_cells: 0,
+        ..RouteParams::default()
+    };
+    let e = RoutePlanner::new(bad).unwrap_err();
+    assert!(e.to_string().contains("route.max_cells"), "{e}");
+    let bad = RouteParams {
+        cells_per_clearance: f64::NAN,
+        ..RouteParams::default()
+    };
+    assert!(RoutePlanner::new(bad).is_err());
+    let r = GlobalRoute::from_points(vec![ok, ok + Vec3::x()]).unwrap();
+    assert!(r.local_goal(&ok, 0.0).is_err());
+    assert!(r.local_goal(&ok, f64::NAN).is_err());
+    assert!(r.progress(&Vec3::new(0.0, f64::INFINITY, 0.0)).is_err());
+    assert!(GlobalRoute::from_points(vec![]).is_err());
+}
+
+#[test]
+fn params_deserialize_with_defaults_and_reject_unknown_fields() {
+    let p: RouteParams = toml::from_str("max_expansions = 10").unwrap();
+    assert_eq!(p.max_expansions, 10);
+    assert_eq!(p.max_cells, RouteParams::default().max_cells);
+    assert!(toml::from_str::<RouteParams>("max_expansion = 10").is_err());
+}
+
+#[test]
+fn an_enclosed_goal_is_unreachable_not_a_hang() {
+    // The goal sits in a closed box (walls all round, floor to ceiling).
+    let map = StaticMap::from_shapes(
+        bounds([20.0, 20.0, 4.0]),
+        vec![
+            aabox([10.0, 8.0, 0.0], [11.0, 14.0, 4.0]),
+            aabox([16.0, 8.0, 0.0], [17.0, 14.0, 4.0]),
+            aabox([10.0, 8.0, 0.0], [17.0, 9.0, 4.0]),
+            aabox([10.0, 13.0, 0.0], [17.0, 14.0, 4.0]),
+        ],
+    )
+    .unwrap();
+    let e = planner()
+        .plan(
+            &map,
+            &Vec3::new(2.0, 2.0, 2.0),
+            &Vec3::new(13.5, 11.0, 2.0),
+            0.3,
+        )
+        .unwrap_err();
+    assert!(matches!(e, RouteError::Unreachable { .. }), "{e}");
+}
+
+#[test]
+fn caps_are_typed_errors_naming_the_cap() {
+    let map = wide_wall();
+    let (s, g) = (Vec3::new(2.0, 30.0, 5.0), Vec3::new(100.0, 30.0, 5.0));
+    let few = RoutePlanner::new(RouteParams {
+        max_expansions: 100,
+        ..RouteParams::default()
+    })
+    .unwrap();
+    assert_eq!(
+        few.plan(&map, &s, &g, 0.3).unwrap_err(),
+        RouteError::ExpansionCap { cap: 100 }
+    );
+    let small = RoutePlanner::new(RouteParams {
+        max_cells: 1000,
+        max_coarsening: 1.0,
+        ..RouteParams::default()
+    })
+    .unwrap();
+    let e = small.plan(&map, &s, &g, 0.3).unwrap_err();
+    assert!(
+        matches!(e, RouteError::TooManyCells { cap: 1000, .. }),
+        "{e}"
+    );
+    let past = std::time::Instant::now();
+    let e = planner()
+        .plan_until(&map, &s, &g, 0.3, Some(past))
+        .unwrap_err();
+    assert!(matches!(e, RouteError::Deadline { .. }), "{e}");
+}
+
+#[test]
+fn a_start_inside_the_inflation_snaps_out_and_a_buried_goal_ends_short() {
+    let map = wide_wall();
+    // 0.2 m from the wall's face: inside the 0.45 m inflation.
+    let s = Vec3::new(24.8, 30.0, 5.0);
+    let g = Vec3::new(100.0, 30.0, 5.0);
+    let r = planner().plan(&map, &s, &g, 0.3).unwrap();
+    assert!(r.start_inside_clearance());
+    assert_eq!(r.points()[0], s);
+    assert_clear(&map, &r);
+    // A goal inside the wall: the route ends at a free cell near it.
+    let buried = Vec3::new(25.5, 30.0, 5.0);
+    let r = planner()
+        .plan(&map, &Vec3::new(2.0, 30.0, 5.0), &buried, 0.3)
+        .unwrap();
+    assert!(
+        r.goal_gap_m() > 0.5 && r.goal_gap_m() < 4.0 * 0.45 + 1e-9,
+        "{}",
+        r.goal_gap_m()
+    );
+    assert_clear(&map, &r);
+    // Deep inside a big block, farther than the snap radius from any free cell.
+    let block = StaticMap::from_shapes(
+        bounds([40.0, 40.0, 10.0]),
+        vec![aabox([10.0, 10.0, 0.0], [30.0, 30.0, 10.0])],
+    )
+    .unwrap();
+    let e = planner()
+        .plan(
+            &block,
+            &Vec3::new(20.0, 20.0, 5.0),
+            &Vec3::new(2.0, 2.0, 2.0),
+            0.3,
+        )
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            RouteError::NoFreeCell {
+                which: Endpoint::Start,
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_route_reports_a_new_obstacle_only_ahead_of_the_vehicle() {
+    let empty = StaticMap::empty(bounds([50.0, 20.0, 5.0])).unwrap();
+    let (s, g) = (Vec3::new(1.0, 10.0, 2.0), Vec3::new(49.0, 10.0, 2.0));
+    let r = planner().plan(&empty, &s, &g, 0.3).unwrap();
+    assert!(!r.is_blocked(&empty, 0.45, 0.0).unwrap());
+    let later = StaticMap::from_shapes(
+        bounds([50.0, 20.0, 5.0]),
+        vec![aabox([20.0, 8.0, 0.0], [21.0, 12.0, 5.0])],
+    )
+    .unwrap();
+    let b = r.first_blocked(&later, 0.45, 0.0).unwrap().unwrap();
+    assert_eq!(b.segment, 0);
+    // Past the obstacle, the rest of the route is clear.
+    assert!(!r.is_blocked(&later, 0.45, 25.0).unwrap());
+}
+
+/// A random map of full-height pillars and boxes in a `size` world, start and goal kept free.
+fn random_map(seed: u64, size: [f64; 3], count: usize, r: f64) -> (StaticMap, Vec3, Vec3) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let s = Vec3::new(0.05 * size[0], 0.5 * size[1], 0.5 * size[2]);
+    let g = Vec3::new(0.95 * size[0], 0.5 * size[1], 0.5 * size[2]);
+    let mut shapes = Vec::new();
+    while shapes.len() < count {
+        let c = Vec3::new(
+            rng.random_range(0.0..size[0]),
+            rng.random_range(0.0..size[1]),
+            0.5 * size[2],
+        );
+        let w = rng.random_range(0.02..0.08) * size[1];
+        let shape: Shape = if rng.random_bool(0.5) {
+            Cylinder::new(c, w, 0.5 * size[2]).unwrap().into()
+        } else {
+            AaBox::from_center_half_extents(c, Vec3::new(w, 2.0 * w, 0.5 * size[2]))
+                .unwrap()
+                .into()
+        };
+        if shape.signed_distance(&s) > 4.0 * r && shape.signed_distance(&g) > 4.0 * r {
+            shapes.push(shape);
+        }
+    }
+    let map = StaticMap::from_shapes(bounds(size), shapes).unwrap();
+    (map, s, g)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(
+        std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(16)
+    ))]
+
+    /// Any seed, room or E4-like scale: the route keeps its clearance (shortcut included), is
+    /// deterministic, and its queries behave.
+    #[test]
+    fn routes_are_clear_deterministic_and_queryable(seed in 0_u64..10_000, big in any::<bool>(), frac in 0.0_f64..1.0, horizon in 0.2_f64..20.0, off in -0.5_f64..0.5) {
+        let (size, r, n) = if big { ([120.0, 40.0, 10.0], 0.3, 40) } else { ([8.0, 6.0, 3.0], 0.1, 8) };
+        let (map, s, g) = random_map(seed, size, n, r);
+        let p = planner();
+        let route = match p.plan(&map, &s, &g, r) {
+            Ok(route) => route,
+            // A random map may wall the goal off; that must be the typed answer, never a panic.
+            Err(RouteError::Unreachable { .. }) => return Ok(()),
+            Err(e) => return Err(TestCaseError::fail(format!("{e}"))),
+        };
+        assert_clear(&map, &route);
+        // Without the shortcut, too (the grid edges alone keep the clearance).
+        let raw = RoutePlanner::new(RouteParams { shortcut: false, ..RouteParams::default() }).unwrap()
+            .plan(&map, &s, &g, r).unwrap();
+        assert_clear(&map, &raw);
+        prop_assert!(route.length() <= raw.length() + 1e-9);
+        prop_assert_eq!(&route, &p.plan(&map, &s, &g, r).unwrap());
+        prop_assert_eq!(route.points()[0], s);
+        prop_assert_eq!(*route.points().last().unwrap(), g);
+
+        // Progress is monotone along the route and equals arc length on it.
+        let mut last = -1.0;
+        for k in 0..=50 {
+            let sk = route.length() * k as f64 / 50.0;
+            let pr = route.progress(&route.point_at(sk)).unwrap();
+            prop_assert!(pr >= last - 1e-9, "progress went back: {} < {}", pr, last);
+            prop_assert!((pr - sk).abs() < 1e-6 * (1.0 + sk), "{} vs {}", pr, sk);
+            last = pr;
+        }
+
+        // The local goal lies on the route, within the horizon of the projection, ahead of it.
+        let pos = route.point_at(frac * route.length()) + Vec3::new(0.0, off * r, off * r);
+        let proj = route.project(&pos).unwrap();
+        let lg = route.local_goal(&pos, horizon).unwrap();
+        prop_assert!((route.point_at(lg.s) - lg.point).norm() < 1e-6);
+        prop_assert!((lg.point - proj.point).norm() <= horizon + 1e-9);
+        prop_assert!(lg.s >= proj.s - 1e-12);
+        prop_assert!(lg.point.iter().all(|c| c.is_finite()));
+        if lg.s < route.length() - 1e-9 {
+            prop_assert!(((lg.point - proj.point).norm() - horizon).abs() < 1e-6);
+        }
+        prop_assert!((route.remaining_length(&pos).unwrap() - (route.length() - proj.s)).abs() < 1e-9);
+    }
+}
