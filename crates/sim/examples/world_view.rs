@@ -14,7 +14,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use nalgebra::Point2;
-use trust_sim::plot::{Bounds, Color, Figure, ForecastRings, MapView, Marker, Shape};
+use trust_plot::{Bounds, Color, Figure, ForecastRings, MapView, Marker, Shape};
 use trust_sim::scenario::{PointCloudSpec, Scenario};
 use trust_sim::world::{World, sample_shapes};
 

@@ -16,10 +16,10 @@ use trust_core::{Scene, SearchStats, State};
 
 use crate::error::SimError;
 use crate::planner;
-use crate::plot::{Color, Figure, ForecastRings, Marker, Plane, Polyline};
 use crate::scenario::Scenario;
 use crate::study::{create_dir, write_json, write_text};
 use crate::world::World;
+use trust_plot::{Color, Figure, ForecastRings, Marker, Plane, Polyline};
 
 /// The paper's Table Sim-B-1: `(H_t s, H_s, I_e, J, CPU ms)` of τ0…τ4.
 pub const PAPER_TABLE: [(f64, f64, f64, f64, f64); 5] = [

@@ -6,9 +6,9 @@
 
 use std::path::PathBuf;
 
-use crate::plot::PlotError;
 use crate::scenario::Problem;
 use crate::vehicle::VehicleError;
+use trust_plot::PlotError;
 
 /// Why a scenario could not be loaded, a world built, or a simulator component created.
 #[derive(Debug, thiserror::Error)]

@@ -6,12 +6,12 @@ use std::path::Path;
 
 use nalgebra::{Point2, Vector3};
 
-use crate::plot::{
+use crate::run::FlightRecord;
+use crate::runlog::{Header, StateRecord, StaticShape};
+use trust_plot::{
     Bounds, Color, Figure, HLine, MapView, Marker, Plane, PlotError, Polyline, Series, Shape,
     TimeSeries, Written,
 };
-use crate::run::FlightRecord;
-use crate::runlog::{Header, StateRecord, StaticShape};
 
 /// Most points of the planner's cloud drawn (the view thins them further).
 const MAX_CLOUD_POINTS: usize = 200_000;

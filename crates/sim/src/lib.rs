@@ -11,7 +11,6 @@ pub mod e3;
 pub mod error;
 pub mod flight_plots;
 pub mod planner;
-pub mod plot;
 pub mod run;
 pub mod runlog;
 pub mod scenario;

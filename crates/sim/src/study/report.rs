@@ -10,8 +10,8 @@ use super::stats::{Mean, Rate, mean_ci, median, wilson};
 use super::{RunRow, StudyConfig, write_json, write_text};
 use crate::error::SimError;
 use crate::flight_plots::write_comparison_view;
-use crate::plot::{Bar, BarChart, Distribution, Figure};
 use crate::runlog::RunLog;
+use trust_plot::{Bar, BarChart, Distribution, Figure};
 
 /// The paper's E4 numbers (Sec. IV-D, Fig. baseline-test-3) for a planner, where the text states
 /// them (the baselines' bars are only drawn in the figure).
@@ -343,7 +343,7 @@ pub fn write_all(
 }
 
 fn write_plots(s: &StudySummary, rows: &[RunRow], out: &Path) -> Result<(), SimError> {
-    let plot = |e: crate::plot::PlotError| SimError::input("plots", e, "writable figures");
+    let plot = |e: trust_plot::PlotError| SimError::input("plots", e, "writable figures");
     let mut success = BarChart::new("Success rate of safe arrival (95 % Wilson interval)")
         .y_label("success rate [%]")
         .y_range(0.0, 100.0)

@@ -92,7 +92,7 @@ pub enum MarkerShape {
 pub(crate) const FAMILY: &str = "DejaVu Sans, sans-serif";
 
 /// DejaVu Sans 2.37 (Bitstream Vera licence, `assets/LICENSE-DejaVu.txt`).
-static FONT_BYTES: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+static FONT_BYTES: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
 /// Registers the bundled font with plotters once per process (also as `sans-serif`, plotters'
 /// default family, so that no text path can fall back to a missing system font).

@@ -23,17 +23,17 @@
 //! # Example
 //!
 //! ```
-//! use trust_sim::plot::{Figure, HLine, Series, TimeSeries};
+//! use trust_plot::{Figure, HLine, Series, TimeSeries};
 //!
 //! let speed: Vec<(f64, f64)> = (0..50).map(|i| (0.1 * i as f64, (0.1 * i as f64).min(2.5))).collect();
 //! let figure = TimeSeries::new("Speed")
 //!     .axis_labels("t [s]", "|v| [m/s]")
 //!     .series(Series::new("TRUST-Planner", speed))
 //!     .limit(HLine::new("v_max = 3 m/s", 3.0));
-//! let dir = std::env::temp_dir().join("trust-sim-plot-doc");
+//! let dir = std::env::temp_dir().join("trust-plot-doc");
 //! let written = figure.write(&dir, "speed")?;
 //! assert!(written.svg.ends_with("speed.svg") && written.png.ends_with("speed.png"));
-//! # Ok::<(), trust_sim::plot::PlotError>(())
+//! # Ok::<(), trust_plot::PlotError>(())
 //! ```
 
 mod axis;

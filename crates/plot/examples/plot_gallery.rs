@@ -1,12 +1,12 @@
-//! Writes one of each figure kind of `trust_sim::plot` into a directory, for reviewing by eye.
+//! Writes one of each figure kind of `trust_plot` into a directory, for reviewing by eye.
 //!
-//! `cargo run -p trust-sim --example plot_gallery -- [DIR]` (default `target/plot-gallery`).
+//! `cargo run -p trust-plot --example plot_gallery -- [DIR]` (default `target/plot-gallery`).
 
 use std::f64::consts::TAU;
 use std::path::PathBuf;
 
 use nalgebra::Point2;
-use trust_sim::plot::{
+use trust_plot::{
     Band, Bar, BarChart, Bounds, Color, Distribution, DistributionKind, Figure, ForecastRings,
     HLine, MapView, Marker, Plane, Polyline, Series, Shape, TimeSeries, Written,
 };

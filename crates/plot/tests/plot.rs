@@ -1,11 +1,11 @@
-//! Public API of `trust_sim::plot`: every figure kind writes SVG + PNG, deterministically, and
+//! Public API of `trust_plot`: every figure kind writes SVG + PNG, deterministically, and
 //! degenerate input gives either a drawing or a typed error, never a panic.
 
 use std::fs;
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Point2, Vector3};
-use trust_sim::plot::{
+use trust_plot::{
     Band, Bar, BarChart, Bounds, BoxStats, Color, Distribution, DistributionKind, Figure,
     ForecastRings, HLine, MapView, Marker, Plane, PlotError, Polyline, Series, Shape, TimeSeries,
     Whiskers, Written,
@@ -15,7 +15,7 @@ const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0D, 0x0A, 0x1A, 0x0A];
 
 /// A fresh, empty directory under the system temp dir, unique per test and process.
 fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("trust-sim-plot-{}-{test}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("trust-plot-{}-{test}", std::process::id()));
     let _ = fs::remove_dir_all(&dir);
     dir
 }
