@@ -35,6 +35,7 @@
 //! assert!(written.svg.ends_with("speed.svg") && written.png.ends_with("speed.png"));
 //! # Ok::<(), trust_plot::PlotError>(())
 //! ```
+#![warn(missing_docs)]
 
 mod axis;
 mod bar;

@@ -7,8 +7,8 @@
 use std::path::PathBuf;
 
 use crate::scenario::Problem;
-use crate::vehicle::VehicleError;
 use trust_plot::PlotError;
+use trust_vehicle::VehicleError;
 
 /// Why a scenario could not be loaded, a world built, or a simulator component created.
 #[derive(Debug, thiserror::Error)]
@@ -73,7 +73,7 @@ pub enum SimError {
     Plot(#[from] PlotError),
     /// A run log could not be written or read.
     #[error(transparent)]
-    Log(#[from] crate::runlog::LogError),
+    Log(#[from] trust_runlog::LogError),
     /// A file could not be written.
     #[error("cannot write {}: {source}", path.display())]
     Write {

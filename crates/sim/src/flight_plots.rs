@@ -7,11 +7,11 @@ use std::path::Path;
 use nalgebra::{Point2, Vector3};
 
 use crate::run::FlightRecord;
-use crate::runlog::{Header, StateRecord, StaticShape};
 use trust_plot::{
     Bounds, Color, Figure, HLine, MapView, Marker, Plane, PlotError, Polyline, Series, Shape,
     TimeSeries, Written,
 };
+use trust_runlog::{Header, StateRecord, StaticShape};
 
 /// Most points of the planner's cloud drawn (the view thins them further).
 const MAX_CLOUD_POINTS: usize = 200_000;
@@ -169,7 +169,7 @@ pub fn write_flight_plots(
         )
         .write(dir, "side")?,
     ];
-    let series = |f: &dyn Fn(&crate::runlog::StateRecord) -> f64| -> Vec<(f64, f64)> {
+    let series = |f: &dyn Fn(&trust_runlog::StateRecord) -> f64| -> Vec<(f64, f64)> {
         record.states.iter().map(|s| (s.t, f(s))).collect()
     };
     let norm = |v: &[f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();

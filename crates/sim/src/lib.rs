@@ -6,16 +6,13 @@
 //! nothing pretends to work.
 #![warn(missing_docs)]
 
-pub mod audit;
 pub mod e3;
 pub mod error;
 pub mod flight_plots;
 pub mod planner;
 pub mod run;
-pub mod runlog;
 pub mod scenario;
 pub mod sensing;
 pub mod study;
 pub mod traffic;
-pub mod vehicle;
 pub mod world;

@@ -15,11 +15,11 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
-use trust_sim::audit::audit;
+use trust_runlog::RunLog;
+use trust_runlog::audit::audit;
 use trust_sim::flight_plots::write_flight_plots;
 use trust_sim::planner::PlannerPreset;
 use trust_sim::run::{RunOptions, fly, header};
-use trust_sim::runlog::RunLog;
 use trust_sim::scenario::{Scenario, VehicleModel};
 use trust_sim::study::{RunStudyOptions, Shard, StudyConfig, merge, run_study};
 use trust_sim::world::World;

@@ -1,7 +1,7 @@
 //! The closed loop: one flight of one planner through one world, written as a run log.
 //!
 //! Every `physics_dt_s` the true obstacles move ([`crate::traffic::Traffic`]) and the vehicle
-//! integrates its dynamics toward the committed plan ([`crate::vehicle::Vehicle`]); at the sensor
+//! integrates its dynamics toward the committed plan ([`trust_vehicle::Vehicle`]); at the sensor
 //! rate the obstacles are measured with noise and dropouts into the trackers
 //! ([`crate::sensing::Sensing`]); at the replanning rate the manager plans from the measured
 //! vehicle state and the trackers' forecasts — never from the true obstacles — and the new plan
@@ -10,7 +10,7 @@
 //! obstacles; the flight ends when it collides, arrives within the goal tolerance, or runs out of
 //! time.
 //!
-//! The run log ([`crate::runlog`]) holds a `state` record at the log rate and at the last instant
+//! The run log ([`trust_runlog`]) holds a `state` record at the log rate and at the last instant
 //! (so a collision or arrival between two log ticks is in the log), a `cycle` record per planning
 //! cycle, and the `outcome`, whose figures are computed from the logged states exactly as the
 //! contract defines them.
@@ -24,14 +24,14 @@ use trust_manager::{Event, Hit, StepReport};
 
 use crate::error::SimError;
 use crate::planner::{self, ResolvedPlanner};
-use crate::runlog::{
+use crate::scenario::{Latency, ShapeSpec, VehicleModel};
+use crate::traffic::MovingShape;
+use crate::world::World;
+use trust_runlog::{
     Bounds, CycleRecord, Dropped, Header, LimitsInfo, LogWriter, ObstacleInfo, ObstacleKind,
     Outcome, Record, SCHEMA, StateRecord, StaticShape, Status, VehicleInfo,
 };
-use crate::scenario::{Latency, ShapeSpec, VehicleModel};
-use crate::traffic::MovingShape;
-use crate::vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle};
-use crate::world::World;
+use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle};
 
 /// Stand-in for "no obstacle of this kind" in the outcome's clearances (JSON has no infinity).
 pub const NO_OBSTACLE_CLEARANCE_M: f64 = 1e9;

@@ -4,10 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
-use trust_sim::audit::audit;
+use trust_runlog::audit::audit;
+use trust_runlog::{Record, RunLog, Status};
 use trust_sim::planner::PlannerPreset;
 use trust_sim::run::{RunOptions, fly};
-use trust_sim::runlog::{Record, RunLog, Status};
 use trust_sim::scenario::Scenario;
 use trust_sim::study::{
     RunRow, RunStudyOptions, Shard, StudyConfig, Variant, merge, read_runs_csv, run_study,

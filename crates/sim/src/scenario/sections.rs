@@ -8,7 +8,7 @@ use trust_geometry::{AaBox, Cylinder, Shape, Sphere};
 
 use crate::scenario::generator::GeneratorSpec;
 use crate::traffic::{Motion, MovingShape};
-use crate::vehicle::{QuadrotorParams, Se3Gains};
+use trust_vehicle::{QuadrotorParams, Se3Gains};
 
 /// An axis-aligned box `{ min = [x, y, z], max = [x, y, z] }`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -344,10 +344,10 @@ fn default_goal_tolerance() -> f64 {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum VehicleModel {
-    /// `trust_sim::vehicle::ControlledQuadrotor` (rigid body + SE(3) controller).
+    /// `trust_vehicle::ControlledQuadrotor` (rigid body + SE(3) controller).
     #[default]
     Quadrotor,
-    /// `trust_sim::vehicle::PerfectTracking` (the state is the reference).
+    /// `trust_vehicle::PerfectTracking` (the state is the reference).
     Perfect,
 }
 

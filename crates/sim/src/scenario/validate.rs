@@ -6,8 +6,8 @@ use trust_geometry::{MAX_VOXELS, checked_voxel_count};
 use super::problem::{Problems, fmt_bounds, fmt_vec};
 use super::{Latency, MovingShapeKind, PointCloudSpec, Problem, Scenario};
 use crate::scenario::points::read_points_file;
-use crate::vehicle::VehicleError;
 use crate::world::generate::{Layout, generate};
+use trust_vehicle::VehicleError;
 
 /// Relative tolerance of "a period is an integer multiple of the physics step".
 const DIVIDE_TOLERANCE: f64 = 1e-9;
@@ -445,5 +445,7 @@ fn vehicle_problem(e: VehicleError, prefix: &str) -> Problem {
             value,
             expected,
         } => Problem::new(format!("{prefix}.{field}"), value, expected),
+        // `VehicleError` is `#[non_exhaustive]`: a future variant still names the section.
+        other => Problem::new(prefix, other, "valid vehicle parameters"),
     }
 }

@@ -10,8 +10,8 @@ use super::stats::{Mean, Rate, mean_ci, median, wilson};
 use super::{RunRow, StudyConfig, write_json, write_text};
 use crate::error::SimError;
 use crate::flight_plots::write_comparison_view;
-use crate::runlog::RunLog;
 use trust_plot::{Bar, BarChart, Distribution, Figure};
+use trust_runlog::RunLog;
 
 /// The paper's E4 numbers (Sec. IV-D, Fig. baseline-test-3) for a planner, where the text states
 /// them (the baselines' bars are only drawn in the figure).
@@ -397,7 +397,7 @@ fn write_plots(s: &StudySummary, rows: &[RunRow], out: &Path) -> Result<(), SimE
             })
             .collect();
         if let Some((_, head)) = logs.first() {
-            let flights: Vec<(String, &[crate::runlog::StateRecord])> = logs
+            let flights: Vec<(String, &[trust_runlog::StateRecord])> = logs
                 .iter()
                 .map(|(label, l)| (label.clone(), l.states.as_slice()))
                 .collect();

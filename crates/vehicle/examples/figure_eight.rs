@@ -1,17 +1,17 @@
 //! Tracking error of the simulator's vehicles on the gentle and the aggressive figure-eight.
 //!
-//! `cargo run --release -p trust-sim --example figure_eight`
+//! `cargo run --release -p trust-vehicle --example figure_eight`
 //!
 //! Flies three laps of each [`FigureEight`] at 500 Hz with the default [`ControlledQuadrotor`]
 //! and with [`PerfectTracking`], both starting on the reference, and prints one line per flight:
 //! errors (position in m, velocity in m/s), the vehicle's peak speed, acceleration, body-rate norm
 //! and thrust, the number of saturated steps, and the fastest wall time of five identical flights
 //! (the least disturbed by other processes). The numbers are the ones quoted in the
-//! `trust_sim::vehicle` module docs.
+//! `trust_vehicle` module docs.
 
 use std::time::Instant;
 
-use trust_sim::vehicle::{
+use trust_vehicle::{
     ControlledQuadrotor, FigureEight, PerfectTracking, QuadrotorParams, Se3Gains, TrackingReport,
     Vehicle, VehicleError, tracking_error,
 };

@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-use crate::runlog::{Header, ObstacleKind, RunLog, StateRecord, StaticShape, Status};
+use crate::{Header, ObstacleKind, RunLog, StateRecord, StaticShape, Status};
 
 /// Clearance tolerance of the contract (m).
 pub const CLEARANCE_TOLERANCE_M: f64 = 0.02;

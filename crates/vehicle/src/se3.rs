@@ -289,7 +289,7 @@ fn vee(s: &Matrix3<f64>) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::vehicle::FigureEight;
+    use crate::FigureEight;
     use approx::assert_relative_eq;
 
     #[test]

@@ -1,4 +1,4 @@
-//! Run logs: JSON Lines following `shared/contracts/run-log-v1.md` (schema `trust-sim-log/1`),
+//! # trust-runlog — run logs of the closed loop: JSON Lines following `shared/contracts/run-log-v1.md` (schema `trust-sim-log/1`),
 //! documented in full in `docs/run-log.md`.
 //!
 //! One object per line, each with a `"type"`: a `header` first, `state` records of the true vehicle
@@ -9,6 +9,9 @@
 //! [`LogWriter`] writes a log line by line (buffered); [`RunLog::read`] reads one back and checks its
 //! structure. Numbers are written in the shortest form that reads back to the same `f64`, and the
 //! writer refuses non-finite numbers (a non-finite value is a bug, not data).
+#![warn(missing_docs)]
+
+pub mod audit;
 
 use std::fs::File;
 use std::io::{BufRead, BufReader, BufWriter, Write};

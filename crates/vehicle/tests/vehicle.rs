@@ -1,10 +1,10 @@
-//! Public-API tests of `trust_sim::vehicle`: the shared contract of every `Vehicle`, the measured
+//! Public-API tests of `trust_vehicle`: the shared contract of every `Vehicle`, the measured
 //! tracking bounds on the figure-eights, limits, degenerate inputs and serde.
 
 use approx::assert_relative_eq;
 use proptest::prelude::*;
 use trust_core::{PolyTraj, Vec3};
-use trust_sim::vehicle::{
+use trust_vehicle::{
     ControlledQuadrotor, FigureEight, PerfectTracking, Quadrotor, QuadrotorParams, Reference,
     Se3Controller, Se3Gains, Vehicle, VehicleError, VehicleState, tracking_error,
 };
@@ -321,7 +321,7 @@ fn limits_are_never_exceeded() {
     ] {
         let mut quad =
             ControlledQuadrotor::starting_on(params, Se3Gains::default(), 0.0, &start).unwrap();
-        let mut seen = trust_sim::vehicle::Saturation::default();
+        let mut seen = trust_vehicle::Saturation::default();
         for _ in 0..10_000 {
             let info = quad.step(DT, &reference).unwrap();
             let cmd = info.command.unwrap();

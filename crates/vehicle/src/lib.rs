@@ -35,7 +35,7 @@
 //! rotor dynamics, delay, noise or wind — so the error is the controller's own: the lag of the
 //! attitude loop (no angular-acceleration feed-forward, zero-order hold; raising its gains shrinks
 //! the error). A real vehicle would do worse.
-//! Reproduce with `cargo run --release -p trust-sim --example figure_eight`, which also prints the
+//! Reproduce with `cargo run --release -p trust-vehicle --example figure_eight`, which also prints the
 //! cost: ≈ 0.4 µs per step including the error bookkeeping, ≈ 6 ms for a 30 s flight, measured on
 //! a shared, loaded 2-core machine; a step allocates nothing. `tests/vehicle.rs` asserts
 //! RMS < 3 mm (gentle) and < 15 mm (aggressive).
@@ -43,7 +43,7 @@
 //! ## Using it in the loop
 //!
 //! ```
-//! use trust_sim::vehicle::{
+//! use trust_vehicle::{
 //!     ControlledQuadrotor, FigureEight, QuadrotorParams, Se3Gains, Vehicle,
 //! };
 //!
@@ -61,8 +61,9 @@
 //! }
 //! let error = (drone.state().p - reference(drone.state().t).p).norm();
 //! assert!(error < 0.05);
-//! # Ok::<(), trust_sim::vehicle::VehicleError>(())
+//! # Ok::<(), trust_vehicle::VehicleError>(())
 //! ```
+#![warn(missing_docs)]
 
 mod controlled;
 mod error;
