@@ -15,14 +15,14 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
+use trust_experiments::flight_plots::write_flight_plots;
+use trust_experiments::study::{RunStudyOptions, Shard, StudyConfig, merge, run_study};
+use trust_flight::{RunOptions, fly, header};
 use trust_runlog::RunLog;
 use trust_runlog::audit::audit;
-use trust_sim::flight_plots::write_flight_plots;
-use trust_sim::planner::PlannerPreset;
-use trust_sim::run::{RunOptions, fly, header};
-use trust_sim::scenario::{Scenario, VehicleModel};
-use trust_sim::study::{RunStudyOptions, Shard, StudyConfig, merge, run_study};
-use trust_sim::world::World;
+use trust_world::World;
+use trust_world::planner::PlannerPreset;
+use trust_world::scenario::{Scenario, VehicleModel};
 
 #[derive(Parser)]
 #[command(
@@ -254,8 +254,8 @@ fn run_cli() -> Result<ExitCode> {
             if let Some(seed) = seed {
                 s = s.with_seed(seed);
             }
-            let summary = trust_sim::e3::run_e3(&s, &out)?;
-            println!("{}", trust_sim::e3::report_md(&summary));
+            let summary = trust_experiments::e3::run_e3(&s, &out)?;
+            println!("{}", trust_experiments::e3::report_md(&summary));
             println!("wrote {}", out.display());
             Ok(ExitCode::SUCCESS)
         }
