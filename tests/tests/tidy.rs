@@ -58,10 +58,28 @@ fn members() -> Vec<Member> {
         .collect()
 }
 
-/// The allowed internal dependencies of each library crate (design.md §2):
-/// `geometry ← predict ← core ← {lbfgs, minco, topo-prm} ← manager ← sim ← xtask`.
-/// `lbfgs` depends on nothing of ours; `minco` and `topo-prm` never depend on each other.
+/// The allowed internal dependencies of each crate (design.md §2, ARCHITECTURE.md "Dependency
+/// order"): the planning libraries
+/// `geometry ← predict ← core ← {lbfgs, minco, topo-prm} ← manager`, then the simulator along its
+/// data path `{plot, vehicle} ; world ← flight (+ runlog) ← experiments ← sim (the binary)`.
+/// `lbfgs` depends on nothing of ours; `minco` and `topo-prm` never depend on each other; `plot`
+/// knows no simulator or planner type; `runlog` knows none of the simulator's types either (a log is
+/// read without building a world); `vehicle` knows nothing of the planner.
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
+    const PLANNING: &[&str] = &[
+        "trust-geometry",
+        "trust-predict",
+        "trust-core",
+        "trust-lbfgs",
+        "trust-minco",
+        "trust-topo-prm",
+        "trust-manager",
+    ];
+    fn with(extra: &[&'static str]) -> &'static [&'static str] {
+        let mut v: Vec<&'static str> = PLANNING.to_vec();
+        v.extend_from_slice(extra);
+        Vec::leak(v)
+    }
     BTreeMap::from([
         ("trust-geometry", &[][..]),
         ("trust-predict", &["trust-geometry"][..]),
@@ -92,7 +110,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
             ][..],
         ),
         (
-            "trust-sim",
+            "trust-fuzz",
             &[
                 "trust-geometry",
                 "trust-predict",
@@ -100,10 +118,54 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-lbfgs",
                 "trust-minco",
                 "trust-topo-prm",
-                "trust-manager",
             ][..],
         ),
+        ("trust-plot", &[][..]),
+        ("trust-runlog", &[][..]),
+        ("trust-vehicle", &["trust-core"][..]),
+        ("trust-world", with(&["trust-vehicle"])),
+        (
+            "trust-flight",
+            with(&["trust-vehicle", "trust-world", "trust-runlog"]),
+        ),
+        (
+            "trust-experiments",
+            with(&[
+                "trust-vehicle",
+                "trust-world",
+                "trust-runlog",
+                "trust-flight",
+                "trust-plot",
+            ]),
+        ),
+        (
+            "trust-sim",
+            with(&[
+                "trust-vehicle",
+                "trust-world",
+                "trust-runlog",
+                "trust-flight",
+                "trust-plot",
+                "trust-experiments",
+            ]),
+        ),
     ])
+}
+
+/// Every workspace member is either in [`allowed`] or one of the automation crates, so that a new
+/// crate cannot escape the layering rules by not being listed.
+#[test]
+fn every_crate_has_a_layer() {
+    let allowed = allowed();
+    let unlisted: Vec<String> = members()
+        .iter()
+        .map(|m| m.name().to_string())
+        .filter(|n| !allowed.contains_key(n.as_str()) && n != "xtask" && n != "trust-tests")
+        .collect();
+    assert!(
+        unlisted.is_empty(),
+        "crates without a place in the dependency order of tidy.rs: {unlisted:?}"
+    );
 }
 
 #[test]
@@ -112,7 +174,7 @@ fn library_crates_respect_the_dependency_direction() {
     let mut violations = Vec::new();
     for m in members() {
         let Some(ok) = allowed.get(m.name()) else {
-            continue; // xtask and the tests crate may use anything.
+            continue; // xtask and the tests crate may use anything (`every_crate_has_a_layer`).
         };
         // Normal and build dependencies define the architecture; dev-dependencies may not break it
         // either (a test of minco must not pull in topo-prm), except that crates may test against

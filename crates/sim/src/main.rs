@@ -7,7 +7,12 @@
 //! trust-sim ablate [--scenario FILE] [--trials N] [--seed S] [--planners a,b] [--variant V]
 //!                  [--out DIR] [--jobs J] [--shard K/M] [--time-limit T] [--no-plots]
 //! trust-sim ablate-merge --out DIR SHARD_DIR...
+//! trust-sim e3 [--scenario FILE] [--seed S] [--out DIR]
 //! ```
+//!
+//! The binary only parses the command line; the work is in `trust-world` (scenarios, worlds),
+//! `trust-flight` (the closed loop), `trust-runlog` (logs, audit) and `trust-experiments`
+//! (studies, E3, figures).
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -92,7 +97,8 @@ enum Cmd {
         )]
         planners: Vec<String>,
         /// One-component ablation applied to every planner it concerns: none, vprm, minco, uvd,
-        /// no-pdc, no-ggs, no-history, no-hysteresis, perfect, quadrotor, mu=X, fault=X.
+        /// no-pdc, no-ggs, no-history, no-hysteresis, perfect, quadrotor, mu=X, fault=X,
+        /// explore=K.
         #[arg(long, default_value = "none")]
         variant: String,
         /// Output directory.
@@ -175,7 +181,8 @@ fn run_cli() -> Result<ExitCode> {
             zero_timing,
             no_plots,
         } => {
-            let mut s = Scenario::load(&scenario)?;
+            // Checked once, with the overrides applied, where the world is built (`run`).
+            let mut s = Scenario::parse_file(&scenario)?;
             if let Some(name) = planner {
                 s.planner.name = parse_preset(&name)?;
                 s.planner.frontend = None;
@@ -250,7 +257,8 @@ fn run_cli() -> Result<ExitCode> {
             seed,
             out,
         } => {
-            let mut s = Scenario::load(&scenario)?;
+            // Checked once, where `run_e3` builds the world.
+            let mut s = Scenario::parse_file(&scenario)?;
             if let Some(seed) = seed {
                 s = s.with_seed(seed);
             }
@@ -270,7 +278,7 @@ fn run_cli() -> Result<ExitCode> {
         Cmd::Validate { scenarios } => {
             let mut bad = 0;
             for path in &scenarios {
-                match Scenario::load(path) {
+                match trust_world::load_checked(path) {
                     Ok(_) => println!("{}: ok", path.display()),
                     Err(e) => {
                         bad += 1;

@@ -160,23 +160,15 @@ impl World {
     pub fn build(scenario: &Scenario) -> Result<World, WorldError> {
         let t0 = Instant::now();
         let origin = scenario.origin();
-        let problems = scenario.validate();
-        if !problems.is_empty() {
-            return Err(WorldError::Invalid {
-                path: origin,
-                problems,
-            });
-        }
-        let bounds = scenario.bounds().ok_or_else(|| {
-            WorldError::input("world.bounds", "(missing)", "bounds or a generator")
+        let Prepared {
+            bounds,
+            layout,
+            cloud_points,
+        } = prepare(scenario).map_err(|problems| WorldError::Invalid {
+            path: origin,
+            problems,
         })?;
         let seeds = scenario.seeds();
-        let layout = generate::generate(scenario, &bounds, seeds.world).map_err(|problems| {
-            WorldError::Invalid {
-                path: origin.clone(),
-                problems,
-            }
-        })?;
         let layout_ms = ms_since(t0);
 
         let t1 = Instant::now();
@@ -209,12 +201,14 @@ impl World {
                 )
             }
             Some(PointCloudSpec::File { esdf_voxel_m, path }) => {
-                let full = scenario.resolve_path(path);
-                let pts = crate::scenario::points::read_points_file(&full)?;
+                // Read once, by the checks in `prepare`.
+                let pts = cloud_points.ok_or_else(|| {
+                    WorldError::input("static.point_cloud.path", path.display(), "a points file")
+                })?;
                 (
                     Some((pts.clone(), *esdf_voxel_m, None)),
                     Some(PointTree::new(pts)),
-                    Some(full),
+                    Some(scenario.resolve_path(path)),
                 )
             }
         };
@@ -357,11 +351,6 @@ impl World {
         &self.planner_map
     }
 
-    /// The planner's static map, shared.
-    pub fn planner_map_arc(&self) -> Arc<StaticMap> {
-        Arc::clone(&self.planner_map)
-    }
-
     /// How much the planner's map may overestimate the distance to a true static obstacle (m):
     /// 0 for analytic shapes; for an ESDF, [`esdf_error_bound`] (0.35 m at 0.2 m voxels).
     pub fn static_map_error_m(&self) -> f64 {
@@ -444,6 +433,72 @@ impl World {
             static_map_error_m: self.static_map_error_m,
             seed: self.seeds.planner,
         }
+    }
+}
+
+/// What [`World::build`] starts from: the checked scenario's bounds, its generated layout and the
+/// cloud points read from its file (if any).
+struct Prepared {
+    bounds: Aabb,
+    layout: generate::Layout,
+    cloud_points: Option<Vec<Vec3>>,
+}
+
+/// Every check of a scenario: the file's ([`Scenario::validate`]) and, when the geometry is valid,
+/// start and goal against the generated layout. The layout is generated once and the points file
+/// read once; `Err` holds every problem, in file order, layout problems last.
+fn prepare(scenario: &Scenario) -> Result<Prepared, Vec<scenario::Problem>> {
+    let file = scenario.check_file();
+    let mut problems = file.problems;
+    let mut layout = None;
+    if file.geometry_ok
+        && let Some(bounds) = &file.bounds
+    {
+        match generate::generate(scenario, bounds, scenario.seeds().world) {
+            Ok(l) => {
+                scenario.check_layout(&mut problems, &l, file.cloud_points.as_deref());
+                layout = Some(l);
+            }
+            Err(p) => problems.list.extend(p),
+        }
+    }
+    match (problems.list.is_empty(), file.bounds, layout) {
+        (true, Some(bounds), Some(layout)) => Ok(Prepared {
+            bounds,
+            layout,
+            cloud_points: file.cloud_points,
+        }),
+        (true, _, _) => Err(vec![scenario::Problem::new(
+            "world.bounds",
+            "(missing)",
+            "bounds or a generator",
+        )]),
+        (false, _, _) => Err(problems.list),
+    }
+}
+
+/// Every problem of `scenario`, as [`World::build`] finds them, without building the maps:
+/// [`Scenario::validate`]'s and start and goal against the generated layout (`trust-sim
+/// validate`). Empty: [`World::build`] will not reject the scenario.
+pub fn check(scenario: &Scenario) -> Vec<scenario::Problem> {
+    prepare(scenario).err().unwrap_or_default()
+}
+
+/// Reads, parses and fully checks a scenario file ([`Scenario::parse_file`], then [`check`]):
+/// what `trust-sim validate` reports, without building the maps.
+///
+/// # Errors
+/// [`WorldError::Read`], [`WorldError::Parse`], or [`WorldError::Invalid`] with every problem.
+pub fn load_checked(path: &Path) -> Result<Scenario, WorldError> {
+    let s = Scenario::parse_file(path)?;
+    let problems = check(&s);
+    if problems.is_empty() {
+        Ok(s)
+    } else {
+        Err(WorldError::Invalid {
+            path: path.to_path_buf(),
+            problems,
+        })
     }
 }
 

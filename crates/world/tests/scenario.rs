@@ -113,7 +113,7 @@ fn broken_files_give_the_expected_messages() {
             "{} has no `# expect:` line",
             path.display()
         );
-        let message = match Scenario::load(path) {
+        let message = match trust_world::load_checked(path) {
             Ok(_) => {
                 failures.push(format!("{}: loaded without error", path.display()));
                 continue;
@@ -135,7 +135,7 @@ fn broken_files_give_the_expected_messages() {
 #[test]
 fn validation_reports_every_problem_not_just_the_first() {
     let path = broken_dir().join("many_problems.toml");
-    match Scenario::load(&path) {
+    match trust_world::load_checked(&path) {
         Err(WorldError::Invalid { problems, path: p }) => {
             assert_eq!(p, path);
             assert_eq!(problems.len(), 10, "{problems:#?}");

@@ -10,7 +10,7 @@
 //! - `study.json`: the [`StudyConfig`] (what to reproduce it with), including the shard;
 //! - `runs.csv`: one [`RunRow`] per flight, sorted by trial and planner — identical for the same
 //!   configuration whatever the number of workers, except the timing columns
-//!   ([`RunRow::TIMING_COLUMNS`]);
+//!   ([`RunRow::timing_columns`]);
 //! - `summary.json`, `report.md` and plots ([`report`]);
 //! - `logs/<planner>/trial-NNNN.jsonl`: every run log (contract `run-log-v1`).
 //!
@@ -237,14 +237,11 @@ impl RunRow {
         "",
     ];
 
-    /// The columns that hold measured times (they differ between runs of the same study).
-    pub const TIMING_COLUMNS: [&'static str; 5] = [
-        "cycle_ms_median",
-        "cycle_ms_p99",
-        "solve_ms_per_trajectory",
-        "cpu_ms_per_trajectory",
-        "wall_s",
-    ];
+    /// The columns that hold measured times (they differ between runs of the same study):
+    /// `cycle_ms_median` … `wall_s` of [`RunRow::COLUMNS`].
+    pub fn timing_columns() -> &'static [&'static str] {
+        &Self::COLUMNS[13..18]
+    }
 
     fn header_line() -> String {
         Self::COLUMNS[..19].join(",")
@@ -641,6 +638,20 @@ fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, ExperimentE
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn timing_columns_are_the_measured_times() {
+        assert_eq!(
+            RunRow::timing_columns(),
+            [
+                "cycle_ms_median",
+                "cycle_ms_p99",
+                "solve_ms_per_trajectory",
+                "cpu_ms_per_trajectory",
+                "wall_s"
+            ]
+        );
+    }
 
     #[test]
     fn shards_partition_the_trials() {

@@ -104,9 +104,10 @@
 //! [`Scenario::load`] keeps toml's message for syntax errors, wrong types, unknown fields and
 //! unknown names (file name, line, column and the offending snippet: [`WorldError::Parse`]), and
 //! then runs [`Scenario::validate`], which collects **every** semantic problem
-//! ([`WorldError::Invalid`]), each as `field.path: value — expected …` ([`Problem`]). Validation
-//! generates the world's layout (cheap; no ESDF) and checks start and goal against the true
-//! geometry.
+//! ([`WorldError::Invalid`]), each as `field.path: value — expected …` ([`Problem`]) that the
+//! file alone shows. Start and goal against the generated layout are checked where the layout is
+//! generated — once per world, in [`crate::World::build`] — or by [`crate::load_checked`]
+//! (`trust-sim validate`), which generates the layout without building the maps.
 
 pub(crate) mod generator;
 pub mod points;
@@ -214,7 +215,9 @@ impl Scenario {
         Scenario::from_toml_str(&text, path)
     }
 
-    /// Reads, parses and validates a scenario file.
+    /// Reads, parses and checks a scenario file ([`Scenario::validate`]: everything the file
+    /// alone shows; the layout checks run where the world is built, [`crate::World::build`], or
+    /// in [`crate::load_checked`]).
     ///
     /// # Errors
     /// [`WorldError::Read`], [`WorldError::Parse`], or [`WorldError::Invalid`] with every problem

@@ -5,7 +5,7 @@ use trust_geometry::{MAX_VOXELS, checked_voxel_count};
 
 use super::problem::{Problems, fmt_bounds, fmt_vec};
 use super::{Latency, MovingShapeKind, PointCloudSpec, Problem, Scenario};
-use crate::generate::{Layout, generate};
+use crate::generate::Layout;
 use crate::scenario::points::read_points_file;
 use trust_vehicle::VehicleError;
 
@@ -15,21 +15,42 @@ const DIVIDE_TOLERANCE: f64 = 1e-9;
 /// The run-log contract's lowest state-record rate (Hz).
 const MIN_LOG_RATE_HZ: f64 = 50.0;
 
+/// What the file-level checks found, and what they computed that the world build reuses (the
+/// bounds, and the cloud points read from the file, so that a points file is read once per build).
+pub(crate) struct FileCheck {
+    /// Every problem, in file order.
+    pub(crate) problems: Problems,
+    /// The world bounds, if given and valid.
+    pub(crate) bounds: Option<Aabb>,
+    /// The cloud points that are truth (inline or file), if any and readable.
+    pub(crate) cloud_points: Option<Vec<Vec3>>,
+    /// Bounds, static map, obstacles, mission and vehicle radius are valid, so the layout can be
+    /// generated and checked ([`Scenario::check_layout`]).
+    pub(crate) geometry_ok: bool,
+}
+
 impl Scenario {
-    /// Every semantic problem of the scenario, in file order (empty: valid).
+    /// Every semantic problem of the scenario that the file alone shows, in file order (empty:
+    /// valid). The checks against the generated layout (start and goal clear of generated shapes
+    /// and cloud points) run where the layout is generated, in [`crate::World::build`] and
+    /// [`crate::check`], so that a world is generated once.
     ///
     /// Checks: non-finite numbers; non-positive sizes, limits, rates and time limit; bounds with
     /// `min ≥ max`; start and goal outside the bounds, inside or within the vehicle radius of a
-    /// static shape or cloud point (also generated ones, against the true geometry), the start
-    /// within the vehicle radius of a moving obstacle at `t = 0`; moving obstacles not fitting
-    /// their region; rates whose periods are not integer multiples of the physics step (within
-    /// 1e-9 relative); a log rate below 50 Hz; bad parameters of the frontend, backend, checker
-    /// and manager (their own `validate()`, with field paths under `planner.`), of the vehicle
-    /// model, the EKF and the generators; a missing or malformed points file; an empty inline
-    /// cloud; an ESDF grid above `trust_geometry::MAX_VOXELS` voxels (computed without
-    /// allocating); a dropout probability outside `[0, 1)`. Names (planner, kinds) are checked
-    /// when the file is parsed.
+    /// static shape or cloud point, the start within the vehicle radius of a moving obstacle at
+    /// `t = 0`; moving obstacles not fitting their region; rates whose periods are not integer
+    /// multiples of the physics step (within 1e-9 relative); a log rate below 50 Hz; bad
+    /// parameters of the frontend, backend, checker and manager (their own `validate()`, with
+    /// field paths under `planner.`), of the vehicle model, the EKF and the generators; a missing
+    /// or malformed points file; an empty inline cloud; an ESDF grid above
+    /// `trust_geometry::MAX_VOXELS` voxels (computed without allocating); a dropout probability
+    /// outside `[0, 1)`. Names (planner, kinds) are checked when the file is parsed.
     pub fn validate(&self) -> Vec<Problem> {
+        self.check_file().problems.list
+    }
+
+    /// The checks of [`Scenario::validate`], with what they computed.
+    pub(crate) fn check_file(&self) -> FileCheck {
         let mut p = Problems::default();
         if self.name.trim().is_empty() {
             p.push("name", "\"\"", "a non-empty name");
@@ -49,14 +70,12 @@ impl Scenario {
         self.sensing.check("sensing", &mut p);
         p.non_negative("traffic.fault_level", self.traffic.fault_level);
         self.check_sim(&mut p);
-
-        if geometry_ok && let Some(bounds) = bounds {
-            match generate(self, &bounds, self.seeds().world) {
-                Ok(layout) => self.check_layout(&mut p, &layout, cloud_points.as_deref()),
-                Err(problems) => p.list.extend(problems),
-            }
+        FileCheck {
+            problems: p,
+            bounds,
+            cloud_points,
+            geometry_ok,
         }
-        p.list
     }
 
     fn check_world(&self, p: &mut Problems) -> Option<Aabb> {
@@ -311,7 +330,7 @@ impl Scenario {
     }
 
     /// Start and goal against the generated (true) geometry.
-    fn check_layout(&self, p: &mut Problems, layout: &Layout, cloud: Option<&[Vec3]>) {
+    pub(crate) fn check_layout(&self, p: &mut Problems, layout: &Layout, cloud: Option<&[Vec3]>) {
         let r = self.vehicle.radius_m;
         if matches!(
             self.static_map.point_cloud,
