@@ -6,7 +6,7 @@
 
 use std::path::PathBuf;
 
-use crate::scenario::Problem;
+use crate::problem::Problem;
 use trust_vehicle::VehicleError;
 
 /// Why a scenario could not be loaded, a world built, or a simulator component created.

@@ -6,9 +6,9 @@ use trust_core::{Aabb, Rng, Vec3};
 use trust_geometry::{AaBox, Cylinder, Shape};
 use trust_predict::ObstacleShape;
 
-use crate::scenario::problem::{Problems, fmt_bounds};
+use crate::problem::{Problems, fmt_bounds, fmt_vec};
 use crate::scenario::{
-    E4Params, GeneratorSpec, MovingShapeKind, Problem, RandomObstacles, Scenario,
+    E4Params, GeneratorSpec, MovingShapeKind, PointCloudSpec, Problem, RandomObstacles, Scenario,
 };
 use crate::traffic::{Motion, MovingObstacle, MovingShape};
 
@@ -293,7 +293,7 @@ fn random_group(
                     format!(
                         "a region large enough for every obstacle size (an obstacle with half \
                          extents {} does not fit)",
-                        crate::scenario::problem::fmt_vec(e.as_slice())
+                        crate::problem::fmt_vec(e.as_slice())
                     ),
                 ));
             }
@@ -510,4 +510,79 @@ fn e4_static(
         }
     }
     Ok(shapes)
+}
+
+/// Start and goal of `scenario` against its generated (true) geometry; `cloud` is the truth
+/// cloud read by the file checks.
+pub(crate) fn check_layout(
+    scenario: &Scenario,
+    p: &mut Problems,
+    layout: &Layout,
+    cloud: Option<&[Vec3]>,
+) {
+    let r = scenario.vehicle.radius_m;
+    if matches!(
+        scenario.static_map.point_cloud,
+        Some(PointCloudSpec::Shapes { .. })
+    ) && layout.shapes.is_empty()
+    {
+        p.push(
+            "static.point_cloud.source",
+            "\"shapes\"",
+            "static shapes to sample (none are given or generated)",
+        );
+    }
+    for (name, q) in [
+        ("mission.start", &scenario.mission.start),
+        ("mission.goal", &scenario.mission.goal),
+    ] {
+        let x = Vec3::from(*q);
+        for (i, s) in layout.shapes.iter().enumerate() {
+            let d = s.signed_distance(&x);
+            if d < r {
+                p.push(
+                    name,
+                    fmt_vec(q),
+                    format!(
+                        "a point at least vehicle.radius_m = {r} m from every static obstacle \
+                         ({} is at {d:.3} m)",
+                        layout.shape_origin(i)
+                    ),
+                );
+            }
+        }
+        if let Some(points) = cloud {
+            let (d, i) = points
+                .iter()
+                .enumerate()
+                .map(|(i, c)| ((c - x).norm(), i))
+                .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a });
+            if d < r {
+                p.push(
+                    name,
+                    fmt_vec(q),
+                    format!(
+                        "a point at least vehicle.radius_m = {r} m from every static cloud \
+                         point (point {i} at {} is at {d:.3} m)",
+                        fmt_vec(points[i].as_slice())
+                    ),
+                );
+            }
+        }
+    }
+    let start = Vec3::from(scenario.mission.start);
+    for (i, o) in layout.obstacles.iter().enumerate() {
+        let d = o.shape.signed_distance(&o.position, &start);
+        if d < r {
+            p.push(
+                "mission.start",
+                fmt_vec(&scenario.mission.start),
+                format!(
+                    "a start at least vehicle.radius_m = {r} m from every moving obstacle at \
+                     t = 0 ({} is at {d:.3} m)",
+                    layout.obstacle_origin(i)
+                ),
+            );
+        }
+    }
 }

@@ -85,6 +85,7 @@ pub mod error;
 pub(crate) mod generate;
 mod kdtree;
 pub mod planner;
+pub mod problem;
 mod sampling;
 pub mod scenario;
 pub mod seeds;
@@ -456,7 +457,7 @@ fn prepare(scenario: &Scenario) -> Result<Prepared, Vec<scenario::Problem>> {
     {
         match generate::generate(scenario, bounds, scenario.seeds().world) {
             Ok(l) => {
-                scenario.check_layout(&mut problems, &l, file.cloud_points.as_deref());
+                generate::check_layout(scenario, &mut problems, &l, file.cloud_points.as_deref());
                 layout = Some(l);
             }
             Err(p) => problems.list.extend(p),

@@ -64,8 +64,8 @@ use trust_topo_prm::{
 };
 
 use crate::error::WorldError;
-use crate::scenario::Problem;
-use crate::scenario::problem::Problems;
+use crate::problem::Problem;
+use crate::problem::Problems;
 
 /// Search budget (ms) given to DEV-PRM, V-PRM and sparse A* in reproducible mode: one minute,
 /// far beyond what their sample and expansion caps need, so that the caps end every search.

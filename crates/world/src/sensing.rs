@@ -39,7 +39,7 @@ use trust_core::{Forecast, Rng, Vec3};
 use trust_predict::{CvEkf, EkfParams, PredictError};
 
 use crate::error::WorldError;
-use crate::scenario::problem::Problems;
+use crate::problem::Problems;
 use crate::traffic::MovingShape;
 
 /// Scenario section `[sensing]`.
@@ -80,7 +80,7 @@ impl Default for SensingParams {
 
 impl SensingParams {
     /// Every problem with these parameters; field paths start with `field` (e.g. `sensing`).
-    pub fn problems(&self, field: &str) -> Vec<crate::scenario::Problem> {
+    pub fn problems(&self, field: &str) -> Vec<crate::problem::Problem> {
         let mut p = Problems::default();
         self.check(field, &mut p);
         p.list
@@ -105,8 +105,8 @@ impl SensingParams {
 }
 
 /// A parameter error of `trust-predict` (fields `ekf.…`) as a problem under `prefix`.
-fn predict_problem(e: PredictError, prefix: &str) -> crate::scenario::Problem {
-    use crate::scenario::Problem;
+fn predict_problem(e: PredictError, prefix: &str) -> crate::problem::Problem {
+    use crate::problem::Problem;
     match e {
         PredictError::NonFinite { field, value } => {
             Problem::new(format!("{prefix}.{field}"), value, "a finite number")

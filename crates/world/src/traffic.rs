@@ -48,7 +48,7 @@ use trust_geometry::{cylinder_sdf, sphere_sdf};
 use trust_predict::ObstacleShape;
 
 use crate::error::WorldError;
-use crate::scenario::problem::{Problems, fmt_bounds, fmt_vec};
+use crate::problem::{Problems, fmt_bounds, fmt_vec};
 use crate::seeds::mix_seed;
 
 /// True shape and size of a moving obstacle. A cylinder is vertical with its centre at
@@ -202,7 +202,7 @@ pub struct MovingObstacle {
 
 impl MovingObstacle {
     /// Every problem with this obstacle; field paths start with `field` (e.g. `obstacles[2]`).
-    pub fn problems(&self, field: &str) -> Vec<crate::scenario::Problem> {
+    pub fn problems(&self, field: &str) -> Vec<crate::problem::Problem> {
         let mut p = Problems::default();
         self.check(field, &mut p);
         p.list

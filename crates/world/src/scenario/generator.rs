@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 use trust_core::{Aabb, Vec3};
 
-use crate::scenario::problem::Problems;
+use crate::problem::Problems;
 use crate::scenario::sections::BoundsSpec;
 use crate::traffic::{ManeuverParams, Motion};
 
@@ -72,7 +72,7 @@ impl GeneratorSpec {
                 {
                     p.push(
                         format!("{field}.region"),
-                        super::problem::fmt_bounds(&r.min, &r.max),
+                        crate::problem::fmt_bounds(&r.min, &r.max),
                         "finite bounds with min < max on every axis",
                     );
                 }

@@ -111,7 +111,7 @@
 
 pub(crate) mod generator;
 pub mod points;
-pub mod problem;
+
 mod sections;
 mod validate;
 
@@ -120,16 +120,16 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use trust_core::Aabb;
 
+pub use crate::problem::Problem;
 pub use generator::{E1Params, E2Params, E3Params, E4Params, GeneratorSpec};
-pub use problem::Problem;
 pub use sections::{
     BoundsSpec, Latency, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec, RandomObstacles,
     ShapeSpec, SimSection, StaticSection, VehicleModel, VehicleSection, WorldSection,
 };
 
-use crate::Seeds;
 use crate::error::WorldError;
 use crate::planner::{PlannerSpec, ResolvedPlanner};
+use crate::seeds::Seeds;
 use crate::sensing::SensingParams;
 use crate::traffic::TrafficParams;
 

@@ -3,9 +3,8 @@
 use trust_core::{Aabb, Vec3};
 use trust_geometry::{MAX_VOXELS, checked_voxel_count};
 
-use super::problem::{Problems, fmt_bounds, fmt_vec};
 use super::{Latency, MovingShapeKind, PointCloudSpec, Problem, Scenario};
-use crate::generate::Layout;
+use crate::problem::{Problems, fmt_bounds, fmt_vec};
 use crate::scenario::points::read_points_file;
 use trust_vehicle::VehicleError;
 
@@ -25,7 +24,7 @@ pub(crate) struct FileCheck {
     /// The cloud points that are truth (inline or file), if any and readable.
     pub(crate) cloud_points: Option<Vec<Vec3>>,
     /// Bounds, static map, obstacles, mission and vehicle radius are valid, so the layout can be
-    /// generated and checked ([`Scenario::check_layout`]).
+    /// generated and checked (`generate::check_layout`).
     pub(crate) geometry_ok: bool,
 }
 
@@ -326,75 +325,6 @@ impl Scenario {
         } = s.latency
         {
             p.non_negative("sim.latency.seconds", seconds);
-        }
-    }
-
-    /// Start and goal against the generated (true) geometry.
-    pub(crate) fn check_layout(&self, p: &mut Problems, layout: &Layout, cloud: Option<&[Vec3]>) {
-        let r = self.vehicle.radius_m;
-        if matches!(
-            self.static_map.point_cloud,
-            Some(PointCloudSpec::Shapes { .. })
-        ) && layout.shapes.is_empty()
-        {
-            p.push(
-                "static.point_cloud.source",
-                "\"shapes\"",
-                "static shapes to sample (none are given or generated)",
-            );
-        }
-        for (name, q) in [
-            ("mission.start", &self.mission.start),
-            ("mission.goal", &self.mission.goal),
-        ] {
-            let x = Vec3::from(*q);
-            for (i, s) in layout.shapes.iter().enumerate() {
-                let d = s.signed_distance(&x);
-                if d < r {
-                    p.push(
-                        name,
-                        fmt_vec(q),
-                        format!(
-                            "a point at least vehicle.radius_m = {r} m from every static obstacle \
-                             ({} is at {d:.3} m)",
-                            layout.shape_origin(i)
-                        ),
-                    );
-                }
-            }
-            if let Some(points) = cloud {
-                let (d, i) = points
-                    .iter()
-                    .enumerate()
-                    .map(|(i, c)| ((c - x).norm(), i))
-                    .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a });
-                if d < r {
-                    p.push(
-                        name,
-                        fmt_vec(q),
-                        format!(
-                            "a point at least vehicle.radius_m = {r} m from every static cloud \
-                             point (point {i} at {} is at {d:.3} m)",
-                            fmt_vec(points[i].as_slice())
-                        ),
-                    );
-                }
-            }
-        }
-        let start = Vec3::from(self.mission.start);
-        for (i, o) in layout.obstacles.iter().enumerate() {
-            let d = o.shape.signed_distance(&o.position, &start);
-            if d < r {
-                p.push(
-                    "mission.start",
-                    fmt_vec(&self.mission.start),
-                    format!(
-                        "a start at least vehicle.radius_m = {r} m from every moving obstacle at \
-                         t = 0 ({} is at {d:.3} m)",
-                        layout.obstacle_origin(i)
-                    ),
-                );
-            }
         }
     }
 }
