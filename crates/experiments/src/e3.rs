@@ -98,7 +98,7 @@ pub struct E3Summary {
 /// file-system or plotting failures.
 pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, ExperimentError> {
     let world = World::build(scenario)?;
-    let resolved = scenario.resolve_planner()?;
+    let resolved = scenario.resolve_planner();
     let mut manager = planner::build(&resolved, &world.planner_context())?;
     let traffic = world.traffic()?;
     let mut sensing = world.sensing()?;

@@ -39,7 +39,7 @@ fn quickstart_arrives_and_its_log_passes_the_independent_audit() {
         zero_timing: false,
         progress_every_s: None,
     };
-    let flight = fly(&world, &s.resolve_planner().unwrap(), &options, |_| {}).unwrap();
+    let flight = fly(&world, &s.resolve_planner(), &options, |_| {}).unwrap();
     let o = &flight.summary.outcome;
     assert_eq!(o.status, Status::Arrived, "{o:?}");
     assert!(o.min_clearance_static_m > 0.0 && o.min_clearance_dynamic_m > 0.0);
@@ -66,7 +66,7 @@ fn quickstart_arrives_and_its_log_passes_the_independent_audit() {
 fn the_same_seed_gives_a_byte_identical_log() {
     let s = quickstart().with_seed(7);
     let world = World::build(&s).unwrap();
-    let planner = s.resolve_planner().unwrap();
+    let planner = s.resolve_planner();
     let dir = temp_dir("identical");
     let mut texts = Vec::new();
     for k in 0..2 {
@@ -92,7 +92,7 @@ fn the_same_seed_gives_a_byte_identical_log() {
         zero_timing: true,
         progress_every_s: None,
     };
-    fly(&w8, &other.resolve_planner().unwrap(), &options, |_| {}).unwrap();
+    fly(&w8, &other.resolve_planner(), &options, |_| {}).unwrap();
     assert!(std::fs::read(&path).unwrap() != texts[0]);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -132,7 +132,7 @@ fn every_shipped_scenario_validates_and_flies_with_every_planner() {
                 zero_timing: false,
                 progress_every_s: None,
             };
-            let f = fly(&w, &t.resolve_planner().unwrap(), &options, |_| {})
+            let f = fly(&w, &t.resolve_planner(), &options, |_| {})
                 .unwrap_or_else(|e| panic!("{} with {}: {e}", s.name, p.name()));
             let o = &f.summary.outcome;
             assert!(

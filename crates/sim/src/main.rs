@@ -346,7 +346,7 @@ fn run(s: &Scenario, out: &Path, zero_timing: bool, plots: bool) -> Result<ExitC
     let tty = std::io::stderr().is_terminal();
     eprintln!("building the world of `{}` (seed {})...", s.name, s.seed);
     let world = World::build(s)?;
-    let planner = s.resolve_planner()?;
+    let planner = s.resolve_planner();
     let log_path = out.join("run.jsonl");
     let options = RunOptions {
         log_path: Some(log_path.clone()),

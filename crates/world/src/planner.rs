@@ -20,7 +20,8 @@
 //! Overrides in the scenario's `[planner]` section replace parts of the preset:
 //! `frontend = { kind = "v-prm", budget_ms = 20 }` replaces the frontend (the fields are that
 //! kind's `…Params`, unspecified ones at their defaults), likewise `backend` and `checker`;
-//! `[planner.manager]` fields are merged key by key onto the preset's `ManagerParams`, so
+//! `[planner.manager]` fields replace single fields of the preset's `ManagerParams`
+//! ([`ManagerOverrides::apply`]), so
 //! `name = "baseline1"` with `manager.horizon_s = 3` stays single-branch.
 //!
 //! # Clearances (set by [`effective`], from the vehicle radius `r`)
@@ -51,12 +52,13 @@
 //! samples). CPU times are still measured and reported. Set `reproducible = false` to study the
 //! real-time behaviour under the budgets.
 
-use serde::{Deserialize, Deserializer, Serialize};
+use serde::{Deserialize, Serialize};
+use trust_core::RankingWeights;
 use trust_core::{
     Curve, HomotopyChecker, Limits, PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult,
     Solution, TrajRequest, TrajectoryBackend,
 };
-use trust_manager::{Manager, ManagerParams};
+use trust_manager::{Manager, ManagerParams, ReanchorParams, SafetyParams};
 use trust_minco::{Minco, MincoParams, UtfMinco, UtfMincoParams};
 use trust_topo_prm::{
     DevPrm, DevPrmParams, SparseAStar, SparseAStarParams, StraightLine, Tvd, TvdParams, Uvd,
@@ -411,22 +413,199 @@ impl PlannerPreset {
     }
 }
 
-/// Fields of `trust_manager::ManagerParams` to merge onto a preset's manager parameters
-/// (scenario table `[planner.manager]`).
-///
-/// Deserializing checks that the table is valid on its own (known fields, right types), so
-/// unknown fields are reported with the line of the table; the merge itself is
-/// [`PlannerSpec::resolve`].
-#[derive(Debug, Clone, PartialEq, Default, Serialize)]
-#[serde(transparent)]
-pub struct ManagerOverrides(pub toml::Table);
+/// Scenario section `[planner.manager]`: fields that replace the preset's [`ManagerParams`] one
+/// by one (meanings and defaults: `trust_manager::ManagerParams`); `[planner.manager.safety]` and
+/// `[planner.manager.reanchor]` replace single fields of those sub-structs. Unknown fields are
+/// errors naming the field. `seed` is not an override: the planner's random stream is seeded from
+/// the trial ([`crate::seeds::Seeds::planner`], set by [`effective`]), so `seed` here is an
+/// unknown-field error instead of a value that would be silently replaced.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ManagerOverrides {
+    /// Replaces `ManagerParams::max_branches`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_branches: Option<usize>,
+    /// Replaces `ManagerParams::history`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub history: Option<bool>,
+    /// Replaces `ManagerParams::max_explored_paths`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_explored_paths: Option<usize>,
+    /// Replaces `ManagerParams::straight_guide_when_empty`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub straight_guide_when_empty: Option<bool>,
+    /// Replaces `ManagerParams::warm_max_evaluations`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warm_max_evaluations: Option<usize>,
+    /// Replaces `ManagerParams::sub_branch_max_evaluations`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sub_branch_max_evaluations: Option<usize>,
+    /// Replaces `ManagerParams::cold_max_evaluations`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cold_max_evaluations: Option<usize>,
+    /// Replaces `ManagerParams::explore_period_cycles`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub explore_period_cycles: Option<usize>,
+    /// Replaces `ManagerParams::repair_margin_m`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub repair_margin_m: Option<f64>,
+    /// Replaces `ManagerParams::ranking`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ranking: Option<RankingWeights>,
+    /// Replaces `ManagerParams::horizon_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub horizon_s: Option<f64>,
+    /// Replaces `ManagerParams::cycle_budget_ms`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cycle_budget_ms: Option<f64>,
+    /// Replaces `ManagerParams::enforce_budget`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub enforce_budget: Option<bool>,
+    /// Replaces `ManagerParams::latency_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub latency_s: Option<f64>,
+    /// Replaces `ManagerParams::reanchor`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reanchor: Option<ReanchorOverrides>,
+    /// Replaces `ManagerParams::hysteresis`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hysteresis: Option<f64>,
+    /// Replaces `ManagerParams::safety`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub safety: Option<SafetyOverrides>,
+}
 
-impl<'de> Deserialize<'de> for ManagerOverrides {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let table = toml::Table::deserialize(d)?;
-        ManagerParams::deserialize(toml::Value::Table(table.clone()))
-            .map_err(|e| serde::de::Error::custom(e.message()))?;
-        Ok(ManagerOverrides(table))
+impl ManagerOverrides {
+    /// No field is given.
+    pub fn is_empty(&self) -> bool {
+        *self == ManagerOverrides::default()
+    }
+
+    /// Writes the given fields onto `p`; the others keep their value.
+    pub fn apply(&self, p: &mut ManagerParams) {
+        if let Some(v) = self.max_branches {
+            p.max_branches = v;
+        }
+        if let Some(v) = self.history {
+            p.history = v;
+        }
+        if let Some(v) = self.max_explored_paths {
+            p.max_explored_paths = v;
+        }
+        if let Some(v) = self.straight_guide_when_empty {
+            p.straight_guide_when_empty = v;
+        }
+        if let Some(v) = self.warm_max_evaluations {
+            p.warm_max_evaluations = Some(v);
+        }
+        if let Some(v) = self.sub_branch_max_evaluations {
+            p.sub_branch_max_evaluations = Some(v);
+        }
+        if let Some(v) = self.cold_max_evaluations {
+            p.cold_max_evaluations = Some(v);
+        }
+        if let Some(v) = self.explore_period_cycles {
+            p.explore_period_cycles = v;
+        }
+        if let Some(v) = self.repair_margin_m {
+            p.repair_margin_m = v;
+        }
+        if let Some(v) = self.ranking {
+            p.ranking = Some(v);
+        }
+        if let Some(v) = self.horizon_s {
+            p.horizon_s = v;
+        }
+        if let Some(v) = self.cycle_budget_ms {
+            p.cycle_budget_ms = v;
+        }
+        if let Some(v) = self.enforce_budget {
+            p.enforce_budget = v;
+        }
+        if let Some(v) = self.latency_s {
+            p.latency_s = Some(v);
+        }
+        if let Some(o) = &self.reanchor {
+            o.apply(&mut p.reanchor);
+        }
+        if let Some(v) = self.hysteresis {
+            p.hysteresis = v;
+        }
+        if let Some(o) = &self.safety {
+            o.apply(&mut p.safety);
+        }
+    }
+}
+
+/// `[planner.manager.reanchor]`: fields replacing the preset's `trust_manager::ReanchorParams`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReanchorOverrides {
+    /// Replaces `ReanchorParams::position_m`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub position_m: Option<f64>,
+    /// Replaces `ReanchorParams::velocity_mps`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub velocity_mps: Option<f64>,
+}
+
+impl ReanchorOverrides {
+    /// Writes the given fields onto `p`; the others keep their value.
+    pub fn apply(&self, p: &mut ReanchorParams) {
+        if let Some(v) = self.position_m {
+            p.position_m = v;
+        }
+        if let Some(v) = self.velocity_mps {
+            p.velocity_mps = v;
+        }
+    }
+}
+
+/// `[planner.manager.safety]`: fields replacing the preset's `trust_manager::SafetyParams`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SafetyOverrides {
+    /// Replaces `SafetyParams::max_step_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_step_s: Option<f64>,
+    /// Replaces `SafetyParams::min_step_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min_step_s: Option<f64>,
+    /// Replaces `SafetyParams::static_clearance_m`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub static_clearance_m: Option<f64>,
+    /// Replaces `SafetyParams::dynamic_clearance_m`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dynamic_clearance_m: Option<f64>,
+    /// Replaces `SafetyParams::limit_tolerance`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit_tolerance: Option<f64>,
+    /// Replaces `SafetyParams::braking_tail`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub braking_tail: Option<bool>,
+}
+
+impl SafetyOverrides {
+    /// Writes the given fields onto `p`; the others keep their value.
+    pub fn apply(&self, p: &mut SafetyParams) {
+        if let Some(v) = self.max_step_s {
+            p.max_step_s = v;
+        }
+        if let Some(v) = self.min_step_s {
+            p.min_step_s = v;
+        }
+        if let Some(v) = self.static_clearance_m {
+            p.static_clearance_m = v;
+        }
+        if let Some(v) = self.dynamic_clearance_m {
+            p.dynamic_clearance_m = v;
+        }
+        if let Some(v) = self.limit_tolerance {
+            p.limit_tolerance = v;
+        }
+        if let Some(v) = self.braking_tail {
+            p.braking_tail = v;
+        }
     }
 }
 
@@ -447,7 +626,7 @@ pub struct PlannerSpec {
     pub backend: Option<BackendSpec>,
     /// Replaces the preset's homotopy checker.
     pub checker: Option<CheckerSpec>,
-    /// Merged key by key onto the preset's manager parameters.
+    /// Replaces single fields of the preset's manager parameters.
     pub manager: Option<ManagerOverrides>,
 }
 
@@ -486,12 +665,8 @@ pub struct ResolvedPlanner {
 }
 
 impl PlannerSpec {
-    /// The preset with the overrides applied.
-    ///
-    /// # Errors
-    /// [`WorldError::Input`] if the merged `planner.manager` table is not valid `ManagerParams`
-    /// (it was valid alone, so only a type clash with the preset is possible).
-    pub fn resolve(&self) -> Result<ResolvedPlanner, WorldError> {
+    /// The preset with the overrides applied (typed: [`ManagerOverrides::apply`]).
+    pub fn resolve(&self) -> ResolvedPlanner {
         let (mut frontend, mut backend, mut checker, mut manager) = self.name.parts();
         let mut overridden = Vec::new();
         if let Some(f) = &self.frontend {
@@ -506,10 +681,10 @@ impl PlannerSpec {
             checker = c.clone();
             overridden.push(format!("checker={}", c.kind_name()));
         }
-        if let Some(ManagerOverrides(table)) = &self.manager
-            && !table.is_empty()
+        if let Some(m) = &self.manager
+            && !m.is_empty()
         {
-            manager = merge_manager(&manager, table)?;
+            m.apply(&mut manager);
             overridden.push("manager".to_string());
         }
         let label = if overridden.is_empty() {
@@ -517,7 +692,7 @@ impl PlannerSpec {
         } else {
             format!("{}[{}]", self.name.name(), overridden.join(","))
         };
-        Ok(ResolvedPlanner {
+        ResolvedPlanner {
             label,
             frontend,
             backend,
@@ -525,7 +700,7 @@ impl PlannerSpec {
             manager,
             reproducible: self.reproducible,
             clearance_margin_m: self.clearance_margin_m,
-        })
+        }
     }
 
     /// Every problem with this section: names are checked by serde when the file is read; this
@@ -534,44 +709,14 @@ impl PlannerSpec {
     pub fn problems(&self) -> Vec<Problem> {
         let mut p = Problems::default();
         p.non_negative("planner.clearance_margin_m", self.clearance_margin_m);
-        match self.resolve() {
-            Err(e) => p.list.extend(e.problems()),
-            Ok(r) => {
-                r.frontend.check(&mut p);
-                r.backend.check(&mut p);
-                r.checker.check(&mut p);
-                if let Err(e) = r.manager.validate() {
-                    p.list.push(plan_problem(e, "manager", "planner.manager"));
-                }
-            }
+        let r = self.resolve();
+        r.frontend.check(&mut p);
+        r.backend.check(&mut p);
+        r.checker.check(&mut p);
+        if let Err(e) = r.manager.validate() {
+            p.list.push(plan_problem(e, "manager", "planner.manager"));
         }
         p.list
-    }
-}
-
-/// `preset` with the fields of `table` merged onto it (sub-tables merged recursively).
-fn merge_manager(preset: &ManagerParams, table: &toml::Table) -> Result<ManagerParams, WorldError> {
-    let mut base = toml::Table::try_from(preset).map_err(|e| {
-        WorldError::input("planner.manager", e, "manager parameters that serialize")
-    })?;
-    merge_tables(&mut base, table);
-    ManagerParams::deserialize(toml::Value::Table(base)).map_err(|e| {
-        WorldError::input(
-            "planner.manager",
-            e.message(),
-            "fields of trust_manager::ManagerParams",
-        )
-    })
-}
-
-fn merge_tables(base: &mut toml::Table, over: &toml::Table) {
-    for (k, v) in over {
-        match (base.get_mut(k), v) {
-            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge_tables(b, o),
-            _ => {
-                base.insert(k.clone(), v.clone());
-            }
-        }
     }
 }
 
@@ -714,7 +859,7 @@ mod tests {
         let spec: PlannerSpec =
             toml::from_str("name = \"baseline1\"\n[manager]\nhorizon_s = 3.0\n[manager.safety]\nmax_step_s = 0.02\n")
                 .unwrap();
-        let r = spec.resolve().unwrap();
+        let r = spec.resolve();
         assert_eq!(r.manager.max_branches, 1);
         assert_eq!(r.manager.horizon_s, 3.0);
         assert_eq!(r.manager.safety.max_step_s, 0.02);
@@ -722,5 +867,10 @@ mod tests {
         assert_eq!(r.label, "baseline1[manager]");
         let e = toml::from_str::<PlannerSpec>("[manager]\nbranches = 3\n").unwrap_err();
         assert!(e.to_string().contains("branches"), "{e}");
+        // The planner's seed comes from the trial: overriding it is an error, not a no-op.
+        let e = toml::from_str::<PlannerSpec>("[manager]\nseed = 3\n").unwrap_err();
+        assert!(e.to_string().contains("unknown field `seed`"), "{e}");
+        let e = toml::from_str::<PlannerSpec>("[manager.safety]\nmax_step = 0.1\n").unwrap_err();
+        assert!(e.to_string().contains("max_step"), "{e}");
     }
 }

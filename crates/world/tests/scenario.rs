@@ -54,7 +54,7 @@ fn every_shipped_scenario_validates_and_builds() {
             "{}: describe what it reproduces",
             path.display()
         );
-        let resolved = s.resolve_planner().unwrap();
+        let resolved = s.resolve_planner();
         // The full E4 ESDF (47 M voxels) is built by the release CLI and the world_view example;
         // a debug test builds E4 at 0.5 m voxels (3 M voxels).
         if let Some(PointCloudSpec::Shapes { esdf_voxel_m, .. }) = &mut s.static_map.point_cloud
@@ -191,7 +191,7 @@ fn each_preset_builds_with_the_papers_parts() {
     ];
     for (preset, frontend, branches, history) in expected {
         let s = spec(&format!("name = \"{}\"", preset.name()));
-        let r = s.resolve().unwrap();
+        let r = s.resolve();
         assert_eq!(r.label, preset.name());
         assert_eq!(r.frontend.build().unwrap().name(), frontend);
         assert_eq!(r.backend.build().unwrap().name(), "utf-minco");
@@ -201,7 +201,7 @@ fn each_preset_builds_with_the_papers_parts() {
         assert_eq!(m.params().history, history);
     }
     assert_eq!(
-        spec("name = \"baseline3\"").resolve().unwrap().manager,
+        spec("name = \"baseline3\"").resolve().manager,
         ManagerParams::multi_branch_without_history()
     );
 }
@@ -213,7 +213,7 @@ fn explicit_overrides_replace_parts() {
          backend = { kind = \"minco\" }\nchecker = { kind = \"uvd\", resolution = 0.2 }\n\
          [manager]\nmax_branches = 3\n",
     );
-    let r = s.resolve().unwrap();
+    let r = s.resolve();
     assert_eq!(
         r.label,
         "trust[frontend=v-prm,backend=minco,checker=uvd,manager]"
@@ -236,7 +236,7 @@ fn explicit_overrides_replace_parts() {
 
 #[test]
 fn clearances_follow_the_vehicle_radius_and_reproducibility_removes_budgets() {
-    let r = spec("name = \"trust\"").resolve().unwrap();
+    let r = spec("name = \"trust\"").resolve();
     let ctx = PlannerContext {
         static_map_error_m: 0.17,
         ..ctx(0.45)
@@ -263,8 +263,7 @@ fn clearances_follow_the_vehicle_radius_and_reproducibility_removes_budgets() {
     let r = spec(
         "reproducible = false\nfrontend = { kind = \"dev-prm\", clearance = 1.0, surface_offset = 1.2 }",
     )
-    .resolve()
-    .unwrap();
+    .resolve();
     let e = planner::effective(&r, &ctx).unwrap();
     match &e.frontend {
         FrontendSpec::DevPrm(p) => {
@@ -303,10 +302,10 @@ fn a_fixed_latency_reaches_the_manager() {
                 [mission]\nstart = [1, 10, 5]\ngoal = [19, 10, 5]\n\
                 [sim]\nlatency = { kind = \"fixed\", seconds = 0.03 }\n";
     let s = Scenario::from_toml_str(text, Path::new("latency.toml")).unwrap();
-    assert_eq!(s.resolve_planner().unwrap().manager.latency_s, Some(0.03));
+    assert_eq!(s.resolve_planner().manager.latency_s, Some(0.03));
     let text = format!("{text}[planner.manager]\nlatency_s = 0.01\n");
     let s = Scenario::from_toml_str(&text, Path::new("latency.toml")).unwrap();
-    assert_eq!(s.resolve_planner().unwrap().manager.latency_s, Some(0.01));
+    assert_eq!(s.resolve_planner().manager.latency_s, Some(0.01));
 }
 
 #[test]
@@ -346,7 +345,7 @@ fn plan_once(world: &World, require_main: bool) {
     for preset in PlannerPreset::ALL {
         let mut s = world.scenario().clone();
         s.planner.name = preset;
-        let resolved = s.resolve_planner().unwrap();
+        let resolved = s.resolve_planner();
         let mut manager = planner::build(&resolved, &world.planner_context()).unwrap();
         let report = manager
             .step(

@@ -184,7 +184,7 @@ fn small_generators_are_deterministic_and_match_their_sources() {
     }
     // r_des = |p_s − p_g| − T_h·v_max = 65 − 4·10 = 25 m (Fig. Sim-A-1-1(a)).
     let r_des = (e3.goal() - e3.start()).norm()
-        - e3.scenario().resolve_planner().unwrap().manager.horizon_s * e3.limits().v_max;
+        - e3.scenario().resolve_planner().manager.horizon_s * e3.limits().v_max;
     assert!((r_des - 25.0).abs() < 1e-9);
 }
 

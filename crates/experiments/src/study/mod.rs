@@ -448,7 +448,7 @@ fn run_trial(
             Some(w) => w.with_scenario(&s)?,
             None => World::build(&s)?,
         };
-        let planner_spec = s.resolve_planner()?;
+        let planner_spec = s.resolve_planner();
         let rel = format!("logs/{}/trial-{trial:04}.jsonl", planner.name());
         let log_path = out.join(&rel);
         if let Some(dir) = log_path.parent() {

@@ -62,7 +62,7 @@ impl Variant {
     /// [`ExperimentError::Input`] if the planner section cannot be resolved.
     pub fn apply(&self, scenario: &mut Scenario) -> Result<(), ExperimentError> {
         let planner = &mut scenario.planner;
-        let resolved = planner.resolve()?;
+        let resolved = planner.resolve();
         match *self {
             Variant::None => {}
             Variant::VPrm => {
@@ -114,27 +114,23 @@ impl Variant {
                 }
                 FrontendSpec::VPrm(_) | FrontendSpec::StraightLine(_) => {}
             },
-            Variant::NoHistory => set_manager(planner, "history", toml::Value::Boolean(false)),
-            Variant::NoHysteresis => set_manager(planner, "hysteresis", toml::Value::Float(1.0)),
+            Variant::NoHistory => manager_overrides(planner).history = Some(false),
+            Variant::NoHysteresis => manager_overrides(planner).hysteresis = Some(1.0),
             Variant::Perfect => scenario.vehicle.model = VehicleModel::Perfect,
             Variant::Quadrotor => scenario.vehicle.model = VehicleModel::Quadrotor,
             Variant::Mu(x) => scenario.sensing.ekf.sigma_scale *= x,
             Variant::Fault(x) => scenario.traffic.fault_level = x,
-            Variant::Explore(k) => set_manager(
-                planner,
-                "explore_period_cycles",
-                toml::Value::Integer(i64::try_from(k).unwrap_or(i64::MAX)),
-            ),
+            Variant::Explore(k) => manager_overrides(planner).explore_period_cycles = Some(k),
         }
         Ok(())
     }
 }
 
-fn set_manager(planner: &mut trust_world::planner::PlannerSpec, key: &str, value: toml::Value) {
-    let overrides = planner
-        .manager
-        .get_or_insert_with(trust_world::planner::ManagerOverrides::default);
-    overrides.0.insert(key.to_string(), value);
+/// The scenario's `[planner.manager]` overrides, created empty if absent.
+fn manager_overrides(
+    planner: &mut trust_world::planner::PlannerSpec,
+) -> &mut trust_world::planner::ManagerOverrides {
+    planner.manager.get_or_insert_default()
 }
 
 impl fmt::Display for Variant {
@@ -276,7 +272,7 @@ mod tests {
         let resolved = |v: Variant| {
             let mut s = base.clone();
             v.apply(&mut s).unwrap();
-            (s.planner.resolve().unwrap(), s)
+            (s.planner.resolve(), s)
         };
         let (r, _) = resolved(Variant::VPrm);
         assert!(matches!(r.frontend, FrontendSpec::VPrm(_)));
@@ -302,14 +298,14 @@ mod tests {
             2.0 * base.sensing.ekf.sigma_scale
         );
         let (r, s) = resolved(Variant::None);
-        assert_eq!(r, base.planner.resolve().unwrap());
+        assert_eq!(r, base.planner.resolve());
         assert_eq!(s, base);
         // Baseline 1 has no frontend to ablate: the V-PRM variant leaves it alone.
         let mut b1 = base.clone();
         b1.planner.name = PlannerPreset::Baseline1;
         Variant::VPrm.apply(&mut b1).unwrap();
         assert!(matches!(
-            b1.planner.resolve().unwrap().frontend,
+            b1.planner.resolve().frontend,
             FrontendSpec::StraightLine(_)
         ));
     }

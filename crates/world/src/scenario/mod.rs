@@ -277,16 +277,13 @@ impl Scenario {
     /// The planner with every part chosen ([`PlannerSpec::resolve`]); a fixed `sim.latency`
     /// with `seconds` also sets the manager's `latency_s` unless `[planner.manager]` sets it,
     /// so that the manager plans for the delay the loop applies.
-    ///
-    /// # Errors
-    /// As [`PlannerSpec::resolve`].
-    pub fn resolve_planner(&self) -> Result<ResolvedPlanner, WorldError> {
-        let mut r = self.planner.resolve()?;
+    pub fn resolve_planner(&self) -> ResolvedPlanner {
+        let mut r = self.planner.resolve();
         let manager_sets_latency = self
             .planner
             .manager
             .as_ref()
-            .is_some_and(|m| m.0.contains_key("latency_s"));
+            .is_some_and(|m| m.latency_s.is_some());
         if let Latency::Fixed {
             seconds: Some(seconds),
         } = self.sim.latency
@@ -294,7 +291,7 @@ impl Scenario {
         {
             r.manager.latency_s = Some(seconds);
         }
-        Ok(r)
+        r
     }
 
     /// The scenario as TOML text (round-trips through [`Scenario::from_toml_str`]).
