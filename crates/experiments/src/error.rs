@@ -8,16 +8,6 @@ use trust_world::scenario::Problem;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ExperimentError {
-    /// A study file or a study option is invalid; `problems` holds every problem found.
-    #[error("{}: {} problem{}:\n{}", path.display(), problems.len(),
-        if problems.len() == 1 { "" } else { "s" },
-        problems.iter().map(|p| format!("  - {p}")).collect::<Vec<_>>().join("\n"))]
-    Invalid {
-        /// The file (or `<string>`).
-        path: PathBuf,
-        /// Every problem, in the order the checks ran.
-        problems: Vec<Problem>,
-    },
     /// One invalid input (a field path, its value and what was expected).
     #[error("{0}")]
     Input(Problem),

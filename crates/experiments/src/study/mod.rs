@@ -33,6 +33,7 @@ use serde::{Deserialize, Serialize};
 use crate::ExperimentError;
 use trust_flight::{RunOptions, fly};
 use trust_world::World;
+use trust_world::WorldError;
 use trust_world::planner::PlannerPreset;
 use trust_world::scenario::Scenario;
 
@@ -393,10 +394,11 @@ pub fn run_study(
         let s = config.trial_scenario(&base, 0, p)?;
         let problems = s.validate();
         if !problems.is_empty() {
-            return Err(ExperimentError::Invalid {
+            return Err(WorldError::Invalid {
                 path: s.origin(),
                 problems,
-            });
+            }
+            .into());
         }
     }
     create_dir(out)?;
