@@ -140,7 +140,7 @@ pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, ExperimentEr
                 p0: f.p0.into(),
                 v0: f.v0.into(),
                 radius_m: f.radius(0.0),
-                radius_at_horizon_m: f.radius(manager.params().horizon_s),
+                radius_at_horizon_m: f.radius(resolved.manager.horizon_s),
             })
             .collect(),
         cycle_ms,
@@ -163,7 +163,7 @@ pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, ExperimentEr
             summary.branches.len()
         ),
     );
-    let horizon = manager.params().horizon_s;
+    let horizon = resolved.manager.horizon_s;
     for f in &forecasts {
         let rings: Vec<(Point2<f64>, f64)> = (0..=4)
             .map(|k| {
