@@ -44,7 +44,7 @@ struct Cli {
 enum Cmd {
     /// Fly one scenario and write the run log, summary.json and plots.
     Run {
-        /// The scenario file (see scenarios/ and `cargo doc -p trust-sim`, module `scenario`).
+        /// The scenario file (see scenarios/ and `cargo doc -p trust-world`, module `scenario`).
         scenario: PathBuf,
         /// Planner preset, replacing the scenario's `[planner]` section: trust, baseline1,
         /// baseline2 or baseline3.
