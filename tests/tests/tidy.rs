@@ -58,11 +58,29 @@ fn members() -> Vec<Member> {
         .collect()
 }
 
-/// The allowed internal dependencies of each library crate (design.md §2):
-/// `geometry ← predict ← core ← {lbfgs, minco, topo-prm} ← manager ← sim ← xtask`.
-/// `lbfgs` depends on nothing of ours; `minco` and `topo-prm` never depend on each other; `route`
-/// (the global route, issue 19) sits beside them on `geometry` (and may use `core`).
+/// The allowed internal dependencies of each crate (design.md §2, ARCHITECTURE.md "Dependency
+/// order"): the planning libraries
+/// `geometry ← predict ← core ← {lbfgs, minco, topo-prm} ← manager`, then the simulator along its
+/// data path `{plot, vehicle} ; world ← flight (+ runlog) ← experiments ← sim (the binary)`.
+/// `lbfgs` depends on nothing of ours; `minco` and `topo-prm` never depend on each other; `plot`
+/// knows no simulator or planner type; `runlog` knows none of the simulator's types either (a log is
+/// read without building a world); `vehicle` knows nothing of the planner; `route`
+/// (the global route, issue 19) sits beside `minco`/`topo-prm` on `geometry` (and may use `core`).
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
+    const PLANNING: &[&str] = &[
+        "trust-geometry",
+        "trust-predict",
+        "trust-core",
+        "trust-lbfgs",
+        "trust-minco",
+        "trust-topo-prm",
+        "trust-manager",
+    ];
+    fn with(extra: &[&'static str]) -> &'static [&'static str] {
+        let mut v: Vec<&'static str> = PLANNING.to_vec();
+        v.extend_from_slice(extra);
+        Vec::leak(v)
+    }
     BTreeMap::from([
         ("trust-geometry", &[][..]),
         ("trust-predict", &["trust-geometry"][..]),
@@ -94,7 +112,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
             ][..],
         ),
         (
-            "trust-sim",
+            "trust-fuzz",
             &[
                 "trust-geometry",
                 "trust-predict",
@@ -102,10 +120,54 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-lbfgs",
                 "trust-minco",
                 "trust-topo-prm",
-                "trust-manager",
             ][..],
         ),
+        ("trust-plot", &[][..]),
+        ("trust-runlog", &[][..]),
+        ("trust-vehicle", &["trust-core"][..]),
+        ("trust-world", with(&["trust-vehicle"])),
+        (
+            "trust-flight",
+            with(&["trust-vehicle", "trust-world", "trust-runlog"]),
+        ),
+        (
+            "trust-experiments",
+            with(&[
+                "trust-vehicle",
+                "trust-world",
+                "trust-runlog",
+                "trust-flight",
+                "trust-plot",
+            ]),
+        ),
+        (
+            "trust-sim",
+            with(&[
+                "trust-vehicle",
+                "trust-world",
+                "trust-runlog",
+                "trust-flight",
+                "trust-plot",
+                "trust-experiments",
+            ]),
+        ),
     ])
+}
+
+/// Every workspace member is either in [`allowed`] or one of the automation crates, so that a new
+/// crate cannot escape the layering rules by not being listed.
+#[test]
+fn every_crate_has_a_layer() {
+    let allowed = allowed();
+    let unlisted: Vec<String> = members()
+        .iter()
+        .map(|m| m.name().to_string())
+        .filter(|n| !allowed.contains_key(n.as_str()) && n != "xtask" && n != "trust-tests")
+        .collect();
+    assert!(
+        unlisted.is_empty(),
+        "crates without a place in the dependency order of tidy.rs: {unlisted:?}"
+    );
 }
 
 #[test]
@@ -114,7 +176,7 @@ fn library_crates_respect_the_dependency_direction() {
     let mut violations = Vec::new();
     for m in members() {
         let Some(ok) = allowed.get(m.name()) else {
-            continue; // xtask and the tests crate may use anything.
+            continue; // xtask and the tests crate may use anything (`every_crate_has_a_layer`).
         };
         // Normal and build dependencies define the architecture; dev-dependencies may not break it
         // either (a test of minco must not pull in topo-prm), except that crates may test against
@@ -240,4 +302,129 @@ fn no_todo_or_unimplemented_in_sources() {
         })
         .collect();
     assert!(offenders.is_empty(), "placeholders left in: {offenders:?}");
+}
+
+/// The top-level modules of a crate's `src` and the other top-level modules each names through
+/// `crate::<module>` (comments skipped; the crate root, which declares them all, is not a node).
+fn module_graph(src: &Path) -> BTreeMap<String, std::collections::BTreeSet<String>> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    let mut files = Vec::new();
+    walk(src, &mut files);
+    let mut graph: BTreeMap<String, std::collections::BTreeSet<String>> = BTreeMap::new();
+    let top = |f: &Path| -> Option<String> {
+        let rel = f.strip_prefix(src).ok()?;
+        let first = rel.components().next()?.as_os_str().to_str()?.to_string();
+        let name = first.strip_suffix(".rs").unwrap_or(&first).to_string();
+        (!matches!(name.as_str(), "lib" | "main")).then_some(name)
+    };
+    for f in &files {
+        if let Some(m) = top(f) {
+            graph.entry(m).or_default();
+        }
+    }
+    for f in &files {
+        let Some(m) = top(f) else { continue };
+        let text = std::fs::read_to_string(f).unwrap_or_default();
+        for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {
+            for (i, _) in line.match_indices("crate::") {
+                if i > 0 && line[..i].ends_with(|c: char| c.is_alphanumeric() || c == '_') {
+                    continue; // `trust_crate::` and the like
+                }
+                let name: String = line[i + "crate::".len()..]
+                    .chars()
+                    .take_while(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || *c == '_')
+                    .collect();
+                if name != m && graph.contains_key(&name) {
+                    graph.get_mut(&m).expect("node").insert(name);
+                }
+            }
+        }
+    }
+    graph
+}
+
+/// A module cycle of `graph`, if any (depth-first search).
+fn find_cycle(graph: &BTreeMap<String, std::collections::BTreeSet<String>>) -> Option<Vec<String>> {
+    fn visit(
+        u: &str,
+        graph: &BTreeMap<String, std::collections::BTreeSet<String>>,
+        state: &mut BTreeMap<String, u8>,
+        stack: &mut Vec<String>,
+    ) -> Option<Vec<String>> {
+        state.insert(u.to_string(), 1);
+        stack.push(u.to_string());
+        for v in &graph[u] {
+            match state.get(v) {
+                Some(1) => {
+                    let at = stack.iter().position(|s| s == v).expect("on stack");
+                    let mut cycle = stack[at..].to_vec();
+                    cycle.push(v.clone());
+                    return Some(cycle);
+                }
+                Some(_) => {}
+                None => {
+                    if let Some(c) = visit(v, graph, state, stack) {
+                        return Some(c);
+                    }
+                }
+            }
+        }
+        stack.pop();
+        state.insert(u.to_string(), 2);
+        None
+    }
+    let mut state = BTreeMap::new();
+    for u in graph.keys() {
+        if !state.contains_key(u)
+            && let Some(c) = visit(u, graph, &mut state, &mut Vec::new())
+        {
+            return Some(c);
+        }
+    }
+    None
+}
+
+#[test]
+fn the_cycle_finder_finds_a_cycle() {
+    let g = BTreeMap::from([
+        ("a".to_string(), ["b".to_string()].into()),
+        ("b".to_string(), ["a".to_string()].into()),
+        ("c".to_string(), Default::default()),
+    ]);
+    assert_eq!(
+        find_cycle(&g),
+        Some(vec!["a".into(), "b".into(), "a".into()])
+    );
+    let dag = BTreeMap::from([
+        ("a".to_string(), ["b".to_string()].into()),
+        ("b".to_string(), Default::default()),
+    ]);
+    assert_eq!(find_cycle(&dag), None);
+}
+
+/// No crate's top-level modules import each other in a circle (issue 17: the simulator's
+/// error ↔ scenario ↔ planner ↔ world cycles).
+#[test]
+fn no_module_cycles_inside_a_crate() {
+    let offenders: Vec<String> = members()
+        .iter()
+        .filter_map(|m| {
+            let src = m.dir.join("src");
+            find_cycle(&module_graph(&src)).map(|c| format!("{}: {}", m.name(), c.join(" -> ")))
+        })
+        .collect();
+    assert!(
+        offenders.is_empty(),
+        "module cycles:\n{}",
+        offenders.join("\n")
+    );
 }

@@ -7,7 +7,12 @@
 //! trust-sim ablate [--scenario FILE] [--trials N] [--seed S] [--planners a,b] [--variant V]
 //!                  [--out DIR] [--jobs J] [--shard K/M] [--time-limit T] [--no-plots]
 //! trust-sim ablate-merge --out DIR SHARD_DIR...
+//! trust-sim e3 [--scenario FILE] [--seed S] [--out DIR]
 //! ```
+//!
+//! The binary only parses the command line; the work is in `trust-world` (scenarios, worlds),
+//! `trust-flight` (the closed loop), `trust-runlog` (logs, audit) and `trust-experiments`
+//! (studies, E3, figures).
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -15,14 +20,14 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
-use trust_sim::audit::audit;
-use trust_sim::flight_plots::write_flight_plots;
-use trust_sim::planner::PlannerPreset;
-use trust_sim::run::{RunOptions, fly, header};
-use trust_sim::runlog::RunLog;
-use trust_sim::scenario::{Scenario, VehicleModel};
-use trust_sim::study::{RunStudyOptions, Shard, StudyConfig, merge, run_study};
-use trust_sim::world::World;
+use trust_experiments::flight_plots::write_flight_plots;
+use trust_experiments::study::{RunStudyOptions, Shard, StudyConfig, merge, run_study};
+use trust_flight::{RunOptions, fly, header};
+use trust_runlog::RunLog;
+use trust_runlog::audit::audit;
+use trust_world::World;
+use trust_world::planner::PlannerPreset;
+use trust_world::scenario::{Scenario, VehicleModel};
 
 #[derive(Parser)]
 #[command(
@@ -39,7 +44,7 @@ struct Cli {
 enum Cmd {
     /// Fly one scenario and write the run log, summary.json and plots.
     Run {
-        /// The scenario file (see scenarios/ and `cargo doc -p trust-sim`, module `scenario`).
+        /// The scenario file (see scenarios/ and `cargo doc -p trust-world`, module `scenario`).
         scenario: PathBuf,
         /// Planner preset, replacing the scenario's `[planner]` section: trust, baseline1,
         /// baseline2 or baseline3.
@@ -92,7 +97,8 @@ enum Cmd {
         )]
         planners: Vec<String>,
         /// One-component ablation applied to every planner it concerns: none, vprm, minco, uvd,
-        /// no-pdc, no-ggs, no-history, no-hysteresis, perfect, quadrotor, mu=X, fault=X.
+        /// no-pdc, no-ggs, no-history, no-hysteresis, perfect, quadrotor, mu=X, fault=X,
+        /// explore=K.
         #[arg(long, default_value = "none")]
         variant: String,
         /// Output directory.
@@ -175,7 +181,8 @@ fn run_cli() -> Result<ExitCode> {
             zero_timing,
             no_plots,
         } => {
-            let mut s = Scenario::load(&scenario)?;
+            // Checked once, with the overrides applied, where the world is built (`run`).
+            let mut s = Scenario::parse_file(&scenario)?;
             if let Some(name) = planner {
                 s.planner.name = parse_preset(&name)?;
                 s.planner.frontend = None;
@@ -250,12 +257,13 @@ fn run_cli() -> Result<ExitCode> {
             seed,
             out,
         } => {
-            let mut s = Scenario::load(&scenario)?;
+            // Checked once, where `run_e3` builds the world.
+            let mut s = Scenario::parse_file(&scenario)?;
             if let Some(seed) = seed {
                 s = s.with_seed(seed);
             }
-            let summary = trust_sim::e3::run_e3(&s, &out)?;
-            println!("{}", trust_sim::e3::report_md(&summary));
+            let summary = trust_experiments::e3::run_e3(&s, &out)?;
+            println!("{}", trust_experiments::e3::report_md(&summary));
             println!("wrote {}", out.display());
             Ok(ExitCode::SUCCESS)
         }
@@ -270,7 +278,7 @@ fn run_cli() -> Result<ExitCode> {
         Cmd::Validate { scenarios } => {
             let mut bad = 0;
             for path in &scenarios {
-                match Scenario::load(path) {
+                match trust_world::load_checked(path) {
                     Ok(_) => println!("{}: ok", path.display()),
                     Err(e) => {
                         bad += 1;
@@ -338,7 +346,7 @@ fn run(s: &Scenario, out: &Path, zero_timing: bool, plots: bool) -> Result<ExitC
     let tty = std::io::stderr().is_terminal();
     eprintln!("building the world of `{}` (seed {})...", s.name, s.seed);
     let world = World::build(s)?;
-    let planner = s.resolve_planner()?;
+    let planner = s.resolve_planner();
     let log_path = out.join("run.jsonl");
     let options = RunOptions {
         log_path: Some(log_path.clone()),

@@ -1,0 +1,572 @@
+//! # trust-flight — the closed loop: one flight of one planner through one world, written as a run log
+//!
+//! The simulator's middle stage (paper Sec. IV-D): it takes a [`World`] built by `trust-world`,
+//! assembles the planner the scenario names ([`trust_world::planner::build`]), flies it and writes
+//! the run log of `trust-runlog`. Use [`fly`] for one flight; studies and experiments
+//! (`trust-experiments`) call it once per trial and planner.
+//!
+//!
+//! Every `physics_dt_s` the true obstacles move ([`trust_world::traffic::Traffic`]) and the vehicle
+//! integrates its dynamics toward the committed plan ([`trust_vehicle::Vehicle`]); at the sensor
+//! rate the obstacles are measured with noise and dropouts into the trackers
+//! ([`trust_world::sensing::Sensing`]); at the replanning rate the manager plans from the measured
+//! vehicle state and the trackers' forecasts — never from the true obstacles — and the new plan
+//! takes effect after the latency (fixed, or the cycle's measured wall time). After every physics
+//! step the true vehicle sphere is checked against the true static geometry and the true
+//! obstacles; the flight ends when it collides, arrives within the goal tolerance, or runs out of
+//! time.
+//!
+//! The run log ([`trust_runlog`]) holds a `state` record at the log rate and at the last instant
+//! (so a collision or arrival between two log ticks is in the log), a `cycle` record per planning
+//! cycle, and the `outcome`, whose figures are computed from the logged states exactly as the
+//! contract defines them.
+#![warn(missing_docs)]
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+use trust_core::{PolyTraj, Scene, Vec3};
+use trust_manager::{Event, Hit, StepReport};
+
+use trust_world::World;
+use trust_world::planner::{self, ResolvedPlanner};
+use trust_world::scenario::{Latency, ShapeSpec, VehicleModel};
+use trust_world::traffic::MovingShape;
+
+mod error;
+pub use error::FlightError;
+use trust_runlog::{
+    Bounds, CycleRecord, Dropped, Header, LimitsInfo, LogWriter, ObstacleInfo, ObstacleKind,
+    Outcome, Record, SCHEMA, StateRecord, StaticShape, Status, VehicleInfo,
+};
+use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle};
+
+/// Stand-in for "no obstacle of this kind" in the outcome's clearances (JSON has no infinity).
+pub const NO_OBSTACLE_CLEARANCE_M: f64 = 1e9;
+
+/// How to run a flight.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RunOptions {
+    /// Write the run log here (`None`: keep nothing on disk; the summary is still returned).
+    pub log_path: Option<PathBuf>,
+    /// Write zeros instead of measured times in the log's `cycle` records, so that two runs with
+    /// the same seed give byte-identical logs (the timing fields are the only machine-dependent
+    /// part of a log with a fixed latency).
+    pub zero_timing: bool,
+    /// Report progress (simulated seconds) to this callback every simulated second.
+    pub progress_every_s: Option<f64>,
+}
+
+/// What one flight did: the outcome and statistics of its planning cycles.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// Scenario name.
+    pub scenario: String,
+    /// Planner label.
+    pub planner: String,
+    /// Trial seed.
+    pub seed: u64,
+    /// The outcome record.
+    pub outcome: Outcome,
+    /// Planning cycles.
+    pub cycle_count: usize,
+    /// Median and 99th percentile of the cycle wall time (ms).
+    pub cycle_ms_median: f64,
+    /// See `cycle_ms_median`.
+    pub cycle_ms_p99: f64,
+    /// Mean solve time per optimized trajectory (ms).
+    pub solve_ms_per_trajectory: f64,
+    /// Mean CPU time per optimized trajectory, frontend and checks included (ms): the paper's
+    /// "CPU time per trajectory".
+    pub cpu_ms_per_trajectory: f64,
+    /// Trajectories optimized in the whole flight.
+    pub trajectory_count: usize,
+    /// Cycles that ended in a braking fallback.
+    pub fallback_count: usize,
+    /// Fallbacks that were not collision-free under the forecasts.
+    pub unsafe_fallback_count: usize,
+    /// Main-branch switches.
+    pub switch_count: usize,
+    /// Re-anchorings on the measured state.
+    pub reanchor_count: usize,
+    /// Wall-clock time of the whole flight, simulation included (s).
+    pub wall_s: f64,
+    /// Simulated seconds per wall-clock second.
+    pub real_time_factor: f64,
+    /// The run log, if written.
+    pub log_path: Option<PathBuf>,
+}
+
+/// Everything kept in memory about a flight for plots and reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlightRecord {
+    /// The logged states.
+    pub states: Vec<StateRecord>,
+    /// The cycle records.
+    pub cycles: Vec<CycleRecord>,
+    /// Static clearance at each logged state (m).
+    pub static_clearance: Vec<f64>,
+    /// Dynamic clearance at each logged state (m).
+    pub dynamic_clearance: Vec<f64>,
+    /// The committed plan at a few instants (every second), for plots.
+    pub plans: Vec<PolyTraj>,
+}
+
+/// The result of [`fly`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Flight {
+    /// The summary.
+    pub summary: RunSummary,
+    /// The in-memory record.
+    pub record: FlightRecord,
+}
+
+fn v3(v: &Vec3) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}
+
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return 0.0;
+    }
+    let pos = q * (sorted.len() - 1) as f64;
+    let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
+    sorted[lo] + (sorted[hi] - sorted[lo]) * (pos - lo as f64)
+}
+
+/// The run-log header for a flight of `planner_label` through `world`; `points_file` is the
+/// header's `static_points_file` (relative to the log's folder).
+pub fn header(world: &World, planner_label: &str, points_file: Option<String>) -> Header {
+    let s = world.scenario();
+    let b = world.bounds();
+    Header {
+        schema: SCHEMA.to_string(),
+        scenario: s.name.clone(),
+        seed: s.seed,
+        planner: planner_label.to_string(),
+        bounds: Bounds {
+            min: v3(&b.min),
+            max: v3(&b.max),
+        },
+        vehicle: VehicleInfo {
+            radius: world.vehicle_radius_m(),
+            model: Some(
+                match s.vehicle.model {
+                    VehicleModel::Quadrotor => "se3-quadrotor",
+                    VehicleModel::Perfect => "perfect-tracking",
+                }
+                .to_string(),
+            ),
+        },
+        limits: LimitsInfo {
+            v_max: world.limits().v_max,
+            a_max: world.limits().a_max,
+        },
+        start: v3(&world.start()),
+        goal: v3(&world.goal()),
+        goal_tolerance: s.mission.goal_tolerance_m,
+        static_shapes: world
+            .static_shape_specs()
+            .iter()
+            .map(|spec| match *spec {
+                ShapeSpec::Sphere { center, radius } => StaticShape::Sphere { center, radius },
+                ShapeSpec::Cylinder {
+                    center,
+                    radius,
+                    z_min,
+                    z_max,
+                } => StaticShape::Cylinder {
+                    center,
+                    radius,
+                    z_min,
+                    z_max,
+                },
+                ShapeSpec::Box { min, max } => StaticShape::Box { min, max },
+            })
+            .collect(),
+        static_points_file: points_file,
+        obstacles: world
+            .obstacles()
+            .iter()
+            .enumerate()
+            .map(|(id, o)| match o.shape {
+                MovingShape::Sphere { radius } => ObstacleInfo {
+                    id,
+                    shape: ObstacleKind::Sphere,
+                    radius,
+                    half_height: None,
+                },
+                MovingShape::Cylinder {
+                    radius,
+                    half_height,
+                } => ObstacleInfo {
+                    id,
+                    shape: ObstacleKind::Cylinder,
+                    radius,
+                    half_height: Some(half_height),
+                },
+            })
+            .collect(),
+        sim: serde_json::to_value(&s.sim).ok(),
+    }
+}
+
+/// The logged figures of a flight, accumulated state by state (the contract's definitions).
+#[derive(Debug, Clone)]
+struct Tally {
+    min_static: f64,
+    min_dynamic: f64,
+    max_speed: f64,
+    max_accel: f64,
+    path_length: f64,
+    last_p: Option<Vec3>,
+}
+
+impl Tally {
+    fn new() -> Self {
+        Tally {
+            min_static: f64::INFINITY,
+            min_dynamic: f64::INFINITY,
+            max_speed: 0.0,
+            max_accel: 0.0,
+            path_length: 0.0,
+            last_p: None,
+        }
+    }
+
+    fn add(&mut self, p: &Vec3, v: &Vec3, a: &Vec3, static_c: f64, dynamic_c: f64) {
+        self.min_static = self.min_static.min(static_c);
+        self.min_dynamic = self.min_dynamic.min(dynamic_c);
+        self.max_speed = self.max_speed.max(v.norm());
+        self.max_accel = self.max_accel.max(a.norm());
+        if let Some(q) = self.last_p {
+            self.path_length += (p - q).norm();
+        }
+        self.last_p = Some(*p);
+    }
+}
+
+fn finite_or_stand_in(x: f64) -> f64 {
+    if x.is_finite() {
+        x
+    } else {
+        NO_OBSTACLE_CLEARANCE_M
+    }
+}
+
+/// Flies `planner` through `world` once (see the module docs).
+///
+/// # Errors
+/// [`FlightError`] for a world or planner that cannot be set up, or a log that cannot be written.
+/// A planner that rejects its input mid-flight is not an error: the outcome is `invalid` with
+/// the reason.
+pub fn fly(
+    world: &World,
+    planner: &ResolvedPlanner,
+    options: &RunOptions,
+    mut progress: impl FnMut(f64),
+) -> Result<Flight, FlightError> {
+    let wall_start = Instant::now();
+    let scenario = world.scenario();
+    let sim = &scenario.sim;
+    let dt = sim.physics_dt_s;
+    let steps_per = |rate_hz: f64| ((1.0 / rate_hz) / dt).round().max(1.0) as u64;
+    let replan_steps = steps_per(sim.replan_rate_hz);
+    let log_steps = steps_per(sim.log_rate_hz);
+    let max_steps = (scenario.time_limit_s / dt).ceil() as u64;
+    let radius = world.vehicle_radius_m();
+    let (start, goal) = (world.start(), world.goal());
+    let tolerance = scenario.mission.goal_tolerance_m;
+
+    let mut traffic = world.traffic()?;
+    let mut sensing = world.sensing()?;
+    let mut manager = planner::build(planner, &world.planner_context())?;
+    let hover = Reference::hover(start);
+    let mut vehicle: Box<dyn Vehicle> = match scenario.vehicle.model {
+        VehicleModel::Quadrotor => Box::new(ControlledQuadrotor::starting_on(
+            scenario.vehicle.quadrotor,
+            scenario.vehicle.gains,
+            0.0,
+            &hover,
+        )?),
+        VehicleModel::Perfect => Box::new(PerfectTracking::new(0.0, &hover)?),
+    };
+    let fixed_latency = match sim.latency {
+        Latency::Fixed { seconds } => Some(seconds.unwrap_or(planner.manager.latency())),
+        Latency::Measured {} => None,
+    };
+
+    let writer = match &options.log_path {
+        Some(path) => {
+            let points_file = match world.static_points_file() {
+                Some(src) => {
+                    let dir = path.parent().unwrap_or(Path::new("."));
+                    let name = "static_points.xyz";
+                    std::fs::copy(src, dir.join(name)).map_err(|source| FlightError::Write {
+                        path: dir.join(name),
+                        source,
+                    })?;
+                    Some(name.to_string())
+                }
+                None => None,
+            };
+            let mut w = LogWriter::create(path)?;
+            w.write(&Record::Header(header(world, &planner.label, points_file)))?;
+            Some(w)
+        }
+        None => None,
+    };
+
+    let mut log = Logger {
+        writer,
+        record: FlightRecord {
+            states: Vec::new(),
+            cycles: Vec::new(),
+            static_clearance: Vec::new(),
+            dynamic_clearance: Vec::new(),
+            plans: Vec::new(),
+        },
+        tally: Tally::new(),
+    };
+
+    let clearances = |p: &Vec3, traffic: &trust_world::traffic::Traffic| {
+        let static_c = world.true_static_clearance(p) - radius;
+        let (d, id) = traffic.clearance(p);
+        (static_c, d - radius, id)
+    };
+
+    // t = 0.
+    sensing.update(0.0, traffic.positions())?;
+    {
+        let (sc, dc, _) = clearances(&vehicle.state().p, &traffic);
+        log.state(0.0, vehicle.as_ref(), traffic.positions(), sc, dc)?;
+    }
+
+    let mut active: Option<PolyTraj> = None;
+    let mut pending: Option<(f64, PolyTraj)> = None;
+    let mut cycle_walls = Vec::new();
+    let (mut solve_ms, mut cpu_ms, mut trajectories) = (0.0, 0.0, 0usize);
+    let (mut fallbacks, mut unsafe_fallbacks, mut switches, mut reanchors) = (0, 0, 0, 0);
+    let mut ended: Option<(Status, Option<String>, Option<String>)> = None;
+    let mut next_progress = options.progress_every_s.unwrap_or(f64::INFINITY);
+    let mut next_plan_snapshot = 0.0;
+    let mut step = 0u64;
+    let mut t = 0.0;
+    while ended.is_none() {
+        // Plan.
+        if step.is_multiple_of(replan_steps) {
+            let forecasts = sensing.forecasts(t)?;
+            let scene = Scene::new(world.planner_map(), &forecasts, t)?;
+            let measured = vehicle.state().kinematic();
+            let cycle_start = Instant::now();
+            match manager.step(t, &measured, &goal, &scene) {
+                Ok(report) => {
+                    let wall = cycle_start.elapsed().as_secs_f64();
+                    let latency = fixed_latency.unwrap_or(wall);
+                    let effective = t + (latency / dt).ceil() * dt;
+                    if let Some(plan) = manager.plan() {
+                        pending = Some((effective, plan.clone()));
+                        if t >= next_plan_snapshot {
+                            log.record.plans.push(plan.clone());
+                            next_plan_snapshot = t + 1.0;
+                        }
+                    }
+                    cycle_walls.push(report.timing.wall_ms);
+                    solve_ms += report.timing.backend_ms;
+                    cpu_ms += report.timing.frontend_ms
+                        + report.timing.backend_ms
+                        + report.timing.checker_ms;
+                    trajectories += report.timing.solve_count;
+                    if let Some(f) = &report.fallback {
+                        fallbacks += 1;
+                        if !f.collision_free {
+                            unsafe_fallbacks += 1;
+                        }
+                    }
+                    switches += usize::from(report.switched());
+                    reanchors += report
+                        .events
+                        .iter()
+                        .filter(|e| matches!(e, trust_manager::Event::Reanchored { .. }))
+                        .count();
+                    log.cycle(cycle_record(&report, effective, options.zero_timing))?;
+                }
+                Err(e) => {
+                    ended = Some((Status::Invalid, None, Some(e.to_string())));
+                    break;
+                }
+            }
+        }
+        if let Some((te, _)) = &pending
+            && t + 0.5 * dt >= *te
+        {
+            active = pending.take().map(|(_, p)| p);
+        }
+
+        // Physics.
+        let reference = |tau: f64| match &active {
+            Some(plan) => Reference::from_traj(plan, tau, 0.0),
+            None => hover,
+        };
+        vehicle.step(dt, &reference)?;
+        traffic.step(dt)?;
+        step += 1;
+        t = step as f64 * dt;
+
+        // Checks.
+        let p = vehicle.state().p;
+        let (sc, dc, id) = clearances(&p, &traffic);
+        if sc < 0.0 || dc < 0.0 {
+            let with = if sc <= dc {
+                "static".to_string()
+            } else {
+                format!("obstacle:{}", id.unwrap_or(0))
+            };
+            ended = Some((Status::Collided, Some(with), None));
+        } else if (p - goal).norm() <= tolerance {
+            ended = Some((Status::Arrived, None, None));
+        } else if step >= max_steps {
+            ended = Some((Status::TimedOut, None, None));
+        }
+        if ended.is_some() || step.is_multiple_of(log_steps) {
+            log.state(t, vehicle.as_ref(), traffic.positions(), sc, dc)?;
+        }
+        sensing.update(t, traffic.positions())?;
+        if t >= next_progress {
+            progress(t);
+            next_progress += options.progress_every_s.unwrap_or(f64::INFINITY);
+        }
+    }
+
+    let Logger {
+        writer,
+        record,
+        tally,
+    } = log;
+    let (status, with, reason) = ended.unwrap_or((Status::Invalid, None, None));
+    let outcome = Outcome {
+        status,
+        t,
+        flight_time_s: t,
+        path_length_m: tally.path_length,
+        min_clearance_static_m: finite_or_stand_in(tally.min_static),
+        min_clearance_dynamic_m: finite_or_stand_in(tally.min_dynamic),
+        max_speed: tally.max_speed,
+        max_accel: tally.max_accel,
+        with,
+        reason,
+        cycle_count: record.cycles.len(),
+    };
+    if let Some(mut w) = writer {
+        w.write(&Record::Outcome(outcome.clone()))?;
+        w.finish()?;
+    }
+    let mut walls = cycle_walls;
+    walls.sort_by(f64::total_cmp);
+    let wall_s = wall_start.elapsed().as_secs_f64();
+    let summary = RunSummary {
+        scenario: scenario.name.clone(),
+        planner: planner.label.clone(),
+        seed: scenario.seed,
+        cycle_count: record.cycles.len(),
+        cycle_ms_median: quantile(&walls, 0.5),
+        cycle_ms_p99: quantile(&walls, 0.99),
+        solve_ms_per_trajectory: solve_ms / trajectories.max(1) as f64,
+        cpu_ms_per_trajectory: cpu_ms / trajectories.max(1) as f64,
+        trajectory_count: trajectories,
+        fallback_count: fallbacks,
+        unsafe_fallback_count: unsafe_fallbacks,
+        switch_count: switches,
+        reanchor_count: reanchors,
+        wall_s,
+        real_time_factor: outcome.t / wall_s.max(1e-9),
+        log_path: options.log_path.clone(),
+        outcome,
+    };
+    Ok(Flight { summary, record })
+}
+
+/// The run log being written and the in-memory record of the flight.
+struct Logger {
+    writer: Option<LogWriter>,
+    record: FlightRecord,
+    tally: Tally,
+}
+
+impl Logger {
+    fn state(
+        &mut self,
+        t: f64,
+        vehicle: &dyn Vehicle,
+        positions: &[Vec3],
+        static_c: f64,
+        dynamic_c: f64,
+    ) -> Result<(), FlightError> {
+        let s = vehicle.state();
+        let rec = StateRecord {
+            t,
+            p: v3(&s.p),
+            v: v3(&s.v),
+            a: v3(&s.a),
+            obstacles: positions.iter().map(v3).collect(),
+        };
+        self.tally.add(&s.p, &s.v, &s.a, static_c, dynamic_c);
+        if let Some(w) = self.writer.as_mut() {
+            w.write(&Record::State(rec.clone()))?;
+        }
+        self.record.states.push(rec);
+        self.record.static_clearance.push(static_c);
+        self.record.dynamic_clearance.push(dynamic_c);
+        Ok(())
+    }
+
+    fn cycle(&mut self, rec: CycleRecord) -> Result<(), FlightError> {
+        if let Some(w) = self.writer.as_mut() {
+            w.write(&Record::Cycle(rec.clone()))?;
+        }
+        self.record.cycles.push(rec);
+        Ok(())
+    }
+}
+
+fn cycle_record(report: &StepReport, effective_t: f64, zero_timing: bool) -> CycleRecord {
+    let time = |x: f64| if zero_timing { 0.0 } else { x };
+    CycleRecord {
+        t: report.t,
+        wall_ms: time(report.timing.wall_ms),
+        main: report.main,
+        branches: report.branches.len(),
+        events: report.event_tags().iter().map(|s| s.to_string()).collect(),
+        frontend_ms: time(report.timing.frontend_ms),
+        backend_ms: time(report.timing.backend_ms),
+        checker_ms: time(report.timing.checker_ms),
+        solve_count: report.timing.solve_count,
+        effective_t,
+        branch_j: report.branches.iter().map(|b| b.j).collect(),
+        fallback_collision_free: report.fallback.as_ref().map(|f| f.collision_free),
+        dropped: dropped(report),
+    }
+}
+
+/// Counts the cycle's safety drops by cause.
+fn dropped(report: &StepReport) -> Dropped {
+    let mut out = Dropped::default();
+    for event in &report.events {
+        if let Event::DroppedCollision {
+            violation,
+            braking_tail,
+            ..
+        } = event
+        {
+            out.braking_tail += usize::from(*braking_tail);
+            match violation.map(|v| v.with) {
+                Some(Hit::Static) => out.static_map += 1,
+                Some(Hit::Obstacle(_)) => out.moving += 1,
+                Some(Hit::Bounds) => out.bounds += 1,
+                None => out.limits += 1,
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,697 @@
+//! # trust-runlog — run logs of the closed loop: JSON Lines following `shared/contracts/run-log-v1.md` (schema `trust-sim-log/1`),
+//! documented in full in `docs/run-log.md`.
+//!
+//! One object per line, each with a `"type"`: a `header` first, `state` records of the true vehicle
+//! and obstacles at ≥ 50 Hz, one `cycle` record per planning cycle, and an `outcome` last. The
+//! contract's fields are never dropped or renamed; this module adds fields (marked "added" in their
+//! docs) and nothing else.
+//!
+//! [`LogWriter`] writes a log line by line (buffered); [`RunLog::read`] reads one back and checks its
+//! structure. Numbers are written in the shortest form that reads back to the same `f64`, and the
+//! writer refuses non-finite numbers (a non-finite value is a bug, not data).
+#![warn(missing_docs)]
+
+pub mod audit;
+
+use std::fs::File;
+use std::io::{BufRead, BufReader, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+/// The schema tag of this version.
+pub const SCHEMA: &str = "trust-sim-log/1";
+
+/// Map bounds.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bounds {
+    /// Lower corner.
+    pub min: [f64; 3],
+    /// Upper corner.
+    pub max: [f64; 3],
+}
+
+/// The vehicle as the log knows it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VehicleInfo {
+    /// Collision radius (m).
+    pub radius: f64,
+    /// Added: `"se3-quadrotor"` or `"perfect-tracking"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
+}
+
+/// Dynamic limits.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LimitsInfo {
+    /// Maximum speed (m/s).
+    pub v_max: f64,
+    /// Maximum acceleration (m/s²).
+    pub a_max: f64,
+}
+
+/// A true static obstacle, externally tagged as in the contract:
+/// `{"sphere": {...}}`, `{"cylinder": {...}}`, `{"box": {...}}`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StaticShape {
+    /// A ball.
+    Sphere {
+        /// Centre.
+        center: [f64; 3],
+        /// Radius.
+        radius: f64,
+    },
+    /// A vertical cylinder: axis through `center` (x, y) from `z_min` to `z_max`.
+    Cylinder {
+        /// Axis position (x, y).
+        center: [f64; 2],
+        /// Radius.
+        radius: f64,
+        /// Bottom.
+        z_min: f64,
+        /// Top.
+        z_max: f64,
+    },
+    /// An axis-aligned box.
+    Box {
+        /// Lower corner.
+        min: [f64; 3],
+        /// Upper corner.
+        max: [f64; 3],
+    },
+}
+
+/// A moving obstacle's identity and true size.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ObstacleInfo {
+    /// Index in every `state` record's `obstacles`.
+    pub id: usize,
+    /// `"sphere"` or `"cylinder"`.
+    pub shape: ObstacleKind,
+    /// Radius (m).
+    pub radius: f64,
+    /// Half of the height (cylinders only; centre at mid-height).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_height: Option<f64>,
+}
+
+/// Shape of a moving obstacle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ObstacleKind {
+    /// A ball.
+    Sphere,
+    /// A vertical cylinder.
+    Cylinder,
+}
+
+/// The first line.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Header {
+    /// Always [`SCHEMA`].
+    pub schema: String,
+    /// Scenario name.
+    pub scenario: String,
+    /// Trial seed.
+    pub seed: u64,
+    /// Planner name.
+    pub planner: String,
+    /// Map bounds.
+    pub bounds: Bounds,
+    /// The vehicle.
+    pub vehicle: VehicleInfo,
+    /// Its limits.
+    pub limits: LimitsInfo,
+    /// Start position.
+    pub start: [f64; 3],
+    /// Goal position.
+    pub goal: [f64; 3],
+    /// Arrival tolerance (m).
+    pub goal_tolerance: f64,
+    /// The true static geometry.
+    pub static_shapes: Vec<StaticShape>,
+    /// A file of `x y z` lines (relative to the log's folder) when the static truth is a point cloud
+    /// without generating shapes; `null` otherwise.
+    pub static_points_file: Option<String>,
+    /// Every moving obstacle with its true size.
+    pub obstacles: Vec<ObstacleInfo>,
+    /// Added: the simulation's settings (physics step, rates, latency model, vehicle model).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sim: Option<serde_json::Value>,
+}
+
+/// The true state at one instant.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StateRecord {
+    /// Time (s).
+    pub t: f64,
+    /// Position.
+    pub p: [f64; 3],
+    /// Velocity.
+    pub v: [f64; 3],
+    /// Acceleration.
+    pub a: [f64; 3],
+    /// True obstacle centres, in header order.
+    pub obstacles: Vec<[f64; 3]>,
+}
+
+/// One planning cycle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CycleRecord {
+    /// Time of the cycle (s).
+    pub t: f64,
+    /// Wall-clock time of the cycle (ms).
+    pub wall_ms: f64,
+    /// Main branch id (`null` while braking).
+    pub main: Option<u64>,
+    /// Number of kept branches.
+    pub branches: usize,
+    /// Event tags.
+    pub events: Vec<String>,
+    /// Added: frontend time (ms).
+    #[serde(default)]
+    pub frontend_ms: f64,
+    /// Added: summed solve time (ms).
+    #[serde(default)]
+    pub backend_ms: f64,
+    /// Added: summed check time (ms).
+    #[serde(default)]
+    pub checker_ms: f64,
+    /// Added: trajectories optimized this cycle.
+    #[serde(default)]
+    pub solve_count: usize,
+    /// Added: the time the new plan took effect (s).
+    #[serde(default)]
+    pub effective_t: f64,
+    /// Added: `J` of the kept branches, in rank order.
+    #[serde(default)]
+    pub branch_j: Vec<f64>,
+    /// Added: whether the plan is a braking fallback, and whether it was collision-free.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback_collision_free: Option<bool>,
+    /// Added: what the safety check dropped this cycle, by the first violation's cause.
+    #[serde(default, skip_serializing_if = "Dropped::is_empty")]
+    pub dropped: Dropped,
+}
+
+/// Trajectories the safety check dropped in one cycle, by cause of the first violation.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Dropped {
+    /// Too close to the static map.
+    pub static_map: usize,
+    /// Too close to a moving obstacle's forecast.
+    pub moving: usize,
+    /// Left the map bounds.
+    pub bounds: usize,
+    /// Only the speed or acceleration limit was exceeded.
+    pub limits: usize,
+    /// Of the above, those whose trajectory was clear and only the braking after its end was
+    /// not (`trust_manager::SafetyParams::braking_tail`).
+    #[serde(default)]
+    pub braking_tail: usize,
+}
+
+impl Dropped {
+    /// Nothing was dropped.
+    pub fn is_empty(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
+/// How a flight ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// Within the goal tolerance, no collision before.
+    Arrived,
+    /// A clearance below zero.
+    Collided,
+    /// The time limit passed.
+    TimedOut,
+    /// The run could not be carried out as specified (e.g. the planner rejected the input).
+    Invalid,
+}
+
+impl Status {
+    /// The contract's spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Arrived => "arrived",
+            Status::Collided => "collided",
+            Status::TimedOut => "timed_out",
+            Status::Invalid => "invalid",
+        }
+    }
+}
+
+/// The last line.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Outcome {
+    /// How it ended.
+    pub status: Status,
+    /// Time of the end (s).
+    pub t: f64,
+    /// `t` minus the first state's time (s).
+    pub flight_time_s: f64,
+    /// Sum of the distances between consecutive logged positions (m).
+    pub path_length_m: f64,
+    /// Smallest static clearance over the state records (m; `null`/absent without static geometry).
+    pub min_clearance_static_m: f64,
+    /// Smallest clearance to a moving obstacle over the state records (m).
+    pub min_clearance_dynamic_m: f64,
+    /// Largest `|v|` over the state records.
+    pub max_speed: f64,
+    /// Largest `|a|` over the state records.
+    pub max_accel: f64,
+    /// For `collided`: `"static"` or `"obstacle:<id>"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub with: Option<String>,
+    /// Added: why the run is `invalid`, or other notes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// Added: planning cycles run.
+    #[serde(default)]
+    pub cycle_count: usize,
+}
+
+/// One line of a run log.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Record {
+    /// First line.
+    Header(Header),
+    /// True state.
+    State(StateRecord),
+    /// Planning cycle.
+    Cycle(CycleRecord),
+    /// Last line.
+    Outcome(Outcome),
+}
+
+/// Errors of reading and writing logs.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum LogError {
+    /// File-system error.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A line is not a valid record.
+    #[error("{path}:{line}: {message}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// The records do not follow the contract's structure.
+    #[error("{path}: {message}")]
+    Structure {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A record to write holds a non-finite number.
+    #[error("refusing to write a non-finite number in a `{record}` record: {detail}")]
+    NonFinite {
+        /// The record type.
+        record: &'static str,
+        /// Which value.
+        detail: String,
+    },
+}
+
+/// Writes a run log line by line.
+#[derive(Debug)]
+pub struct LogWriter {
+    path: PathBuf,
+    out: BufWriter<File>,
+    line: String,
+}
+
+impl LogWriter {
+    /// Creates (truncates) the file.
+    ///
+    /// # Errors
+    /// [`LogError::Io`].
+    pub fn create(path: &Path) -> Result<Self, LogError> {
+        let file = File::create(path).map_err(|source| LogError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(LogWriter {
+            path: path.to_path_buf(),
+            out: BufWriter::new(file),
+            line: String::new(),
+        })
+    }
+
+    /// The file being written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Writes one record as one line.
+    ///
+    /// # Errors
+    /// [`LogError::NonFinite`] (nothing is written) or [`LogError::Io`].
+    pub fn write(&mut self, record: &Record) -> Result<(), LogError> {
+        check_finite(record)?;
+        self.line.clear();
+        let json = serde_json::to_string(record).map_err(|e| LogError::NonFinite {
+            record: record_type(record),
+            detail: e.to_string(),
+        })?;
+        self.line.push_str(&json);
+        self.line.push('\n');
+        self.out
+            .write_all(self.line.as_bytes())
+            .map_err(|source| LogError::Io {
+                path: self.path.clone(),
+                source,
+            })
+    }
+
+    /// Flushes and closes the file.
+    ///
+    /// # Errors
+    /// [`LogError::Io`].
+    pub fn finish(mut self) -> Result<(), LogError> {
+        self.out.flush().map_err(|source| LogError::Io {
+            path: self.path.clone(),
+            source,
+        })
+    }
+}
+
+fn record_type(r: &Record) -> &'static str {
+    match r {
+        Record::Header(_) => "header",
+        Record::State(_) => "state",
+        Record::Cycle(_) => "cycle",
+        Record::Outcome(_) => "outcome",
+    }
+}
+
+fn check_finite(record: &Record) -> Result<(), LogError> {
+    let bad = |detail: String| {
+        Err(LogError::NonFinite {
+            record: record_type(record),
+            detail,
+        })
+    };
+    let all = |xs: &[f64]| xs.iter().all(|x| x.is_finite());
+    match record {
+        Record::State(s) => {
+            if !s.t.is_finite() || !all(&s.p) || !all(&s.v) || !all(&s.a) {
+                return bad(format!("vehicle at t = {}", s.t));
+            }
+            if let Some(i) = s.obstacles.iter().position(|o| !all(o)) {
+                return bad(format!("obstacle {i} at t = {}", s.t));
+            }
+        }
+        Record::Cycle(c) => {
+            if !c.t.is_finite() || !c.wall_ms.is_finite() || !c.effective_t.is_finite() {
+                return bad(format!("cycle at t = {}", c.t));
+            }
+            if !all(&c.branch_j) {
+                return bad(format!("branch J at t = {}", c.t));
+            }
+        }
+        Record::Outcome(o) => {
+            let xs = [
+                o.t,
+                o.flight_time_s,
+                o.path_length_m,
+                o.min_clearance_static_m,
+                o.min_clearance_dynamic_m,
+                o.max_speed,
+                o.max_accel,
+            ];
+            if !all(&xs) {
+                return bad(format!("{xs:?}"));
+            }
+        }
+        Record::Header(h) => {
+            if !all(&h.start) || !all(&h.goal) || !h.goal_tolerance.is_finite() {
+                return bad("start, goal or tolerance".into());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A whole run log, read back.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunLog {
+    /// The header.
+    pub header: Header,
+    /// The state records in order.
+    pub states: Vec<StateRecord>,
+    /// The cycle records in order.
+    pub cycles: Vec<CycleRecord>,
+    /// The outcome.
+    pub outcome: Outcome,
+}
+
+impl RunLog {
+    /// Reads a log and checks the contract's structure: a header first (with the right schema),
+    /// an outcome last, exactly one of each, state times strictly increasing with steps ≤ 0.02 s,
+    /// every state listing one position per header obstacle.
+    ///
+    /// # Errors
+    /// [`LogError`] naming the file and, for a bad line, its number.
+    pub fn read(path: &Path) -> Result<RunLog, LogError> {
+        let io = |source| LogError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let file = File::open(path).map_err(io)?;
+        let mut header = None;
+        let mut outcome = None;
+        let mut states = Vec::new();
+        let mut cycles = Vec::new();
+        for (i, line) in BufReader::new(file).lines().enumerate() {
+            let line = line.map_err(io)?;
+            if line.trim().is_empty() {
+                continue;
+            }
+            let parse = |message: String| LogError::Parse {
+                path: path.to_path_buf(),
+                line: i + 1,
+                message,
+            };
+            let record: Record = serde_json::from_str(&line).map_err(|e| parse(e.to_string()))?;
+            if outcome.is_some() {
+                return Err(parse("a record after the outcome".into()));
+            }
+            if !matches!(record, Record::Header(_)) && header.is_none() {
+                return Err(parse("the first line must be the header".into()));
+            }
+            match record {
+                Record::Header(h) => {
+                    if header.is_some() || i > 0 {
+                        return Err(parse("the header must be the first line, once".into()));
+                    }
+                    if h.schema != SCHEMA {
+                        return Err(parse(format!("schema `{}`, expected `{SCHEMA}`", h.schema)));
+                    }
+                    header = Some(h);
+                }
+                Record::State(s) => {
+                    let expected = header.as_ref().map_or(0, |h| h.obstacles.len());
+                    if s.obstacles.len() != expected {
+                        return Err(parse(format!(
+                            "{} obstacle positions, the header lists {expected}",
+                            s.obstacles.len()
+                        )));
+                    }
+                    if let Some(prev) = states.last().map(|p: &StateRecord| p.t)
+                        && !(s.t > prev && s.t - prev <= 0.02 + 1e-9)
+                    {
+                        return Err(parse(format!(
+                            "state time {} after {prev}: times must increase by at most 0.02 s",
+                            s.t
+                        )));
+                    }
+                    states.push(s);
+                }
+                Record::Cycle(c) => cycles.push(c),
+                Record::Outcome(o) => outcome = Some(o),
+            }
+        }
+        let structure = |message: &str| LogError::Structure {
+            path: path.to_path_buf(),
+            message: message.to_string(),
+        };
+        let header = header.ok_or_else(|| structure("no header"))?;
+        let outcome = outcome.ok_or_else(|| structure("no outcome (the run did not finish)"))?;
+        if states.is_empty() {
+            return Err(structure("no state records"));
+        }
+        Ok(RunLog {
+            header,
+            states,
+            cycles,
+            outcome,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn header() -> Header {
+        Header {
+            schema: SCHEMA.into(),
+            scenario: "unit".into(),
+            seed: 7,
+            planner: "trust".into(),
+            bounds: Bounds {
+                min: [0.0; 3],
+                max: [10.0, 10.0, 5.0],
+            },
+            vehicle: VehicleInfo {
+                radius: 0.3,
+                model: None,
+            },
+            limits: LimitsInfo {
+                v_max: 10.0,
+                a_max: 15.0,
+            },
+            start: [1.0, 1.0, 1.0],
+            goal: [9.0, 9.0, 1.0],
+            goal_tolerance: 0.5,
+            static_shapes: vec![
+                StaticShape::Sphere {
+                    center: [5.0, 5.0, 1.0],
+                    radius: 1.0,
+                },
+                StaticShape::Cylinder {
+                    center: [2.0, 8.0],
+                    radius: 0.5,
+                    z_min: 0.0,
+                    z_max: 5.0,
+                },
+                StaticShape::Box {
+                    min: [7.0, 1.0, 0.0],
+                    max: [8.0, 2.0, 3.0],
+                },
+            ],
+            static_points_file: None,
+            obstacles: vec![ObstacleInfo {
+                id: 0,
+                shape: ObstacleKind::Cylinder,
+                radius: 0.4,
+                half_height: Some(1.5),
+            }],
+            sim: None,
+        }
+    }
+
+    #[test]
+    fn the_header_serializes_as_in_the_contract() {
+        let json = serde_json::to_value(Record::Header(header())).unwrap();
+        assert_eq!(json["type"], "header");
+        assert_eq!(json["schema"], SCHEMA);
+        assert_eq!(json["static_shapes"][0]["sphere"]["radius"], 1.0);
+        assert_eq!(json["static_shapes"][1]["cylinder"]["z_max"], 5.0);
+        assert_eq!(json["static_shapes"][2]["box"]["min"][0], 7.0);
+        assert_eq!(json["obstacles"][0]["shape"], "cylinder");
+        assert_eq!(json["obstacles"][0]["half_height"], 1.5);
+        assert!(json["static_points_file"].is_null());
+        let outcome = Record::Outcome(Outcome {
+            status: Status::Collided,
+            t: 1.0,
+            flight_time_s: 1.0,
+            path_length_m: 2.0,
+            min_clearance_static_m: -0.1,
+            min_clearance_dynamic_m: 1.0,
+            max_speed: 2.0,
+            max_accel: 1.0,
+            with: Some("static".into()),
+            reason: None,
+            cycle_count: 10,
+        });
+        let json = serde_json::to_value(outcome).unwrap();
+        assert_eq!(json["status"], "collided");
+        assert_eq!(json["with"], "static");
+        let timed_out = serde_json::to_value(Status::TimedOut).unwrap();
+        assert_eq!(timed_out, "timed_out");
+    }
+
+    #[test]
+    fn a_log_round_trips_and_bad_structure_is_named() {
+        let dir = std::env::temp_dir().join(format!("trust-runlog-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("run.jsonl");
+        let mut w = LogWriter::create(&path).unwrap();
+        w.write(&Record::Header(header())).unwrap();
+        let state = |t: f64| StateRecord {
+            t,
+            p: [1.0 + t, 1.0, 1.0],
+            v: [1.0 / 3.0, 0.0, 0.0],
+            a: [0.0, 0.1, 0.0],
+            obstacles: vec![[4.0, 4.0, 1.5]],
+        };
+        w.write(&Record::State(state(0.0))).unwrap();
+        w.write(&Record::State(state(0.02))).unwrap();
+        let mut bad = state(0.03);
+        bad.p[0] = f64::NAN;
+        assert!(matches!(
+            w.write(&Record::State(bad)),
+            Err(LogError::NonFinite { .. })
+        ));
+        let outcome = Outcome {
+            status: Status::TimedOut,
+            t: 0.02,
+            flight_time_s: 0.02,
+            path_length_m: 0.02,
+            min_clearance_static_m: 1.0,
+            min_clearance_dynamic_m: 1.0,
+            max_speed: 1.0 / 3.0,
+            max_accel: 0.1,
+            with: None,
+            reason: None,
+            cycle_count: 0,
+        };
+        w.write(&Record::Outcome(outcome.clone())).unwrap();
+        w.finish().unwrap();
+        let log = RunLog::read(&path).unwrap();
+        assert_eq!(log.header, header());
+        assert_eq!(log.states.len(), 2);
+        assert_eq!(log.states[0].v[0], 1.0 / 3.0, "shortest round-trip floats");
+        assert_eq!(log.outcome, outcome);
+
+        // A state too late after the previous one, and a missing outcome.
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let gap = format!(
+            "{}\n{}\n{}\n",
+            lines[0],
+            lines[1],
+            lines[2].replace("0.02", "0.5")
+        );
+        std::fs::write(&path, gap).unwrap();
+        let e = RunLog::read(&path).unwrap_err().to_string();
+        assert!(e.contains(":3:") && e.contains("0.02 s"), "{e}");
+        std::fs::write(&path, format!("{}\n{}\n", lines[0], lines[1])).unwrap();
+        let e = RunLog::read(&path).unwrap_err().to_string();
+        assert!(e.contains("no outcome"), "{e}");
+        std::fs::write(&path, format!("{}\n{}\n", lines[1], lines[0])).unwrap();
+        let e = RunLog::read(&path).unwrap_err().to_string();
+        assert!(e.contains(":1:"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

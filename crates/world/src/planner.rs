@@ -1,0 +1,876 @@
+//! Planners assembled by name: the paper's TRUST-Planner and baselines 1–3 (Sec. IV-D), or any
+//! combination of frontend, backend, homotopy checker and manager mode.
+//!
+//! Style rule 4: the concrete types are chosen once, here, from closed serde enums
+//! ([`FrontendSpec`], [`BackendSpec`], [`CheckerSpec`]); everything below is generic
+//! (`trust_manager::Manager<F, B, H>`). [`AnyFrontend`], [`AnyBackend`] and [`AnyChecker`] are
+//! closed enums that implement the `trust-core` traits by delegation, so a planner of any
+//! combination is one type, [`AnyManager`].
+//!
+//! | preset (`planner.name`) | frontend | backend | checker | manager |
+//! |---|---|---|---|---|
+//! | `trust` | DEV-PRM | UTF-MINCO | TVD | [`ManagerParams::trust`] |
+//! | `baseline1` | straight line | UTF-MINCO | TVD | [`ManagerParams::single_branch`] |
+//! | `baseline2` | sparse A* | UTF-MINCO | TVD | [`ManagerParams::single_branch`] |
+//! | `baseline3` | DEV-PRM | UTF-MINCO | TVD | [`ManagerParams::multi_branch_without_history`] |
+//!
+//! Every preset's UTF-MINCO uses [`closed_loop_backend`]: the library defaults with the time and
+//! terminal weights raised from GCOPTER's 20 / our 50 to 60 / 60.
+//!
+//! Overrides in the scenario's `[planner]` section replace parts of the preset:
+//! `frontend = { kind = "v-prm", budget_ms = 20 }` replaces the frontend (the fields are that
+//! kind's `…Params`, unspecified ones at their defaults), likewise `backend` and `checker`;
+//! `[planner.manager]` fields replace single fields of the preset's `ManagerParams`
+//! ([`ManagerOverrides::apply`]), so
+//! `name = "baseline1"` with `manager.horizon_s = 3` stays single-branch.
+//!
+//! # Clearances (set by [`effective`], from the vehicle radius `r`)
+//!
+//! Forecasts already hold the vehicle radius in their `r_safe` ([`crate::sensing`]), so the
+//! moving-obstacle clearances of the parts stay as given. The static map holds the obstacles
+//! themselves, so:
+//!
+//! * the manager's `safety.static_clearance_m ≥ r + e`, where `e` is how much the planner's map
+//!   may overestimate a distance (0 for analytic shapes; see
+//!   [`crate::World::static_map_error_m`]) — a branch the safety check passes keeps the
+//!   vehicle's body off the true static obstacles;
+//! * the backend's `penalty.static_clearance_m ≥ r + clearance_margin_m + e`: the optimizer aims
+//!   for a margin beyond what the safety check requires (its penalty is soft and sampled);
+//! * DEV-PRM's and V-PRM's `clearance ≥ r` (samples closer than the vehicle radius to an obstacle
+//!   are useless guides; DEV-PRM's `surface_offset` is raised with it, as it must be `≥
+//!   clearance`), sparse A*'s `clearance ≥ r`.
+//!
+//! Each is a lower bound: a larger value in the scenario is kept.
+//!
+//! # Reproducible studies
+//!
+//! With `planner.reproducible = true` (the default) wall-clock budgets are switched off: the
+//! manager does not pass its cycle deadline to the backend (`enforce_budget = false`), and DEV-PRM,
+//! V-PRM and sparse A* get a budget of [`REPRODUCIBLE_BUDGET_MS`] so that only their sample,
+//! stall and expansion caps end a search. A run then depends only on the seeds, not on how loaded
+//! the machine is; wall-clock budgets make runs machine-dependent (a slower machine draws fewer
+//! samples). CPU times are still measured and reported. Set `reproducible = false` to study the
+//! real-time behaviour under the budgets.
+
+use serde::{Deserialize, Serialize};
+use trust_core::RankingWeights;
+use trust_core::{
+    Curve, HomotopyChecker, Limits, PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult,
+    Solution, TrajRequest, TrajectoryBackend,
+};
+use trust_manager::{Manager, ManagerParams, ReanchorParams, SafetyParams};
+use trust_minco::{Minco, MincoParams, UtfMinco, UtfMincoParams};
+use trust_topo_prm::{
+    DevPrm, DevPrmParams, SparseAStar, SparseAStarParams, StraightLine, Tvd, TvdParams, Uvd,
+    UvdParams, Vprm, VprmParams,
+};
+
+use crate::error::WorldError;
+use crate::problem::Problem;
+use crate::problem::Problems;
+
+/// Search budget (ms) given to DEV-PRM, V-PRM and sparse A* in reproducible mode: one minute,
+/// far beyond what their sample and expansion caps need, so that the caps end every search.
+pub const REPRODUCIBLE_BUDGET_MS: f64 = 60_000.0;
+
+/// A frontend of any supported kind, implementing [`PathFrontend`] by delegation.
+#[derive(Debug, Clone)]
+pub enum AnyFrontend {
+    /// DEV-PRM (`"dev-prm"`).
+    DevPrm(DevPrm),
+    /// V-PRM (`"v-prm"`).
+    Vprm(Vprm),
+    /// The straight line of baseline 1 (`"straight-line"`).
+    StraightLine(StraightLine),
+    /// Sparse A* of baseline 2 (`"sparse-a-star"`).
+    SparseAStar(SparseAStar),
+}
+
+impl PathFrontend for AnyFrontend {
+    fn name(&self) -> &str {
+        match self {
+            AnyFrontend::DevPrm(f) => f.name(),
+            AnyFrontend::Vprm(f) => f.name(),
+            AnyFrontend::StraightLine(f) => f.name(),
+            AnyFrontend::SparseAStar(f) => f.name(),
+        }
+    }
+
+    fn search(
+        &self,
+        query: &PathQuery,
+        scene: &Scene<'_>,
+        rng: &mut Rng,
+    ) -> Result<SearchResult, PlanError> {
+        match self {
+            AnyFrontend::DevPrm(f) => f.search(query, scene, rng),
+            AnyFrontend::Vprm(f) => f.search(query, scene, rng),
+            AnyFrontend::StraightLine(f) => f.search(query, scene, rng),
+            AnyFrontend::SparseAStar(f) => f.search(query, scene, rng),
+        }
+    }
+}
+
+/// A backend of any supported kind, implementing [`TrajectoryBackend`] by delegation.
+#[derive(Debug, Clone)]
+pub enum AnyBackend {
+    /// UTF-MINCO (`"utf-minco"`).
+    UtfMinco(UtfMinco),
+    /// The original fixed-terminal MINCO (`"minco"`).
+    Minco(Minco),
+}
+
+impl TrajectoryBackend for AnyBackend {
+    fn name(&self) -> &str {
+        match self {
+            AnyBackend::UtfMinco(b) => b.name(),
+            AnyBackend::Minco(b) => b.name(),
+        }
+    }
+
+    fn optimize(&self, req: &TrajRequest<'_>, scene: &Scene<'_>) -> Result<Solution, PlanError> {
+        match self {
+            AnyBackend::UtfMinco(b) => b.optimize(req, scene),
+            AnyBackend::Minco(b) => b.optimize(req, scene),
+        }
+    }
+}
+
+/// A homotopy checker of any supported kind, implementing [`HomotopyChecker`] by delegation.
+#[derive(Debug, Clone)]
+pub enum AnyChecker {
+    /// Temporal visibility deformation (`"tvd"`).
+    Tvd(Tvd),
+    /// Uniform visibility deformation (`"uvd"`).
+    Uvd(Uvd),
+}
+
+impl HomotopyChecker for AnyChecker {
+    fn name(&self) -> &str {
+        match self {
+            AnyChecker::Tvd(c) => c.name(),
+            AnyChecker::Uvd(c) => c.name(),
+        }
+    }
+
+    fn equivalent(
+        &self,
+        a: &dyn Curve,
+        b: &dyn Curve,
+        scene: &Scene<'_>,
+    ) -> Result<bool, PlanError> {
+        match self {
+            AnyChecker::Tvd(c) => c.equivalent(a, b, scene),
+            AnyChecker::Uvd(c) => c.equivalent(a, b, scene),
+        }
+    }
+}
+
+/// The manager of any planner this module assembles.
+pub type AnyManager = Manager<AnyFrontend, AnyBackend, AnyChecker>;
+
+/// Parameters of the straight-line frontend: none (the empty table rejects unknown fields).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StraightLineParams {}
+
+/// Which frontend, with its parameters (scenario key `planner.frontend`, tagged by `kind`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum FrontendSpec {
+    /// `{ kind = "dev-prm", ...DevPrmParams }`.
+    DevPrm(DevPrmParams),
+    /// `{ kind = "v-prm", ...VprmParams }`.
+    VPrm(VprmParams),
+    /// `{ kind = "straight-line" }`.
+    StraightLine(StraightLineParams),
+    /// `{ kind = "sparse-a-star", ...SparseAStarParams }` (alias `"sparse-astar"`, the
+    /// frontend's report name).
+    #[serde(rename = "sparse-a-star", alias = "sparse-astar")]
+    SparseAStar(SparseAStarParams),
+}
+
+impl FrontendSpec {
+    /// The scenario name of this kind.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            FrontendSpec::DevPrm(_) => "dev-prm",
+            FrontendSpec::VPrm(_) => "v-prm",
+            FrontendSpec::StraightLine(_) => "straight-line",
+            FrontendSpec::SparseAStar(_) => "sparse-a-star",
+        }
+    }
+
+    fn check(&self, p: &mut Problems) {
+        let r = match self {
+            FrontendSpec::DevPrm(x) => x.validate().map_err(|e| (e, "devprm")),
+            FrontendSpec::VPrm(x) => x.validate().map_err(|e| (e, "vprm")),
+            FrontendSpec::StraightLine(_) => Ok(()),
+            FrontendSpec::SparseAStar(x) => x.validate().map_err(|e| (e, "sparse_astar")),
+        };
+        if let Err((e, prefix)) = r {
+            p.list.push(plan_problem(e, prefix, "planner.frontend"));
+        }
+    }
+
+    /// The frontend alone (experiment E1 runs it without a manager). [`build`] applies the
+    /// vehicle-dependent adjustments first; this does not.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] naming the invalid parameter.
+    pub fn build(&self) -> Result<AnyFrontend, PlanError> {
+        Ok(match self {
+            FrontendSpec::DevPrm(x) => AnyFrontend::DevPrm(DevPrm::new(x.clone())?),
+            FrontendSpec::VPrm(x) => AnyFrontend::Vprm(Vprm::new(x.clone())?),
+            FrontendSpec::StraightLine(_) => AnyFrontend::StraightLine(StraightLine),
+            FrontendSpec::SparseAStar(x) => AnyFrontend::SparseAStar(SparseAStar::new(x.clone())?),
+        })
+    }
+}
+
+/// Which backend, with its parameters (scenario key `planner.backend`, tagged by `kind`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum BackendSpec {
+    /// `{ kind = "utf-minco", weights = {..}, penalty = {..}, pieces = {..}, solver = {..} }`.
+    UtfMinco(UtfMincoParams),
+    /// `{ kind = "minco", ... }` with the same fields.
+    Minco(MincoParams),
+}
+
+impl BackendSpec {
+    /// The scenario name of this kind.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            BackendSpec::UtfMinco(_) => "utf-minco",
+            BackendSpec::Minco(_) => "minco",
+        }
+    }
+
+    fn check(&self, p: &mut Problems) {
+        let r = match self {
+            BackendSpec::UtfMinco(x) => x.validate("planner.backend"),
+            BackendSpec::Minco(x) => x.validate("planner.backend"),
+        };
+        if let Err(e) = r {
+            p.list.push(plan_problem(e, "", "planner.backend"));
+        }
+    }
+
+    /// The backend alone (experiment E2 runs it without a manager). [`build`] applies the
+    /// vehicle-dependent adjustments first; this does not.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] naming the invalid parameter.
+    pub fn build(&self) -> Result<AnyBackend, PlanError> {
+        Ok(match self {
+            BackendSpec::UtfMinco(x) => AnyBackend::UtfMinco(UtfMinco::new(x.clone())?),
+            BackendSpec::Minco(x) => AnyBackend::Minco(Minco::new(x.clone())?),
+        })
+    }
+
+    fn penalty_mut(&mut self) -> &mut trust_minco::PenaltyParams {
+        match self {
+            BackendSpec::UtfMinco(x) => &mut x.penalty,
+            BackendSpec::Minco(x) => &mut x.penalty,
+        }
+    }
+}
+
+/// Which homotopy checker, with its parameters (scenario key `planner.checker`, tagged by
+/// `kind`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum CheckerSpec {
+    /// `{ kind = "tvd", dt_s = 0.05, clearance = 0 }`.
+    Tvd(TvdParams),
+    /// `{ kind = "uvd", ...UvdParams }`.
+    Uvd(UvdParams),
+}
+
+impl CheckerSpec {
+    /// The scenario name of this kind.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            CheckerSpec::Tvd(_) => "tvd",
+            CheckerSpec::Uvd(_) => "uvd",
+        }
+    }
+
+    fn check(&self, p: &mut Problems) {
+        let r = match self {
+            CheckerSpec::Tvd(x) => x.validate().map_err(|e| (e, "tvd")),
+            CheckerSpec::Uvd(x) => x.validate().map_err(|e| (e, "uvd")),
+        };
+        if let Err((e, prefix)) = r {
+            p.list.push(plan_problem(e, prefix, "planner.checker"));
+        }
+    }
+
+    /// The checker alone.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidInput`] naming the invalid parameter.
+    pub fn build(&self) -> Result<AnyChecker, PlanError> {
+        Ok(match self {
+            CheckerSpec::Tvd(x) => AnyChecker::Tvd(Tvd::new(x.clone())?),
+            CheckerSpec::Uvd(x) => AnyChecker::Uvd(Uvd::new(x.clone())?),
+        })
+    }
+}
+
+/// A [`PlanError`] as a [`Problem`] whose field path starts with `to` instead of the component's
+/// own prefix `from` (`devprm.budget_ms` → `planner.frontend.budget_ms`).
+fn plan_problem(e: PlanError, from: &str, to: &str) -> Problem {
+    match e {
+        PlanError::InvalidInput {
+            field,
+            value,
+            expected,
+        } => {
+            let rest = if from.is_empty() {
+                field.clone()
+            } else {
+                field
+                    .strip_prefix(from)
+                    .map(|r| format!("{to}{r}"))
+                    .unwrap_or_else(|| format!("{to}.{field}"))
+            };
+            Problem {
+                field: rest,
+                value,
+                expected,
+            }
+        }
+        other => Problem::new(to, other, "valid parameters"),
+    }
+}
+
+/// The paper's planners by name (scenario key `planner.name`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PlannerPreset {
+    /// TRUST-Planner: DEV-PRM + UTF-MINCO + TVD, multi-branch with history.
+    #[default]
+    Trust,
+    /// Baseline 1: straight line + UTF-MINCO + TVD, single branch.
+    Baseline1,
+    /// Baseline 2: sparse A* + UTF-MINCO + TVD, single branch.
+    Baseline2,
+    /// Baseline 3: DEV-PRM + UTF-MINCO + TVD, multi-branch without history.
+    Baseline3,
+}
+
+impl PlannerPreset {
+    /// The scenario name (`"trust"`, `"baseline1"`, …).
+    pub fn name(&self) -> &'static str {
+        match self {
+            PlannerPreset::Trust => "trust",
+            PlannerPreset::Baseline1 => "baseline1",
+            PlannerPreset::Baseline2 => "baseline2",
+            PlannerPreset::Baseline3 => "baseline3",
+        }
+    }
+
+    /// All presets, in the paper's order.
+    pub const ALL: [PlannerPreset; 4] = [
+        PlannerPreset::Trust,
+        PlannerPreset::Baseline1,
+        PlannerPreset::Baseline2,
+        PlannerPreset::Baseline3,
+    ];
+
+    /// The preset's parts (module table).
+    pub fn parts(&self) -> (FrontendSpec, BackendSpec, CheckerSpec, ManagerParams) {
+        let backend = BackendSpec::UtfMinco(closed_loop_backend());
+        let checker = CheckerSpec::Tvd(TvdParams::default());
+        match self {
+            PlannerPreset::Trust => (
+                FrontendSpec::DevPrm(DevPrmParams::default()),
+                backend,
+                checker,
+                ManagerParams::trust(),
+            ),
+            PlannerPreset::Baseline1 => (
+                FrontendSpec::StraightLine(StraightLineParams {}),
+                backend,
+                checker,
+                ManagerParams::single_branch(),
+            ),
+            PlannerPreset::Baseline2 => (
+                FrontendSpec::SparseAStar(SparseAStarParams::default()),
+                backend,
+                checker,
+                ManagerParams::single_branch(),
+            ),
+            PlannerPreset::Baseline3 => (
+                FrontendSpec::DevPrm(DevPrmParams::default()),
+                backend,
+                checker,
+                ManagerParams::multi_branch_without_history(),
+            ),
+        }
+    }
+}
+
+/// Scenario section `[planner.manager]`: fields that replace the preset's [`ManagerParams`] one
+/// by one (meanings and defaults: `trust_manager::ManagerParams`); `[planner.manager.safety]` and
+/// `[planner.manager.reanchor]` replace single fields of those sub-structs. Unknown fields are
+/// errors naming the field. `seed` is not an override: the planner's random stream is seeded from
+/// the trial ([`crate::seeds::Seeds::planner`], set by [`effective`]), so `seed` here is an
+/// unknown-field error instead of a value that would be silently replaced.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ManagerOverrides {
+    /// Replaces `ManagerParams::max_branches`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_branches: Option<usize>,
+    /// Replaces `ManagerParams::history`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub history: Option<bool>,
+    /// Replaces `ManagerParams::max_explored_paths`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_explored_paths: Option<usize>,
+    /// Replaces `ManagerParams::straight_guide_when_empty`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub straight_guide_when_empty: Option<bool>,
+    /// Replaces `ManagerParams::warm_max_evaluations`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warm_max_evaluations: Option<usize>,
+    /// Replaces `ManagerParams::sub_branch_max_evaluations`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sub_branch_max_evaluations: Option<usize>,
+    /// Replaces `ManagerParams::cold_max_evaluations`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cold_max_evaluations: Option<usize>,
+    /// Replaces `ManagerParams::explore_period_cycles`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub explore_period_cycles: Option<usize>,
+    /// Replaces `ManagerParams::repair_margin_m`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub repair_margin_m: Option<f64>,
+    /// Replaces `ManagerParams::ranking`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ranking: Option<RankingWeights>,
+    /// Replaces `ManagerParams::horizon_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub horizon_s: Option<f64>,
+    /// Replaces `ManagerParams::cycle_budget_ms`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cycle_budget_ms: Option<f64>,
+    /// Replaces `ManagerParams::enforce_budget`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub enforce_budget: Option<bool>,
+    /// Replaces `ManagerParams::latency_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub latency_s: Option<f64>,
+    /// Replaces `ManagerParams::reanchor`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reanchor: Option<ReanchorOverrides>,
+    /// Replaces `ManagerParams::hysteresis`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hysteresis: Option<f64>,
+    /// Replaces `ManagerParams::safety`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub safety: Option<SafetyOverrides>,
+}
+
+impl ManagerOverrides {
+    /// No field is given.
+    pub fn is_empty(&self) -> bool {
+        *self == ManagerOverrides::default()
+    }
+
+    /// Writes the given fields onto `p`; the others keep their value.
+    pub fn apply(&self, p: &mut ManagerParams) {
+        if let Some(v) = self.max_branches {
+            p.max_branches = v;
+        }
+        if let Some(v) = self.history {
+            p.history = v;
+        }
+        if let Some(v) = self.max_explored_paths {
+            p.max_explored_paths = v;
+        }
+        if let Some(v) = self.straight_guide_when_empty {
+            p.straight_guide_when_empty = v;
+        }
+        if let Some(v) = self.warm_max_evaluations {
+            p.warm_max_evaluations = Some(v);
+        }
+        if let Some(v) = self.sub_branch_max_evaluations {
+            p.sub_branch_max_evaluations = Some(v);
+        }
+        if let Some(v) = self.cold_max_evaluations {
+            p.cold_max_evaluations = Some(v);
+        }
+        if let Some(v) = self.explore_period_cycles {
+            p.explore_period_cycles = v;
+        }
+        if let Some(v) = self.repair_margin_m {
+            p.repair_margin_m = v;
+        }
+        if let Some(v) = self.ranking {
+            p.ranking = Some(v);
+        }
+        if let Some(v) = self.horizon_s {
+            p.horizon_s = v;
+        }
+        if let Some(v) = self.cycle_budget_ms {
+            p.cycle_budget_ms = v;
+        }
+        if let Some(v) = self.enforce_budget {
+            p.enforce_budget = v;
+        }
+        if let Some(v) = self.latency_s {
+            p.latency_s = Some(v);
+        }
+        if let Some(o) = &self.reanchor {
+            o.apply(&mut p.reanchor);
+        }
+        if let Some(v) = self.hysteresis {
+            p.hysteresis = v;
+        }
+        if let Some(o) = &self.safety {
+            o.apply(&mut p.safety);
+        }
+    }
+}
+
+/// `[planner.manager.reanchor]`: fields replacing the preset's `trust_manager::ReanchorParams`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReanchorOverrides {
+    /// Replaces `ReanchorParams::position_m`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub position_m: Option<f64>,
+    /// Replaces `ReanchorParams::velocity_mps`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub velocity_mps: Option<f64>,
+}
+
+impl ReanchorOverrides {
+    /// Writes the given fields onto `p`; the others keep their value.
+    pub fn apply(&self, p: &mut ReanchorParams) {
+        if let Some(v) = self.position_m {
+            p.position_m = v;
+        }
+        if let Some(v) = self.velocity_mps {
+            p.velocity_mps = v;
+        }
+    }
+}
+
+/// `[planner.manager.safety]`: fields replacing the preset's `trust_manager::SafetyParams`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SafetyOverrides {
+    /// Replaces `SafetyParams::max_step_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_step_s: Option<f64>,
+    /// Replaces `SafetyParams::min_step_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub min_step_s: Option<f64>,
+    /// Replaces `SafetyParams::static_clearance_m`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub static_clearance_m: Option<f64>,
+    /// Replaces `SafetyParams::dynamic_clearance_m`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dynamic_clearance_m: Option<f64>,
+    /// Replaces `SafetyParams::limit_tolerance`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit_tolerance: Option<f64>,
+    /// Replaces `SafetyParams::braking_tail`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub braking_tail: Option<bool>,
+}
+
+impl SafetyOverrides {
+    /// Writes the given fields onto `p`; the others keep their value.
+    pub fn apply(&self, p: &mut SafetyParams) {
+        if let Some(v) = self.max_step_s {
+            p.max_step_s = v;
+        }
+        if let Some(v) = self.min_step_s {
+            p.min_step_s = v;
+        }
+        if let Some(v) = self.static_clearance_m {
+            p.static_clearance_m = v;
+        }
+        if let Some(v) = self.dynamic_clearance_m {
+            p.dynamic_clearance_m = v;
+        }
+        if let Some(v) = self.limit_tolerance {
+            p.limit_tolerance = v;
+        }
+        if let Some(v) = self.braking_tail {
+            p.braking_tail = v;
+        }
+    }
+}
+
+/// Scenario section `[planner]`: a preset by name plus optional overrides (module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlannerSpec {
+    /// The preset. Default `trust`.
+    pub name: PlannerPreset,
+    /// Switch wall-clock budgets off for machine-independent runs (module docs). Default `true`.
+    pub reproducible: bool,
+    /// Margin (m) of the backend's static clearance beyond the vehicle radius (module docs).
+    /// Default 0.1 m: the backends' own default static clearance.
+    pub clearance_margin_m: f64,
+    /// Replaces the preset's frontend.
+    pub frontend: Option<FrontendSpec>,
+    /// Replaces the preset's backend.
+    pub backend: Option<BackendSpec>,
+    /// Replaces the preset's homotopy checker.
+    pub checker: Option<CheckerSpec>,
+    /// Replaces single fields of the preset's manager parameters.
+    pub manager: Option<ManagerOverrides>,
+}
+
+impl Default for PlannerSpec {
+    fn default() -> Self {
+        PlannerSpec {
+            name: PlannerPreset::Trust,
+            reproducible: true,
+            clearance_margin_m: 0.1,
+            frontend: None,
+            backend: None,
+            checker: None,
+            manager: None,
+        }
+    }
+}
+
+/// A planner with every part chosen, before the vehicle-dependent adjustments of [`effective`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ResolvedPlanner {
+    /// For reports and the run log: the preset name, followed by the overridden parts in
+    /// brackets (`trust`, `trust[frontend=v-prm]`, `baseline1[manager]`).
+    pub label: String,
+    /// The frontend.
+    pub frontend: FrontendSpec,
+    /// The backend.
+    pub backend: BackendSpec,
+    /// The homotopy checker.
+    pub checker: CheckerSpec,
+    /// The manager's parameters.
+    pub manager: ManagerParams,
+    /// See [`PlannerSpec::reproducible`].
+    pub reproducible: bool,
+    /// See [`PlannerSpec::clearance_margin_m`].
+    pub clearance_margin_m: f64,
+}
+
+impl PlannerSpec {
+    /// The preset with the overrides applied (typed: [`ManagerOverrides::apply`]).
+    pub fn resolve(&self) -> ResolvedPlanner {
+        let (mut frontend, mut backend, mut checker, mut manager) = self.name.parts();
+        let mut overridden = Vec::new();
+        if let Some(f) = &self.frontend {
+            frontend = f.clone();
+            overridden.push(format!("frontend={}", f.kind_name()));
+        }
+        if let Some(b) = &self.backend {
+            backend = b.clone();
+            overridden.push(format!("backend={}", b.kind_name()));
+        }
+        if let Some(c) = &self.checker {
+            checker = c.clone();
+            overridden.push(format!("checker={}", c.kind_name()));
+        }
+        if let Some(m) = &self.manager
+            && !m.is_empty()
+        {
+            m.apply(&mut manager);
+            overridden.push("manager".to_string());
+        }
+        let label = if overridden.is_empty() {
+            self.name.name().to_string()
+        } else {
+            format!("{}[{}]", self.name.name(), overridden.join(","))
+        };
+        ResolvedPlanner {
+            label,
+            frontend,
+            backend,
+            checker,
+            manager,
+            reproducible: self.reproducible,
+            clearance_margin_m: self.clearance_margin_m,
+        }
+    }
+
+    /// Every problem with this section: names are checked by serde when the file is read; this
+    /// checks the margin, the merged manager parameters and each part's own `validate()`, with
+    /// field paths under `planner.`.
+    pub fn problems(&self) -> Vec<Problem> {
+        let mut p = Problems::default();
+        p.non_negative("planner.clearance_margin_m", self.clearance_margin_m);
+        let r = self.resolve();
+        r.frontend.check(&mut p);
+        r.backend.check(&mut p);
+        r.checker.check(&mut p);
+        if let Err(e) = r.manager.validate() {
+            p.list.push(plan_problem(e, "manager", "planner.manager"));
+        }
+        p.list
+    }
+}
+
+/// What the assembly needs to know about the vehicle and the trial.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlannerContext {
+    /// The vehicle's limits.
+    pub limits: Limits,
+    /// The vehicle's radius (m).
+    pub vehicle_radius_m: f64,
+    /// How much the planner's static map may overestimate a distance (m):
+    /// [`crate::World::static_map_error_m`].
+    pub static_map_error_m: f64,
+    /// Seed of the planner's random stream (`ManagerParams::seed`), usually
+    /// [`crate::Seeds::planner`].
+    pub seed: u64,
+}
+
+/// The parameters actually used: `resolved` with the clearances raised to the vehicle's
+/// (module docs), the reproducible-mode budgets applied, and `manager.seed = ctx.seed`.
+///
+/// # Errors
+/// [`WorldError::Input`] for a negative or non-finite radius or map error.
+pub fn effective(
+    resolved: &ResolvedPlanner,
+    ctx: &PlannerContext,
+) -> Result<ResolvedPlanner, WorldError> {
+    let r = ctx.vehicle_radius_m;
+    if !(r.is_finite() && r >= 0.0) {
+        return Err(WorldError::input(
+            "vehicle.radius_m",
+            r,
+            "a finite number >= 0",
+        ));
+    }
+    let e = ctx.static_map_error_m;
+    if !(e.is_finite() && e >= 0.0) {
+        return Err(WorldError::input(
+            "static_map_error_m",
+            e,
+            "a finite number >= 0",
+        ));
+    }
+    let mut out = resolved.clone();
+    match &mut out.frontend {
+        FrontendSpec::DevPrm(x) => {
+            x.clearance = x.clearance.max(r);
+            x.surface_offset = x.surface_offset.max(x.clearance);
+            if out.reproducible {
+                x.budget_ms = x.budget_ms.max(REPRODUCIBLE_BUDGET_MS);
+            }
+        }
+        FrontendSpec::VPrm(x) => {
+            x.clearance = x.clearance.max(r);
+            if out.reproducible {
+                x.budget_ms = x.budget_ms.max(REPRODUCIBLE_BUDGET_MS);
+            }
+        }
+        FrontendSpec::SparseAStar(x) => {
+            x.clearance = x.clearance.max(r);
+            if out.reproducible {
+                x.budget_ms = x.budget_ms.max(REPRODUCIBLE_BUDGET_MS);
+            }
+        }
+        FrontendSpec::StraightLine(_) => {}
+    }
+    let penalty = out.backend.penalty_mut();
+    penalty.static_clearance_m = penalty
+        .static_clearance_m
+        .max(r + out.clearance_margin_m + e);
+    let safety = &mut out.manager.safety;
+    safety.static_clearance_m = safety.static_clearance_m.max(r + e);
+    if out.reproducible {
+        out.manager.enforce_budget = false;
+    }
+    out.manager.seed = ctx.seed;
+    Ok(out)
+}
+
+/// UTF-MINCO as the presets fly it: [`UtfMincoParams::default`] with the time weight `λ_t` and
+/// the terminal weight `λ_s` at 60 (library defaults: GCOPTER's 20 and our 50; `λ_s` must stay
+/// above `λ_t / v` for the free terminal to reach the goal, see `trust_minco::CostWeights`).
+/// With 20 / 50 the vehicle flew E4 at ~8 m/s on average. E4 seeds 0–7 (every flight arrived):
+///
+/// | `λ_t` / `λ_s` | flight times (s) | mean | E3 branches, seeds 0–9 |
+/// |---|---|---|---|
+/// | 20 / 50 | 30.9 29.1 36.3 32.3 29.7 32.9 30.4 28.3 | 31.2 | 2 1 1 3 2 2 4 2 4 3 |
+/// | 60 / 60 | 28.1 28.2 29.0 28.4 28.2 28.1 32.5 27.5 | 28.7 | 2 1 1 3 3 2 4 2 4 3 |
+/// | 150 / 150 | 27.7 28.0 28.3 27.3 27.3 28.3 27.2 26.8 | 27.6 | 2 1 1 3 2 0 4 2 4 3 |
+///
+/// (paper: 29.4 s; distance / `v_max` = 24.6 s). Above 60 the cold solves of E3 stall above
+/// `v_max` more often (seed 5 kept no branch at 150 / 150); 300 / 300 also let E4's speed
+/// overshoot `v_max` by 0.2 % (the feasibility penalty is soft).
+///
+/// A scenario's `backend = { kind = "utf-minco", … }` starts from the library defaults, not from
+/// these: give `weights` there to keep them.
+pub fn closed_loop_backend() -> UtfMincoParams {
+    let mut p = UtfMincoParams::default();
+    p.weights.time = 60.0;
+    p.weights.terminal = 60.0;
+    p
+}
+
+/// Builds the manager of `resolved` for a vehicle and trial ([`effective`] parameters).
+///
+/// # Errors
+/// [`WorldError::Input`] as [`effective`]; [`WorldError::Plan`] naming the invalid field of a part.
+pub fn build(resolved: &ResolvedPlanner, ctx: &PlannerContext) -> Result<AnyManager, WorldError> {
+    let eff = effective(resolved, ctx)?;
+    let frontend = eff.frontend.build()?;
+    let backend = eff.backend.build()?;
+    let checker = eff.checker.build()?;
+    Ok(Manager::new(
+        frontend,
+        backend,
+        checker,
+        ctx.limits,
+        eff.manager,
+    )?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plan_problems_are_reprefixed() {
+        let e = PlanError::invalid("devprm.budget_ms", -1.0, "a finite number > 0");
+        let p = plan_problem(e, "devprm", "planner.frontend");
+        assert_eq!(p.field, "planner.frontend.budget_ms");
+        let e = PlanError::invalid("planner.backend.pieces.min_pieces", 0, ">= 1");
+        assert_eq!(
+            plan_problem(e, "", "planner.backend").field,
+            "planner.backend.pieces.min_pieces"
+        );
+    }
+
+    #[test]
+    fn manager_overrides_merge_onto_the_preset() {
+        let spec: PlannerSpec =
+            toml::from_str("name = \"baseline1\"\n[manager]\nhorizon_s = 3.0\n[manager.safety]\nmax_step_s = 0.02\n")
+                .unwrap();
+        let r = spec.resolve();
+        assert_eq!(r.manager.max_branches, 1);
+        assert_eq!(r.manager.horizon_s, 3.0);
+        assert_eq!(r.manager.safety.max_step_s, 0.02);
+        assert_eq!(r.manager.safety.min_step_s, 1e-3);
+        assert_eq!(r.label, "baseline1[manager]");
+        let e = toml::from_str::<PlannerSpec>("[manager]\nbranches = 3\n").unwrap_err();
+        assert!(e.to_string().contains("branches"), "{e}");
+        // The planner's seed comes from the trial: overriding it is an error, not a no-op.
+        let e = toml::from_str::<PlannerSpec>("[manager]\nseed = 3\n").unwrap_err();
+        assert!(e.to_string().contains("unknown field `seed`"), "{e}");
+        let e = toml::from_str::<PlannerSpec>("[manager.safety]\nmax_step = 0.1\n").unwrap_err();
+        assert!(e.to_string().contains("max_step"), "{e}");
+    }
+}

@@ -1,0 +1,305 @@
+//! Scenario files: everything one simulated flight needs, in TOML.
+//!
+//! A scenario names the world (bounds, static obstacles, moving obstacles — explicit or from a
+//! generator), the mission, the vehicle, the planner, the sensing, how the truth departs from the
+//! forecasts, the closed loop's clocks, a time limit and a seed. Every table rejects unknown
+//! fields; every section except `[mission]` has defaults, so a minimal file is short:
+//!
+//! ```toml
+//! name = "minimal"
+//! [world]
+//! bounds = { min = [0, 0, 0], max = [20, 20, 10] }
+//! [mission]
+//! start = [1, 10, 5]
+//! goal = [19, 10, 5]
+//! ```
+//!
+//! # Format (annotated)
+//!
+//! ```toml
+//! name = "quickstart"            # for reports and the run log
+//! description = "…"              # optional, free text
+//! seed = 1                       # the trial seed: world, maneuvers, sensor noise, planner
+//! time_limit_s = 20.0            # default 60
+//!
+//! [world]
+//! bounds = { min = [0, 0, 0], max = [40, 20, 10] }   # optional with a generator
+//! # generator = { kind = "e4", pillar_count = 150 } # e1 | e2-static | e2-dynamic | e3 | e4
+//!
+//! [[static.shapes]]              # vertical cylinder, as in the run-log contract
+//! kind = "cylinder"
+//! center = [12, 8]
+//! radius = 1.0
+//! z_min = 0.0
+//! z_max = 10.0
+//! [[static.shapes]]
+//! kind = "box"
+//! min = [20, 12, 0]
+//! max = [23, 16, 6]
+//! [[static.shapes]]
+//! kind = "sphere"
+//! center = [30, 6, 4]
+//! radius = 1.2
+//!
+//! [static.point_cloud]           # optional: the planner sees a cloud, not the shapes
+//! source = "shapes"              # shapes | inline (points = [[x,y,z], …]) | file (path = "…")
+//! esdf_voxel_m = 0.2
+//!
+//! [[obstacles]]                  # an explicit moving obstacle
+//! shape = "cylinder"             # sphere | cylinder
+//! radius_m = 0.5
+//! half_height_m = 1.5            # cylinders only
+//! position = [25, 15, 5]
+//! velocity = [0, -1.5, 0]
+//! motion = { kind = "random-maneuvers", max_accel_m_s2 = 0.1, speed_m_s = [1, 2] }
+//!
+//! [[random_obstacles]]           # a group drawn from the seed
+//! count = 4
+//! speed_m_s = [0.5, 2.0]
+//! region = { min = [8, 0, 0], max = [34, 20, 10] }
+//! motion = { kind = "random-maneuvers" }
+//!
+//! [mission]
+//! start = [2, 10, 3]
+//! goal = [38, 10, 3]
+//! goal_tolerance_m = 0.5
+//!
+//! [vehicle]
+//! radius_m = 0.3
+//! limits = { v_max = 10.0, a_max = 15.0 }
+//! model = "quadrotor"            # quadrotor | perfect; [vehicle.quadrotor], [vehicle.gains]
+//!
+//! [planner]
+//! name = "trust"                 # trust | baseline1 | baseline2 | baseline3
+//! reproducible = true            # no wall-clock budgets (crate::planner)
+//! # frontend = { kind = "v-prm", budget_ms = 20 }   # dev-prm | v-prm | straight-line | sparse-a-star
+//! # backend = { kind = "minco" }                    # utf-minco | minco
+//! # checker = { kind = "uvd" }                      # tvd | uvd
+//! # [planner.manager]                               # merged onto the preset's ManagerParams
+//! # horizon_s = 3.0
+//!
+//! [sensing]
+//! rate_hz = 20.0
+//! position_noise_m = 0.1
+//! dropout_probability = 0.0
+//! r_safe_margin_m = 0.1
+//! # [sensing.ekf]                # trust_predict::EkfParams
+//!
+//! [traffic]
+//! fault_level = 0.0              # > 0: maneuvers beyond the forecasts' mu
+//!
+//! [sim]
+//! physics_dt_s = 0.002
+//! replan_rate_hz = 10.0
+//! log_rate_hz = 50.0
+//! latency = { kind = "fixed" }   # fixed (seconds = …, default the manager's) | measured
+//! ```
+//!
+//! Tagged tables use a `kind` key (`source` for point clouds) next to the variant's own fields;
+//! serde's internally tagged enums keep `deny_unknown_fields` working there, and an unknown
+//! `kind` is reported with the list of accepted names.
+//!
+//! # Errors
+//!
+//! [`Scenario::load`] keeps toml's message for syntax errors, wrong types, unknown fields and
+//! unknown names (file name, line, column and the offending snippet: [`WorldError::Parse`]), and
+//! then runs [`Scenario::validate`], which collects **every** semantic problem
+//! ([`WorldError::Invalid`]), each as `field.path: value — expected …` ([`Problem`]) that the
+//! file alone shows. Start and goal against the generated layout are checked where the layout is
+//! generated — once per world, in [`crate::World::build`] — or by [`crate::load_checked`]
+//! (`trust-sim validate`), which generates the layout without building the maps.
+
+pub(crate) mod generator;
+pub mod points;
+
+mod sections;
+mod validate;
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use trust_core::Aabb;
+
+pub use crate::problem::Problem;
+pub use generator::{E1Params, E2Params, E3Params, E4Params, GeneratorSpec};
+pub use sections::{
+    BoundsSpec, Latency, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec, RandomObstacles,
+    ShapeSpec, SimSection, StaticSection, VehicleModel, VehicleSection, WorldSection,
+};
+
+use crate::error::WorldError;
+use crate::planner::{PlannerSpec, ResolvedPlanner};
+use crate::seeds::Seeds;
+use crate::sensing::SensingParams;
+use crate::traffic::TrafficParams;
+
+/// One scenario file (module docs for the format).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Name, for reports and the run log header's `scenario`.
+    pub name: String,
+    /// Free text: what the scenario reproduces.
+    #[serde(default)]
+    pub description: String,
+    /// The trial seed (see [`Seeds`]). Default 0.
+    #[serde(default)]
+    pub seed: u64,
+    /// Simulated time limit (s), `> 0`. Default 60 s.
+    #[serde(default = "default_time_limit")]
+    pub time_limit_s: f64,
+    /// `[world]`: bounds and generator.
+    #[serde(default)]
+    pub world: WorldSection,
+    /// `[static]`: static shapes and what the planner sees of them.
+    #[serde(default, rename = "static")]
+    pub static_map: StaticSection,
+    /// `[[obstacles]]`: explicit moving obstacles.
+    #[serde(default)]
+    pub obstacles: Vec<ObstacleSpec>,
+    /// `[[random_obstacles]]`: groups of random moving obstacles.
+    #[serde(default)]
+    pub random_obstacles: Vec<RandomObstacles>,
+    /// `[mission]`: start, goal and arrival tolerance.
+    pub mission: Mission,
+    /// `[vehicle]`: radius, limits and model.
+    #[serde(default)]
+    pub vehicle: VehicleSection,
+    /// `[planner]`: preset and overrides.
+    #[serde(default)]
+    pub planner: PlannerSpec,
+    /// `[sensing]`: obstacle sensor and tracker.
+    #[serde(default)]
+    pub sensing: SensingParams,
+    /// `[traffic]`: fault level of the true maneuvers.
+    #[serde(default)]
+    pub traffic: TrafficParams,
+    /// `[sim]`: physics, replanning and logging clocks, latency.
+    #[serde(default)]
+    pub sim: SimSection,
+    /// The file it was read from (relative paths in it are resolved against its folder);
+    /// `None` for a scenario made in code (paths relative to the current directory). Not part
+    /// of the file.
+    #[serde(skip)]
+    pub path: Option<PathBuf>,
+}
+
+fn default_time_limit() -> f64 {
+    60.0
+}
+
+impl Scenario {
+    /// Parses scenario text; `origin` names it in errors and gives the folder relative paths are
+    /// resolved against (its parent). Does not validate.
+    ///
+    /// # Errors
+    /// [`WorldError::Parse`] with toml's message (line, column, snippet).
+    pub fn from_toml_str(text: &str, origin: &Path) -> Result<Scenario, WorldError> {
+        let mut s: Scenario = toml::from_str(text).map_err(|e| WorldError::Parse {
+            path: origin.to_path_buf(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        s.path = Some(origin.to_path_buf());
+        Ok(s)
+    }
+
+    /// Reads and parses a scenario file without validating it.
+    ///
+    /// # Errors
+    /// [`WorldError::Read`], [`WorldError::Parse`].
+    pub fn parse_file(path: &Path) -> Result<Scenario, WorldError> {
+        let text = std::fs::read_to_string(path).map_err(|source| WorldError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Scenario::from_toml_str(&text, path)
+    }
+
+    /// Reads, parses and checks a scenario file ([`Scenario::validate`]: everything the file
+    /// alone shows; the layout checks run where the world is built, [`crate::World::build`], or
+    /// in [`crate::load_checked`]).
+    ///
+    /// # Errors
+    /// [`WorldError::Read`], [`WorldError::Parse`], or [`WorldError::Invalid`] with every problem
+    /// [`Scenario::validate`] found.
+    pub fn load(path: &Path) -> Result<Scenario, WorldError> {
+        let s = Scenario::parse_file(path)?;
+        let problems = s.validate();
+        if problems.is_empty() {
+            Ok(s)
+        } else {
+            Err(WorldError::Invalid {
+                path: path.to_path_buf(),
+                problems,
+            })
+        }
+    }
+
+    /// The same scenario with another trial seed (Monte Carlo trials).
+    #[must_use]
+    pub fn with_seed(&self, seed: u64) -> Scenario {
+        Scenario {
+            seed,
+            ..self.clone()
+        }
+    }
+
+    /// The seeds of this trial's random streams.
+    pub fn seeds(&self) -> Seeds {
+        Seeds::from_trial(self.seed)
+    }
+
+    /// The world bounds: `world.bounds`, else the generator's
+    /// ([`GeneratorSpec::default_bounds`]); `None` if neither is given.
+    pub fn bounds(&self) -> Option<Aabb> {
+        match (&self.world.bounds, &self.world.generator) {
+            (Some(b), _) => Some(b.aabb()),
+            (None, Some(g)) => Some(g.default_bounds()),
+            (None, None) => None,
+        }
+    }
+
+    /// A path from the file, resolved against the folder of [`Scenario::path`].
+    pub fn resolve_path(&self, path: &Path) -> PathBuf {
+        match self.path.as_deref().and_then(Path::parent) {
+            Some(dir) if path.is_relative() => dir.join(path),
+            _ => path.to_path_buf(),
+        }
+    }
+
+    /// What errors call this scenario: its file, or `<scenario NAME>`.
+    pub fn origin(&self) -> PathBuf {
+        self.path
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("<scenario {}>", self.name)))
+    }
+
+    /// The planner with every part chosen ([`PlannerSpec::resolve`]); a fixed `sim.latency`
+    /// with `seconds` also sets the manager's `latency_s` unless `[planner.manager]` sets it,
+    /// so that the manager plans for the delay the loop applies.
+    pub fn resolve_planner(&self) -> ResolvedPlanner {
+        let mut r = self.planner.resolve();
+        let manager_sets_latency = self
+            .planner
+            .manager
+            .as_ref()
+            .is_some_and(|m| m.latency_s.is_some());
+        if let Latency::Fixed {
+            seconds: Some(seconds),
+        } = self.sim.latency
+            && !manager_sets_latency
+        {
+            r.manager.latency_s = Some(seconds);
+        }
+        r
+    }
+
+    /// The scenario as TOML text (round-trips through [`Scenario::from_toml_str`]).
+    ///
+    /// # Errors
+    /// [`WorldError::Input`] if a value cannot be written as TOML (a seed above `i64::MAX`).
+    pub fn to_toml_string(&self) -> Result<String, WorldError> {
+        toml::to_string(self)
+            .map_err(|e| WorldError::input("scenario", e, "a TOML-serializable scenario"))
+    }
+}

@@ -1,0 +1,431 @@
+//! The sections of a scenario file (see the [`crate::scenario`] module docs for the format).
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+use trust_core::{Aabb, Limits, Vec3};
+use trust_geometry::{AaBox, Cylinder, Shape, Sphere};
+
+use crate::scenario::generator::GeneratorSpec;
+use crate::traffic::{Motion, MovingShape};
+use trust_vehicle::{QuadrotorParams, Se3Gains};
+
+/// An axis-aligned box `{ min = [x, y, z], max = [x, y, z] }`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoundsSpec {
+    /// Lower corner (m).
+    pub min: [f64; 3],
+    /// Upper corner (m).
+    pub max: [f64; 3],
+}
+
+impl BoundsSpec {
+    /// The box, without checks.
+    pub fn aabb(&self) -> Aabb {
+        Aabb {
+            min: Vec3::from(self.min),
+            max: Vec3::from(self.max),
+        }
+    }
+
+    /// From a box.
+    pub fn from_aabb(a: &Aabb) -> Self {
+        BoundsSpec {
+            min: a.min.into(),
+            max: a.max.into(),
+        }
+    }
+
+    /// Finite corners with `min < max` on every axis.
+    pub fn is_valid(&self) -> bool {
+        self.min.iter().chain(&self.max).all(|x| x.is_finite())
+            && (0..3).all(|i| self.min[i] < self.max[i])
+    }
+}
+
+/// Section `[world]`: the bounds and an optional generator.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorldSection {
+    /// The map bounds, where the vehicle may fly. Optional with a generator (each has natural
+    /// bounds, [`GeneratorSpec::default_bounds`]); required without one.
+    pub bounds: Option<BoundsSpec>,
+    /// A generator that fills static shapes and/or moving obstacles, seeded by the scenario's
+    /// `seed`. Explicit `[[static.shapes]]`, `[[obstacles]]` and `[[random_obstacles]]` are
+    /// added to what it generates.
+    pub generator: Option<GeneratorSpec>,
+}
+
+/// A static obstacle (tagged by `kind`). Cylinders are vertical: axis through `center = [x, y]`
+/// from `z_min` to `z_max`, as in the run-log contract.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ShapeSpec {
+    /// `{ kind = "sphere", center = [x, y, z], radius = r }`.
+    Sphere {
+        /// Centre (m).
+        center: [f64; 3],
+        /// Radius (m), `> 0`.
+        radius: f64,
+    },
+    /// `{ kind = "cylinder", center = [x, y], radius = r, z_min = a, z_max = b }`.
+    Cylinder {
+        /// Axis position (m).
+        center: [f64; 2],
+        /// Radius (m), `> 0`.
+        radius: f64,
+        /// Bottom (m).
+        z_min: f64,
+        /// Top (m), `> z_min`.
+        z_max: f64,
+    },
+    /// `{ kind = "box", min = [x, y, z], max = [x, y, z] }` (axis-aligned).
+    Box {
+        /// Lower corner (m).
+        min: [f64; 3],
+        /// Upper corner (m), `> min` on every axis.
+        max: [f64; 3],
+    },
+}
+
+impl ShapeSpec {
+    /// The geometry shape, without checks (see [`ShapeSpec::is_valid`]).
+    pub fn shape(&self) -> Shape {
+        match *self {
+            ShapeSpec::Sphere { center, radius } => Shape::Sphere(Sphere {
+                center: Vec3::from(center),
+                radius,
+            }),
+            ShapeSpec::Cylinder {
+                center,
+                radius,
+                z_min,
+                z_max,
+            } => Shape::Cylinder(Cylinder {
+                center: Vec3::new(center[0], center[1], 0.5 * (z_min + z_max)),
+                radius,
+                half_height: 0.5 * (z_max - z_min),
+            }),
+            ShapeSpec::Box { min, max } => Shape::AaBox(AaBox {
+                min: Vec3::from(min),
+                max: Vec3::from(max),
+            }),
+        }
+    }
+
+    /// The scenario (and run-log) form of a geometry shape.
+    pub fn from_shape(s: &Shape) -> Self {
+        match s {
+            Shape::Sphere(s) => ShapeSpec::Sphere {
+                center: s.center.into(),
+                radius: s.radius,
+            },
+            Shape::Cylinder(c) => ShapeSpec::Cylinder {
+                center: [c.center.x, c.center.y],
+                radius: c.radius,
+                z_min: c.center.z - c.half_height,
+                z_max: c.center.z + c.half_height,
+            },
+            Shape::AaBox(b) => ShapeSpec::Box {
+                min: b.min.into(),
+                max: b.max.into(),
+            },
+        }
+    }
+
+    /// Finite numbers, positive sizes.
+    pub fn is_valid(&self) -> bool {
+        match *self {
+            ShapeSpec::Sphere { center, radius } => {
+                center.iter().all(|x| x.is_finite()) && radius.is_finite() && radius > 0.0
+            }
+            ShapeSpec::Cylinder {
+                center,
+                radius,
+                z_min,
+                z_max,
+            } => {
+                center.iter().all(|x| x.is_finite())
+                    && radius.is_finite()
+                    && radius > 0.0
+                    && z_min.is_finite()
+                    && z_max.is_finite()
+                    && z_min < z_max
+            }
+            ShapeSpec::Box { min, max } => BoundsSpec { min, max }.is_valid(),
+        }
+    }
+}
+
+/// Section `[static]`: static obstacles known in advance (paper Sec. IV-D: the static map is
+/// given).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StaticSection {
+    /// Analytic shapes (`[[static.shapes]]`), added to a generator's.
+    #[serde(default)]
+    pub shapes: Vec<ShapeSpec>,
+    /// What the planner sees as a point cloud (`[static.point_cloud]`); absent: the planner sees
+    /// the shapes analytically.
+    pub point_cloud: Option<PointCloudSpec>,
+}
+
+/// `[static.point_cloud]`, tagged by `source`. The planner's map is a voxel ESDF of the cloud
+/// (`trust_geometry::StaticMap::with_point_cloud`) over the world bounds.
+///
+/// * `source = "shapes"`: the cloud is sampled from all static shapes (generated and explicit),
+///   which stay the truth; the planner sees only the cloud ([`crate`] describes the
+///   sampling).
+/// * `source = "inline"` / `"file"`: the points are the truth (a point closer than the vehicle
+///   radius is a collision) and the planner sees them as an ESDF, plus any shapes analytically.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "source", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum PointCloudSpec {
+    /// Sampled from the static shapes.
+    Shapes {
+        /// ESDF voxel size (m), `> 0`; the grid must stay within `trust_geometry::MAX_VOXELS`.
+        esdf_voxel_m: f64,
+        /// Lattice spacing of the samples (m), `> 0`. Default: `esdf_voxel_m`.
+        spacing_m: Option<f64>,
+    },
+    /// Points listed in the file.
+    Inline {
+        /// ESDF voxel size (m).
+        esdf_voxel_m: f64,
+        /// The points `[[x, y, z], ...]`, at least one.
+        points: Vec<[f64; 3]>,
+    },
+    /// Points read from a text file of `x y z` lines (blank lines and `#` comments allowed).
+    File {
+        /// ESDF voxel size (m).
+        esdf_voxel_m: f64,
+        /// The file, relative to the scenario file's folder (or absolute).
+        path: PathBuf,
+    },
+}
+
+impl PointCloudSpec {
+    /// The ESDF voxel size (m).
+    pub fn esdf_voxel_m(&self) -> f64 {
+        match self {
+            PointCloudSpec::Shapes { esdf_voxel_m, .. }
+            | PointCloudSpec::Inline { esdf_voxel_m, .. }
+            | PointCloudSpec::File { esdf_voxel_m, .. } => *esdf_voxel_m,
+        }
+    }
+}
+
+/// Shape kind of an explicit moving obstacle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MovingShapeKind {
+    /// A ball of radius `radius_m`.
+    Sphere,
+    /// A vertical cylinder of radius `radius_m` and half-height `half_height_m`, centred at
+    /// mid-height.
+    Cylinder,
+}
+
+/// One explicit moving obstacle (`[[obstacles]]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleSpec {
+    /// `"sphere"` or `"cylinder"`.
+    pub shape: MovingShapeKind,
+    /// Radius (m), `> 0`.
+    pub radius_m: f64,
+    /// Half-height (m) of a cylinder, `> 0`; required for cylinders, not allowed for spheres.
+    pub half_height_m: Option<f64>,
+    /// Centre at `t = 0` (m).
+    pub position: [f64; 3],
+    /// Velocity at `t = 0` (m/s). Default at rest.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Motion model. Default `{ kind = "constant-velocity" }`.
+    #[serde(default)]
+    pub motion: Motion,
+    /// The box it stays inside (reflecting at its walls). Default: the world bounds.
+    pub region: Option<BoundsSpec>,
+}
+
+impl ObstacleSpec {
+    /// The true shape (a missing cylinder half-height reads as 0, which validation rejects).
+    pub fn moving_shape(&self) -> MovingShape {
+        match self.shape {
+            MovingShapeKind::Sphere => MovingShape::Sphere {
+                radius: self.radius_m,
+            },
+            MovingShapeKind::Cylinder => MovingShape::Cylinder {
+                radius: self.radius_m,
+                half_height: self.half_height_m.unwrap_or(0.0),
+            },
+        }
+    }
+}
+
+/// A group of random moving obstacles (`[[random_obstacles]]`), drawn from the scenario's seed.
+///
+/// Each obstacle is a cylinder with probability `cylinder_fraction`, else a sphere; sizes and
+/// speed are uniform in their ranges; the centre is uniform over the positions that keep the
+/// whole obstacle inside `region`; the direction of motion is uniform in yaw, horizontal for
+/// cylinders and, for spheres, uniform on the part of the unit sphere within `max_climb_deg` of
+/// the horizontal. Placements that come within `vehicle.radius_m + endpoint_clearance_m` of the
+/// start or the goal, or (with `avoid_static`) overlap a static shape, are redrawn (up to 1000
+/// times per obstacle). Defaults are those of experiment E1's random scenes
+/// (`trust_topo_prm::scenes::SceneParams::default()`: radii 0.5–1.5 m, speeds 0.5–3 m/s, half
+/// cylinders, full-height cylinders, directions uniform on the sphere, 1 m endpoint clearance).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RandomObstacles {
+    /// Number of obstacles.
+    pub count: usize,
+    /// Probability that an obstacle is a cylinder, in `[0, 1]`.
+    pub cylinder_fraction: f64,
+    /// Sphere radius range (m).
+    pub sphere_radius_m: [f64; 2],
+    /// Cylinder radius range (m).
+    pub cylinder_radius_m: [f64; 2],
+    /// Cylinder half-height range (m); `None`: full height of the region (as in E1).
+    pub cylinder_half_height_m: Option<[f64; 2]>,
+    /// Speed range (m/s).
+    pub speed_m_s: [f64; 2],
+    /// Largest climb angle of a sphere's initial velocity (degrees, `[0, 90]`).
+    pub max_climb_deg: f64,
+    /// Where the obstacles start and stay (reflecting at its walls). Default: the world bounds.
+    pub region: Option<BoundsSpec>,
+    /// Extra clearance (m) of start and goal from every obstacle at `t = 0`, beyond the vehicle
+    /// radius.
+    pub endpoint_clearance_m: f64,
+    /// Do not start inside (or touching) a static shape.
+    pub avoid_static: bool,
+    /// Motion model of every obstacle; with `random-maneuvers` and no `speed_m_s`, the group's
+    /// speed range is used.
+    pub motion: Motion,
+}
+
+impl Default for RandomObstacles {
+    fn default() -> Self {
+        let e1 = trust_topo_prm::scenes::SceneParams::default();
+        RandomObstacles {
+            count: 10,
+            cylinder_fraction: e1.cylinder_fraction,
+            sphere_radius_m: [e1.radius.0, e1.radius.1],
+            cylinder_radius_m: [e1.radius.0, e1.radius.1],
+            cylinder_half_height_m: None,
+            speed_m_s: [e1.speed.0, e1.speed.1],
+            max_climb_deg: 90.0,
+            region: None,
+            endpoint_clearance_m: e1.endpoint_clearance,
+            avoid_static: true,
+            motion: Motion::default(),
+        }
+    }
+}
+
+/// Section `[mission]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Mission {
+    /// Start position (m); the vehicle starts at rest at `t = 0`.
+    pub start: [f64; 3],
+    /// Goal position (m).
+    pub goal: [f64; 3],
+    /// Arrival radius around the goal (m), `> 0`. Default 0.5 m (the run-log contract's example).
+    #[serde(default = "default_goal_tolerance")]
+    pub goal_tolerance_m: f64,
+}
+
+fn default_goal_tolerance() -> f64 {
+    0.5
+}
+
+/// Which vehicle model flies the plan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum VehicleModel {
+    /// `trust_vehicle::ControlledQuadrotor` (rigid body + SE(3) controller).
+    #[default]
+    Quadrotor,
+    /// `trust_vehicle::PerfectTracking` (the state is the reference).
+    Perfect,
+}
+
+/// Section `[vehicle]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct VehicleSection {
+    /// Radius of the sphere that must stay clear of obstacles (m), `> 0`. Default 0.3 m (the
+    /// run-log contract's example; the default quadrotor's 0.15 m arms plus 5-inch propellers
+    /// and a margin).
+    pub radius_m: f64,
+    /// Planner limits. Default the paper's (Sec. IV): `v_max = 10 m/s`, `a_max = 15 m/s²`.
+    pub limits: Limits,
+    /// `"quadrotor"` (default) or `"perfect"`.
+    pub model: VehicleModel,
+    /// Rigid-body parameters of the quadrotor model.
+    pub quadrotor: QuadrotorParams,
+    /// Gains of its SE(3) controller.
+    pub gains: Se3Gains,
+}
+
+impl Default for VehicleSection {
+    fn default() -> Self {
+        VehicleSection {
+            radius_m: 0.3,
+            limits: Limits::default(),
+            model: VehicleModel::Quadrotor,
+            quadrotor: QuadrotorParams::default(),
+            gains: Se3Gains::default(),
+        }
+    }
+}
+
+/// When a new plan takes effect after the state it was planned from (`sim.latency`, tagged by
+/// `kind`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Latency {
+    /// A fixed delay: `{ kind = "fixed", seconds = 0.05 }`; without `seconds`, the manager's
+    /// latency (`ManagerParams::latency()`: its `latency_s`, else its cycle budget).
+    Fixed {
+        /// The delay (s), `≥ 0`.
+        seconds: Option<f64>,
+    },
+    /// The measured CPU time of each cycle: `{ kind = "measured" }` (machine-dependent).
+    Measured {},
+}
+
+impl Default for Latency {
+    fn default() -> Self {
+        Latency::Fixed { seconds: None }
+    }
+}
+
+/// Section `[sim]`: the closed loop's clocks.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimSection {
+    /// Physics (and control) step (s). Default 0.002 s: the 500 Hz the vehicle model was
+    /// validated at (`trust_world::vehicle`).
+    pub physics_dt_s: f64,
+    /// Replanning rate (Hz); its period must be a multiple of `physics_dt_s`. Default 10 Hz
+    /// (design.md §4).
+    pub replan_rate_hz: f64,
+    /// State-record rate of the run log (Hz), `≥ 50` (run-log contract); its period must be a
+    /// multiple of `physics_dt_s`. Default 50 Hz.
+    pub log_rate_hz: f64,
+    /// Latency model. Default fixed at the manager's latency.
+    pub latency: Latency,
+}
+
+impl Default for SimSection {
+    fn default() -> Self {
+        SimSection {
+            physics_dt_s: 0.002,
+            replan_rate_hz: 10.0,
+            log_rate_hz: 50.0,
+            latency: Latency::default(),
+        }
+    }
+}

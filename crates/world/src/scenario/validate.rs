@@ -1,0 +1,400 @@
+//! [`Scenario::validate`]: every semantic check, collecting all problems.
+
+use trust_core::{Aabb, Vec3};
+use trust_geometry::{MAX_VOXELS, checked_voxel_count};
+
+use super::{Latency, MovingShapeKind, PointCloudSpec, Problem, Scenario};
+use crate::problem::{Problems, fmt_bounds, fmt_vec};
+use crate::scenario::points::read_points_file;
+use trust_vehicle::VehicleError;
+
+/// Relative tolerance of "a period is an integer multiple of the physics step".
+const DIVIDE_TOLERANCE: f64 = 1e-9;
+
+/// The run-log contract's lowest state-record rate (Hz).
+const MIN_LOG_RATE_HZ: f64 = 50.0;
+
+/// What the file-level checks found, and what they computed that the world build reuses (the
+/// bounds, and the cloud points read from the file, so that a points file is read once per build).
+pub(crate) struct FileCheck {
+    /// Every problem, in file order.
+    pub(crate) problems: Problems,
+    /// The world bounds, if given and valid.
+    pub(crate) bounds: Option<Aabb>,
+    /// The cloud points that are truth (inline or file), if any and readable.
+    pub(crate) cloud_points: Option<Vec<Vec3>>,
+    /// Bounds, static map, obstacles, mission and vehicle radius are valid, so the layout can be
+    /// generated and checked (`generate::check_layout`).
+    pub(crate) geometry_ok: bool,
+}
+
+impl Scenario {
+    /// Every semantic problem of the scenario that the file alone shows, in file order (empty:
+    /// valid). The checks against the generated layout (start and goal clear of generated shapes
+    /// and cloud points) run where the layout is generated, in [`crate::World::build`] and
+    /// [`crate::check`], so that a world is generated once.
+    ///
+    /// Checks: non-finite numbers; non-positive sizes, limits, rates and time limit; bounds with
+    /// `min ≥ max`; start and goal outside the bounds, inside or within the vehicle radius of a
+    /// static shape or cloud point, the start within the vehicle radius of a moving obstacle at
+    /// `t = 0`; moving obstacles not fitting their region; rates whose periods are not integer
+    /// multiples of the physics step (within 1e-9 relative); a log rate below 50 Hz; bad
+    /// parameters of the frontend, backend, checker and manager (their own `validate()`, with
+    /// field paths under `planner.`), of the vehicle model, the EKF and the generators; a missing
+    /// or malformed points file; an empty inline cloud; an ESDF grid above
+    /// `trust_geometry::MAX_VOXELS` voxels (computed without allocating); a dropout probability
+    /// outside `[0, 1)`. Names (planner, kinds) are checked when the file is parsed.
+    pub fn validate(&self) -> Vec<Problem> {
+        self.check_file().problems.list
+    }
+
+    /// The checks of [`Scenario::validate`], with what they computed.
+    pub(crate) fn check_file(&self) -> FileCheck {
+        let mut p = Problems::default();
+        if self.name.trim().is_empty() {
+            p.push("name", "\"\"", "a non-empty name");
+        }
+        p.positive("time_limit_s", self.time_limit_s);
+
+        let geometry_start = p.list.len();
+        let bounds = self.check_world(&mut p);
+        let cloud_points = self.check_static(&mut p, bounds.as_ref());
+        self.check_obstacles(&mut p, bounds.as_ref());
+        self.check_mission(&mut p, bounds.as_ref());
+        let radius_ok = p.positive("vehicle.radius_m", self.vehicle.radius_m);
+        let geometry_ok = p.list.len() == geometry_start && radius_ok;
+
+        self.check_vehicle(&mut p);
+        p.list.extend(self.planner.problems());
+        self.sensing.check("sensing", &mut p);
+        p.non_negative("traffic.fault_level", self.traffic.fault_level);
+        self.check_sim(&mut p);
+        FileCheck {
+            problems: p,
+            bounds,
+            cloud_points,
+            geometry_ok,
+        }
+    }
+
+    fn check_world(&self, p: &mut Problems) -> Option<Aabb> {
+        if let Some(g) = &self.world.generator {
+            g.check("world.generator", p);
+        }
+        match (&self.world.bounds, &self.world.generator) {
+            (None, None) => {
+                p.push(
+                    "world.bounds",
+                    "(missing)",
+                    "bounds { min = [x, y, z], max = [x, y, z] } when there is no world.generator",
+                );
+                None
+            }
+            (Some(b), _) if !b.is_valid() => {
+                p.push(
+                    "world.bounds",
+                    fmt_bounds(&b.min, &b.max),
+                    "finite bounds with min < max on every axis",
+                );
+                None
+            }
+            _ => self.bounds(),
+        }
+    }
+
+    /// Checks `[static]`; returns the cloud points that are truth (inline or file), if readable.
+    fn check_static(&self, p: &mut Problems, bounds: Option<&Aabb>) -> Option<Vec<Vec3>> {
+        for (i, s) in self.static_map.shapes.iter().enumerate() {
+            check_shape(p, &format!("static.shapes[{i}]"), s);
+        }
+        let cloud = self.static_map.point_cloud.as_ref()?;
+        let voxel = cloud.esdf_voxel_m();
+        if p.positive("static.point_cloud.esdf_voxel_m", voxel)
+            && let Some(b) = bounds
+        {
+            let dims = esdf_dims(b, voxel);
+            if checked_voxel_count(dims).is_err() {
+                let count = dims.iter().map(|&d| d as f64).product::<f64>();
+                p.push(
+                    "static.point_cloud.esdf_voxel_m",
+                    voxel,
+                    format!(
+                        "a voxel size giving at most {MAX_VOXELS} voxels over world.bounds \
+                         (this one gives {} x {} x {} = {count:.3e})",
+                        dims[0], dims[1], dims[2]
+                    ),
+                );
+            }
+        }
+        match cloud {
+            PointCloudSpec::Shapes { spacing_m, .. } => {
+                if let Some(s) = spacing_m {
+                    p.positive("static.point_cloud.spacing_m", *s);
+                }
+                None
+            }
+            PointCloudSpec::Inline { points, .. } => {
+                if points.is_empty() {
+                    p.push(
+                        "static.point_cloud.points",
+                        "[]",
+                        "at least one point [x, y, z]",
+                    );
+                    return None;
+                }
+                let mut ok = true;
+                for (i, q) in points.iter().enumerate() {
+                    ok &= p.finite_vec(&format!("static.point_cloud.points[{i}]"), q);
+                }
+                ok.then(|| points.iter().map(|q| Vec3::from(*q)).collect())
+            }
+            PointCloudSpec::File { path, .. } => {
+                let full = self.resolve_path(path);
+                match read_points_file(&full) {
+                    Ok(pts) if pts.is_empty() => {
+                        p.push(
+                            "static.point_cloud.path",
+                            format!("{:?}", path.display().to_string()),
+                            format!(
+                                "a file with at least one `x y z` line ({} has none)",
+                                full.display()
+                            ),
+                        );
+                        None
+                    }
+                    Ok(pts) => Some(pts),
+                    Err(e) => {
+                        p.push(
+                            "static.point_cloud.path",
+                            format!("{:?}", path.display().to_string()),
+                            format!("a readable file of `x y z` lines ({e})"),
+                        );
+                        None
+                    }
+                }
+            }
+        }
+    }
+
+    fn check_obstacles(&self, p: &mut Problems, bounds: Option<&Aabb>) {
+        for (i, o) in self.obstacles.iter().enumerate() {
+            let field = format!("obstacles[{i}]");
+            match (o.shape, o.half_height_m) {
+                (MovingShapeKind::Cylinder, None) => p.push(
+                    format!("{field}.half_height_m"),
+                    "(missing)",
+                    "a half-height > 0 for a cylinder",
+                ),
+                (MovingShapeKind::Sphere, Some(h)) => p.push(
+                    format!("{field}.half_height_m"),
+                    h,
+                    "no half-height for a sphere (use shape = \"cylinder\")",
+                ),
+                _ => {}
+            }
+            let region = match (&o.region, bounds) {
+                (Some(r), _) => Some(r.aabb()),
+                (None, Some(b)) => Some(*b),
+                (None, None) => None,
+            };
+            if let Some(region) = region {
+                let m = crate::traffic::MovingObstacle {
+                    shape: o.moving_shape(),
+                    position: Vec3::from(o.position),
+                    velocity: Vec3::from(o.velocity),
+                    motion: o.motion.clone(),
+                    region,
+                };
+                let mut sub = Problems::default();
+                m.check(&field, &mut sub);
+                // A missing half-height was reported above; its 0 would be reported again.
+                sub.list.retain(|q| {
+                    !(o.half_height_m.is_none() && q.field == format!("{field}.half_height_m"))
+                });
+                p.list.extend(sub.list);
+            }
+        }
+        for (i, g) in self.random_obstacles.iter().enumerate() {
+            let f = |name: &str| format!("random_obstacles[{i}].{name}");
+            p.probability(&f("cylinder_fraction"), g.cylinder_fraction);
+            p.range(&f("sphere_radius_m"), g.sphere_radius_m, true);
+            p.range(&f("cylinder_radius_m"), g.cylinder_radius_m, true);
+            if let Some(h) = g.cylinder_half_height_m {
+                p.range(&f("cylinder_half_height_m"), h, true);
+            }
+            p.range(&f("speed_m_s"), g.speed_m_s, false);
+            if !(0.0..=90.0).contains(&g.max_climb_deg) {
+                p.push(
+                    f("max_climb_deg"),
+                    g.max_climb_deg,
+                    "an angle in [0, 90] degrees",
+                );
+            }
+            if let Some(r) = &g.region
+                && !r.is_valid()
+            {
+                p.push(
+                    f("region"),
+                    fmt_bounds(&r.min, &r.max),
+                    "finite bounds with min < max on every axis",
+                );
+            }
+            p.non_negative(&f("endpoint_clearance_m"), g.endpoint_clearance_m);
+            super::generator::check_motion(&f("motion"), &g.motion, p);
+        }
+    }
+
+    fn check_mission(&self, p: &mut Problems, bounds: Option<&Aabb>) {
+        let m = &self.mission;
+        for (name, q) in [("mission.start", &m.start), ("mission.goal", &m.goal)] {
+            if !p.finite_vec(name, q) {
+                continue;
+            }
+            if let Some(b) = bounds
+                && !b.contains(&Vec3::from(*q))
+            {
+                p.push(
+                    name,
+                    fmt_vec(q),
+                    format!(
+                        "a point inside world.bounds {}",
+                        fmt_bounds(b.min.as_slice(), b.max.as_slice())
+                    ),
+                );
+            }
+        }
+        p.positive("mission.goal_tolerance_m", m.goal_tolerance_m);
+    }
+
+    fn check_vehicle(&self, p: &mut Problems) {
+        let v = &self.vehicle;
+        p.positive("vehicle.limits.v_max", v.limits.v_max);
+        p.positive("vehicle.limits.a_max", v.limits.a_max);
+        if let Err(e) = v.quadrotor.validate() {
+            p.list.push(vehicle_problem(e, "vehicle.quadrotor"));
+        }
+        if let Err(e) = v.gains.validate() {
+            p.list.push(vehicle_problem(e, "vehicle.gains"));
+        }
+    }
+
+    fn check_sim(&self, p: &mut Problems) {
+        let s = &self.sim;
+        let dt_ok = p.positive("sim.physics_dt_s", s.physics_dt_s);
+        let sensing_ok = self.sensing.rate_hz.is_finite() && self.sensing.rate_hz > 0.0;
+        let rates = [
+            ("sim.replan_rate_hz", s.replan_rate_hz, true),
+            ("sim.log_rate_hz", s.log_rate_hz, true),
+            ("sensing.rate_hz", self.sensing.rate_hz, false),
+        ];
+        for (name, rate, report_sign) in rates {
+            let ok = if report_sign {
+                p.positive(name, rate)
+            } else {
+                sensing_ok
+            };
+            if !(ok && dt_ok) {
+                continue;
+            }
+            let period = 1.0 / rate;
+            let n = period / s.physics_dt_s;
+            let k = n.round();
+            if k < 1.0 || (n - k).abs() > DIVIDE_TOLERANCE * n {
+                p.push(
+                    name,
+                    rate,
+                    format!(
+                        "a rate whose period (1/{rate} = {period} s) is an integer multiple of \
+                         sim.physics_dt_s ({} s); it is {n} steps",
+                        s.physics_dt_s
+                    ),
+                );
+            }
+        }
+        if s.log_rate_hz.is_finite() && s.log_rate_hz > 0.0 && s.log_rate_hz < MIN_LOG_RATE_HZ {
+            p.push(
+                "sim.log_rate_hz",
+                s.log_rate_hz,
+                format!(
+                    "at least {MIN_LOG_RATE_HZ} Hz (run-log contract: state records at >= 50 Hz)"
+                ),
+            );
+        }
+        if let Latency::Fixed {
+            seconds: Some(seconds),
+        } = s.latency
+        {
+            p.non_negative("sim.latency.seconds", seconds);
+        }
+    }
+}
+
+/// Voxels per axis of an ESDF of `resolution` over `bounds`, as `Esdf::from_points` computes
+/// them (without allocating).
+pub(crate) fn esdf_dims(bounds: &Aabb, resolution: f64) -> [usize; 3] {
+    let ext = bounds.extent();
+    let mut dims = [0usize; 3];
+    for i in 0..3 {
+        let n = (ext[i] / resolution * (1.0 - 1e-12)).ceil().max(1.0);
+        dims[i] = if n < 1e15 { n as usize } else { usize::MAX / 4 };
+    }
+    dims
+}
+
+fn check_shape(p: &mut Problems, field: &str, s: &super::ShapeSpec) {
+    use super::ShapeSpec;
+    match *s {
+        ShapeSpec::Sphere { center, radius } => {
+            p.finite_vec(&format!("{field}.center"), &center);
+            p.positive(&format!("{field}.radius"), radius);
+        }
+        ShapeSpec::Cylinder {
+            center,
+            radius,
+            z_min,
+            z_max,
+        } => {
+            p.finite_vec(&format!("{field}.center"), &center);
+            p.positive(&format!("{field}.radius"), radius);
+            let a = p.finite(&format!("{field}.z_min"), z_min);
+            let b = p.finite(&format!("{field}.z_max"), z_max);
+            if a && b && z_min >= z_max {
+                p.push(
+                    format!("{field}.z_max"),
+                    z_max,
+                    format!("a top above z_min = {z_min}"),
+                );
+            }
+        }
+        ShapeSpec::Box { min, max } => {
+            let a = p.finite_vec(&format!("{field}.min"), &min);
+            let b = p.finite_vec(&format!("{field}.max"), &max);
+            if a && b {
+                for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+                    if min[i] >= max[i] {
+                        p.push(
+                            format!("{field}.max"),
+                            fmt_vec(&max),
+                            format!("max.{axis} > min.{axis} = {} (a box with volume)", min[i]),
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn vehicle_problem(e: VehicleError, prefix: &str) -> Problem {
+    match e {
+        VehicleError::NonFinite { field, value } => {
+            Problem::new(format!("{prefix}.{field}"), value, "a finite number")
+        }
+        VehicleError::OutOfRange {
+            field,
+            value,
+            expected,
+        } => Problem::new(format!("{prefix}.{field}"), value, expected),
+        // `VehicleError` is `#[non_exhaustive]`: a future variant still names the section.
+        other => Problem::new(prefix, other, "valid vehicle parameters"),
+    }
+}
