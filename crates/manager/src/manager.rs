@@ -227,7 +227,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         check_step_input(now, measured, goal, scene)?;
         let mut cycle = self.begin_cycle(now, measured, spans.started);
 
-        // Algorithm 1, lines 4–8: FwdMarch of the main branch and BwdReplan of the sub-branches,
+        // Algorithm 1, lines 5–8: FwdMarch of the main branch and BwdReplan of the sub-branches,
         // in parallel with FwdExplore.
         let warm = self.warm_branches();
         let (explored, resolved) = self.solve_in_parallel(&cycle, goal, scene, &warm, &mut spans);
@@ -241,23 +241,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
 
         // Algorithm 1, line 9: AddNewBranch (with PopBack) for each explored trajectory that
         // passes the safety pass.
-        let incumbent = self.main.filter(|_| self.params.history);
         for cand in explored.candidates {
-            let Some((solution, verdict)) = self.safety_pass(cand, None, &mut cycle, &mut spans)
-            else {
-                continue;
-            };
-            let new = Branch {
-                id: 0,
-                j: solution.costs.ranking_cost(&cycle.weights),
-                solution,
-                origin: Origin::Explored,
-                warm_started: false,
-                verdict,
-            };
-            spans.time(Span::Checks, || {
-                self.add_new_branch(&mut kept, new, scene, incumbent, &mut cycle.events);
-            });
+            self.explored_branch(&mut kept, cand, &mut cycle, scene, &mut spans);
         }
 
         // The main branch (hysteresis), PopBack protecting it, and the fallback without one.
@@ -443,6 +428,33 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         }
         sort_by_j(&mut kept);
         kept
+    }
+
+    /// One explored trajectory through the safety pass and, if it passes, AddNewBranch (whose
+    /// PopBack protects the incumbent main branch).
+    fn explored_branch(
+        &mut self,
+        kept: &mut Vec<Branch>,
+        cand: Candidate,
+        cycle: &mut Cycle,
+        scene: &Scene<'_>,
+        spans: &mut Spans,
+    ) {
+        let Some((solution, verdict)) = self.safety_pass(cand, None, cycle, spans) else {
+            return;
+        };
+        let new = Branch {
+            id: 0,
+            j: solution.costs.ranking_cost(&cycle.weights),
+            solution,
+            origin: Origin::Explored,
+            warm_started: false,
+            verdict,
+        };
+        let incumbent = self.main.filter(|_| self.params.history);
+        spans.time(Span::Checks, || {
+            self.add_new_branch(kept, new, scene, incumbent, &mut cycle.events);
+        });
     }
 
     /// Commits the main branch, or with none the braking fallback ([`Manager::fallback`]).
