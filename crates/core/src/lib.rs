@@ -14,6 +14,12 @@
 //! | [`TrajectoryBackend`] | MINCO, UTF-MINCO (`trust-minco`) | Sec. III-D |
 //! | [`HomotopyChecker`] | UVD, TVD (`trust-topo-prm`) | Sec. III-A |
 //!
+//! A few pieces of mathematics that several stages share live here once, as free functions:
+//! [`bernstein_points`] (convex-hull bounds of a polynomial piece; the manager's safety check and
+//! UTF-MINCO's penalty integration), [`guidance_radius`] (`r_des` of the goal guidance surface;
+//! DEV-PRM and UTF-MINCO) and [`straight_end`] (the straight guide; the straight-line frontend
+//! and the manager).
+//!
 //! Use this crate when you write a new frontend, backend or checker, or when you drive the planner
 //! yourself. It depends only on `trust-geometry` and `trust-predict`; implementations depend on it,
 //! never the reverse.
@@ -37,8 +43,10 @@
 //! ```
 #![warn(missing_docs)]
 
+mod bernstein;
 mod curve;
 mod error;
+mod guidance;
 mod path;
 mod scene;
 mod solution;
@@ -46,11 +54,13 @@ mod state;
 mod traits;
 mod traj;
 
+pub use bernstein::bernstein_points;
 pub use curve::Curve;
 pub use error::{
     PlanError, check_finite, check_finite_vec, check_non_negative, check_positive, check_scaled,
     check_scaled_vec,
 };
+pub use guidance::{guidance_radius, straight_end};
 pub use path::GuidePath;
 pub use scene::Scene;
 pub use solution::{CostBreakdown, RankingWeights, Solution, SolveStats, SolveStatus};

@@ -7,8 +7,7 @@ use crate::LbfgsError;
 /// Parameters of the L-BFGS solver.
 ///
 /// The defaults are those of LBFGS-Lite (Zhepei Wang, `lbfgs.hpp`, `lbfgs_parameter_t` and its
-/// default initializer), as recorded in `shared/reference/minco-lbfgs.md`, section "LBFGS-Lite";
-/// `max_evaluations` is our addition (LBFGS-Lite has no evaluation budget) and defaults to
+/// default initializer); `max_evaluations` is our addition (LBFGS-Lite has no evaluation budget) and defaults to
 /// "unlimited" so that the defaults behave exactly as LBFGS-Lite's.
 ///
 /// Call [`LbfgsParams::validate`] (done by [`crate::Lbfgs::new`]) to check the ranges.

@@ -55,6 +55,20 @@
 //! assert_eq!(plan.t_start(), report.replan_start.t);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! # Changelog
+//!
+//! - `Manager::step` follows Algorithm 1 step by step (`fwd_march`, `bwd_replan`, `fwd_explore`,
+//!   the safety pass, `add_new_branch` with `pop_back`, the main-branch choice and the fallback);
+//!   FwdExplore's cold solves now start as soon as the frontend returns, in parallel with the warm
+//!   re-solves, instead of after them. Results, events and their order are unchanged (the run logs
+//!   of `trust-sim run` are byte-identical); [`CycleTiming`] keeps its fields and meaning.
+//! - `safety::bernstein_points` moved to `trust_core::bernstein_points` (arrays in, arrays out);
+//!   `safety::piece_speed_bound`, `piece_box`, `window_bounds` and `forecasts_near` are now
+//!   internal (they were public only for tests).
+//! - The manager's homotopy checks and the safety check share one nearby-forecast filter; a
+//!   forecast whose swept box cannot be computed (a non-finite window, which neither caller
+//!   produces) now counts as near in both.
 #![warn(missing_docs)]
 
 pub mod brake;

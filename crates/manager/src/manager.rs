@@ -5,9 +5,9 @@ use std::time::{Duration, Instant};
 use rand::SeedableRng;
 use rayon::prelude::*;
 use trust_core::{
-    Aabb, Forecast, GuidePath, HomotopyChecker, InitialGuess, Limits, PathFrontend, PathQuery,
-    PlanError, PolyTraj, RankingWeights, Rng, Scene, Solution, State, TrajRequest,
-    TrajectoryBackend, Vec3, check_finite, check_finite_vec,
+    Forecast, GuidePath, HomotopyChecker, InitialGuess, Limits, PathFrontend, PathQuery, PlanError,
+    PolyTraj, RankingWeights, Rng, Scene, Solution, State, TrajRequest, TrajectoryBackend, Vec3,
+    check_finite, check_finite_vec, straight_end,
 };
 
 use crate::ManagerParams;
@@ -16,7 +16,9 @@ use crate::report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
     Origin, StepReport,
 };
-use crate::safety::{SafetyVerdict, assess_trajectory, check_trajectory, window_bounds};
+use crate::safety::{
+    SafetyVerdict, assess_trajectory, check_trajectory, forecasts_near, window_bounds,
+};
 
 /// One kept trajectory branch.
 #[derive(Debug, Clone, PartialEq)]
@@ -221,40 +223,108 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         goal: &Vec3,
         scene: &Scene<'_>,
     ) -> Result<StepReport, PlanError> {
-        let started = Instant::now();
-        check_finite("now", now)?;
-        measured.validate("state")?;
-        check_finite_vec("goal", goal)?;
-        scene.check_in_bounds("goal", goal)?;
-        scene.check_static_free("goal", goal, 0.0)?;
+        let mut spans = Spans::start();
+        check_step_input(now, measured, goal, scene)?;
+        let mut cycle = self.begin_cycle(now, measured, spans.started);
 
-        let weights = self.params.ranking_weights(&self.limits);
+        // Algorithm 1, lines 5–8: FwdMarch of the main branch and BwdReplan of the sub-branches,
+        // in parallel with FwdExplore.
+        let warm = self.warm_branches();
+        let (explored, resolved) = self.solve_in_parallel(&cycle, goal, scene, &warm, &mut spans);
+        if let Some(error) = explored.frontend_error {
+            cycle.events.push(Event::FrontendFailed { error });
+        }
+
+        // The safety pass over the re-solved branches, then one branch per homotopy class.
+        let kept = self.keep_resolved(warm, resolved, &mut cycle, scene, &mut spans);
+        let mut kept = spans.time(Span::Checks, || self.dedupe(kept, scene, &mut cycle.events));
+
+        // Algorithm 1, line 9: AddNewBranch (with PopBack) for each explored trajectory that
+        // passes the safety pass.
+        for cand in explored.candidates {
+            self.explored_branch(&mut kept, cand, &mut cycle, scene, &mut spans);
+        }
+
+        // The main branch (hysteresis), PopBack protecting it, and the fallback without one.
+        let main = self.select_main(&kept, &cycle.start, goal, &cycle.weights, &mut cycle.events);
+        pop_back(&mut kept, self.params.max_branches, main, &mut cycle.events);
+        let fallback = self.commit(main, &kept, &mut cycle, scene, &mut spans);
+        self.branches = kept;
+        Ok(StepReport {
+            t: now,
+            replan_start: cycle.start,
+            main: self.main,
+            branches: self
+                .branches
+                .iter()
+                .map(|b| b.report(Some(b.id) == self.main))
+                .collect(),
+            events: cycle.events,
+            frontend: explored.frontend,
+            straight_guide: explored.straight_guide,
+            timing: spans.finish(),
+            fallback,
+        })
+    }
+
+    /// The cycle's starting point: the replan start, the ranking weights, the deadline and
+    /// whether FwdExplore runs this cycle.
+    fn begin_cycle(&mut self, now: f64, measured: &State, started: Instant) -> Cycle {
         let mut events = Vec::new();
         let (start, reanchored) = self.replan_start(now, measured, &mut events);
-        let deadline = self
-            .params
-            .enforce_budget
-            .then(|| started + Duration::from_secs_f64(self.params.cycle_budget_ms * 1e-3));
-
-        // Warm re-solves (FwdMarch, BwdReplan) in parallel with the frontend, then the cold solves.
-        let history = self.params.history;
-        let warm: Vec<(BranchId, Origin, PolyTraj)> = if history {
-            self.branches
-                .iter()
-                .map(|b| {
-                    let origin = if Some(b.id) == self.main {
-                        Origin::Marched
-                    } else {
-                        Origin::Replanned
-                    };
-                    (b.id, origin, b.solution.traj.clone())
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
-        let query = PathQuery {
+        let explore = !self.params.history
+            || self
+                .cycle_count
+                .is_multiple_of(self.params.explore_period_cycles as u64)
+            || self.branches.len() < 2
+            || self.main.is_none();
+        self.cycle_count += 1;
+        Cycle {
             start,
+            reanchored,
+            weights: self.params.ranking_weights(&self.limits),
+            deadline: self
+                .params
+                .enforce_budget
+                .then(|| started + Duration::from_secs_f64(self.params.cycle_budget_ms * 1e-3)),
+            explore,
+            events,
+            rejected: Vec::new(),
+        }
+    }
+
+    /// The kept branches to re-solve, in rank order: the main branch marches forward, the others
+    /// are replanned; none without history.
+    fn warm_branches(&self) -> Vec<(BranchId, Origin, PolyTraj)> {
+        if !self.params.history {
+            return Vec::new();
+        }
+        self.branches
+            .iter()
+            .map(|b| {
+                let origin = if Some(b.id) == self.main {
+                    Origin::Marched
+                } else {
+                    Origin::Replanned
+                };
+                (b.id, origin, b.solution.traj.clone())
+            })
+            .collect()
+    }
+
+    /// Runs [`Solver::fwd_march`] / [`Solver::bwd_replan`] on every `warm` branch (in parallel)
+    /// alongside [`fwd_explore`] when the cycle explores; the re-solves come back in `warm`'s
+    /// order.
+    fn solve_in_parallel(
+        &mut self,
+        cycle: &Cycle,
+        goal: &Vec3,
+        scene: &Scene<'_>,
+        warm: &[(BranchId, Origin, PolyTraj)],
+        spans: &mut Spans,
+    ) -> (Explored, Vec<Candidate>) {
+        let query = PathQuery {
+            start: cycle.start,
             goal: *goal,
             limits: self.limits,
             horizon_s: self.params.horizon_s,
@@ -262,217 +332,157 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let solver = Solver {
             backend: &self.backend,
             scene,
-            start,
+            start: cycle.start,
             goal: *goal,
             limits: self.limits,
             horizon_s: self.params.horizon_s,
-            deadline,
+            deadline: cycle.deadline,
             params: &self.params,
         };
-        let explore = !history
-            || self
-                .cycle_count
-                .is_multiple_of(self.params.explore_period_cycles as u64)
-            || self.branches.len() < 2
-            || self.main.is_none();
-        self.cycle_count += 1;
-        let frontend = &self.frontend;
-        let rng = &mut self.rng;
-        let (search, warm_out) = rayon::join(
-            || {
-                let t = Instant::now();
-                let r = if explore {
-                    Some(frontend.search(&query, scene, rng))
-                } else {
-                    None
-                };
-                (r, t.elapsed())
+        let (frontend, rng) = (&self.frontend, &mut self.rng);
+        rayon::join(
+            || match cycle.explore {
+                true => fwd_explore(frontend, rng, &query, &solver, spans),
+                false => Explored::default(),
             },
             || {
                 warm.par_iter()
-                    .map(|(_, origin, traj)| {
-                        let budget = match origin {
-                            Origin::Replanned => solver.params.sub_branch_max_evaluations,
-                            _ => None,
-                        }
-                        .or(solver.params.warm_max_evaluations);
-                        solver.repaired(solver.solve_with(InitialGuess::WarmStart(traj), budget))
+                    .map(|(_, origin, traj)| match origin {
+                        Origin::Marched => solver.fwd_march(traj),
+                        _ => solver.bwd_replan(traj),
                     })
-                    .collect::<Vec<_>>()
+                    .collect()
             },
-        );
-        let (search, frontend_time) = search;
-        let (paths, frontend_report) = match search {
-            None => (Vec::new(), None),
-            Some(Ok(mut result)) => {
-                let path_count = result.paths.len();
-                result.paths.truncate(self.params.max_explored_paths);
-                let report = FrontendReport {
-                    name: self.frontend.name().to_string(),
-                    path_count,
-                    explored_count: result.paths.len(),
-                    stats: result.stats,
-                };
-                (result.paths, Some(report))
-            }
-            Some(Err(e)) => {
-                events.push(Event::FrontendFailed {
+        )
+    }
+
+    /// The safety pass over one solved trajectory: its statistics go to the cycle's timing; a
+    /// solve error (`SolveFailed`) or a failed safety check (`DroppedCollision`, the trajectory
+    /// kept in `cycle.rejected` for the fallback) drops it, otherwise it is returned. `id` is the
+    /// re-solved branch, `None` for an explored candidate (a cold solve).
+    fn safety_pass(
+        &self,
+        cand: Candidate,
+        id: Option<BranchId>,
+        cycle: &mut Cycle,
+        spans: &mut Spans,
+    ) -> Option<(Solution, SafetyVerdict)> {
+        spans.solved(&cand, id.is_none());
+        if cand.repaired {
+            cycle.events.push(Event::Repaired { id });
+        }
+        match cand.result {
+            Err(e) => {
+                cycle.events.push(Event::SolveFailed {
+                    id,
                     error: e.to_string(),
                 });
-                (Vec::new(), None)
+                None
             }
-        };
-        let mut paths = paths;
-        let mut fallback_guide = false;
-        if explore && paths.is_empty() && self.params.straight_guide_when_empty {
-            // Beyond the paper: never explore empty-handed. The frontend's cones are
-            // conservative (an obstacle's whole sweep over the horizon), so in crowded moments it
-            // may find no path while a trajectory that passes behind an obstacle exists; the
-            // straight guide lets the backend look for it in time.
-            let reach = self.params.horizon_s * self.limits.v_max;
-            let d = (goal - start.p).norm();
-            let end = if d <= reach || d == 0.0 {
-                *goal
-            } else {
-                start.p + (goal - start.p) * (reach / d)
-            };
-            if let Ok(g) = GuidePath::new(vec![start.p, end]) {
-                paths.push(g);
-                fallback_guide = true;
+            Ok((solution, verdict)) if verdict.safe => Some((solution, verdict)),
+            Ok((solution, verdict)) => {
+                cycle
+                    .events
+                    .push(dropped_collision(id, &verdict, &self.limits));
+                let kind = if id.is_some() { "branch" } else { "candidate" };
+                cycle.rejected.push((kind, solution.traj));
+                None
             }
         }
-        let cold_out: Vec<Candidate> = paths
-            .par_iter()
-            .map(|p: &GuidePath| {
-                solver.repaired(
-                    solver.solve_with(InitialGuess::Guide(p), self.params.cold_max_evaluations),
-                )
-            })
-            .collect();
+    }
 
-        let mut timing = CycleTiming {
-            frontend_ms: ms(frontend_time),
-            ..CycleTiming::default()
-        };
-        let mut rejected: Vec<(&'static str, PolyTraj)> = Vec::new();
-
-        // Kept branches, re-solved.
+    /// The re-solved branches that pass the safety pass, sorted by `J`; a main branch whose
+    /// re-solve failed keeps its committed trajectory if that still passes
+    /// ([`Manager::keep_committed`]), unless the replan was re-anchored.
+    fn keep_resolved(
+        &self,
+        warm: Vec<(BranchId, Origin, PolyTraj)>,
+        resolved: Vec<Candidate>,
+        cycle: &mut Cycle,
+        scene: &Scene<'_>,
+        spans: &mut Spans,
+    ) -> Vec<Branch> {
         let mut kept: Vec<Branch> = Vec::new();
-        for ((id, origin, _), cand) in warm.into_iter().zip(warm_out) {
-            timing.add(&cand, false);
-            if cand.repaired {
-                events.push(Event::Repaired { id: Some(id) });
-            }
-            let failed = match cand.result {
-                Err(e) => {
-                    events.push(Event::SolveFailed {
-                        id: Some(id),
-                        error: e.to_string(),
+        for ((id, origin, _), cand) in warm.into_iter().zip(resolved) {
+            match self.safety_pass(cand, Some(id), cycle, spans) {
+                Some((solution, verdict)) => kept.push(Branch {
+                    id,
+                    j: solution.costs.ranking_cost(&cycle.weights),
+                    solution,
+                    origin,
+                    warm_started: true,
+                    verdict,
+                }),
+                None if origin == Origin::Marched && !cycle.reanchored => {
+                    let (start, weights) = (cycle.start, cycle.weights);
+                    let previous = spans.time(Span::Checks, || {
+                        self.keep_committed(id, &start, scene, &weights)
                     });
-                    true
+                    if let Some(b) = previous {
+                        cycle.events.push(Event::KeptCommitted { id });
+                        kept.push(b);
+                    }
                 }
-                Ok((solution, verdict)) if verdict.safe => {
-                    kept.push(Branch {
-                        id,
-                        j: solution.costs.ranking_cost(&weights),
-                        solution,
-                        origin,
-                        warm_started: true,
-                        verdict,
-                    });
-                    false
-                }
-                Ok((solution, verdict)) => {
-                    events.push(dropped_collision(Some(id), &verdict, &self.limits));
-                    rejected.push(("branch", solution.traj));
-                    true
-                }
-            };
-            if failed && origin == Origin::Marched && !reanchored {
-                let t = Instant::now();
-                if let Some(b) = self.keep_committed(id, &start, scene, &weights) {
-                    events.push(Event::KeptCommitted { id });
-                    kept.push(b);
-                }
-                timing.checker_ms += ms(t.elapsed());
+                None => {}
             }
         }
         sort_by_j(&mut kept);
-        let mut check_time = Duration::ZERO;
-        if kept.len() > 1 {
-            let t = Instant::now();
-            kept = self.dedupe(kept, scene, &mut events);
-            check_time += t.elapsed();
-        }
+        kept
+    }
 
-        // AddNewBranch for each explored trajectory.
-        let incumbent = if history { self.main } else { None };
-        for cand in cold_out {
-            timing.add(&cand, true);
-            if cand.repaired {
-                events.push(Event::Repaired { id: None });
-            }
-            match cand.result {
-                Err(e) => events.push(Event::SolveFailed {
-                    id: None,
-                    error: e.to_string(),
-                }),
-                Ok((solution, verdict)) if !verdict.safe => {
-                    events.push(dropped_collision(None, &verdict, &self.limits));
-                    rejected.push(("candidate", solution.traj));
-                }
-                Ok((solution, verdict)) => {
-                    let t = Instant::now();
-                    let new = Branch {
-                        id: 0,
-                        j: solution.costs.ranking_cost(&weights),
-                        solution,
-                        origin: Origin::Explored,
-                        warm_started: false,
-                        verdict,
-                    };
-                    self.add_new_branch(&mut kept, new, scene, incumbent, &mut events);
-                    check_time += t.elapsed();
-                }
-            }
-        }
-        timing.checker_ms += ms(check_time);
+    /// One explored trajectory through the safety pass and, if it passes, AddNewBranch (whose
+    /// PopBack protects the incumbent main branch).
+    fn explored_branch(
+        &mut self,
+        kept: &mut Vec<Branch>,
+        cand: Candidate,
+        cycle: &mut Cycle,
+        scene: &Scene<'_>,
+        spans: &mut Spans,
+    ) {
+        let Some((solution, verdict)) = self.safety_pass(cand, None, cycle, spans) else {
+            return;
+        };
+        let new = Branch {
+            id: 0,
+            j: solution.costs.ranking_cost(&cycle.weights),
+            solution,
+            origin: Origin::Explored,
+            warm_started: false,
+            verdict,
+        };
+        let incumbent = self.main.filter(|_| self.params.history);
+        spans.time(Span::Checks, || {
+            self.add_new_branch(kept, new, scene, incumbent, &mut cycle.events);
+        });
+    }
 
-        // The main branch, with hysteresis.
-        let new_main = self.select_main(&kept, &start, goal, &weights, &mut events);
-        pop_back(&mut kept, self.params.max_branches, new_main, &mut events);
-
-        let mut fallback = None;
-        match new_main.and_then(|id| kept.iter().find(|b| b.id == id)) {
-            Some(main) => {
-                self.committed = Some(main.solution.traj.clone());
-                self.main = Some(main.id);
-            }
-            None => {
-                let t = Instant::now();
-                let report = self.fallback(&start, reanchored, &rejected, scene, &mut events);
-                timing.checker_ms += ms(t.elapsed());
-                fallback = report;
-                self.main = None;
-            }
+    /// Commits the main branch, or with none the braking fallback ([`Manager::fallback`]).
+    fn commit(
+        &mut self,
+        main: Option<BranchId>,
+        kept: &[Branch],
+        cycle: &mut Cycle,
+        scene: &Scene<'_>,
+        spans: &mut Spans,
+    ) -> Option<FallbackReport> {
+        if let Some(main) = main.and_then(|id| kept.iter().find(|b| b.id == id)) {
+            self.committed = Some(main.solution.traj.clone());
+            self.main = Some(main.id);
+            return None;
         }
-        self.branches = kept;
-        timing.wall_ms = ms(started.elapsed());
-        Ok(StepReport {
-            t: now,
-            replan_start: start,
-            main: self.main,
-            branches: self
-                .branches
-                .iter()
-                .map(|b| b.report(Some(b.id) == self.main))
-                .collect(),
-            events,
-            frontend: frontend_report,
-            straight_guide: fallback_guide,
-            timing,
-            fallback,
-        })
+        let (start, reanchored) = (cycle.start, cycle.reanchored);
+        let report = spans.time(Span::Checks, || {
+            self.fallback(
+                &start,
+                reanchored,
+                &cycle.rejected,
+                scene,
+                &mut cycle.events,
+            )
+        });
+        self.main = None;
+        report
     }
 
     /// The state the new plan starts from, and whether it was re-anchored on the measurement.
@@ -622,17 +632,9 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let until = a.t_end().max(b.t_end());
         let (_, box_a) = window_bounds(a, from, until);
         let (_, box_b) = window_bounds(b, from, until);
-        let region: Aabb = box_a.union(&box_b);
-        let near: Vec<Forecast> = scene
-            .forecasts
-            .iter()
-            .filter(|f| {
-                f.aabb_over(from, until)
-                    .map(|x| x.intersects(&region))
-                    .unwrap_or(true)
-            })
-            .copied()
-            .collect();
+        let mut indices = Vec::new();
+        forecasts_near(scene, &box_a.union(&box_b), from, until, 0.0, &mut indices);
+        let near: Vec<Forecast> = indices.iter().map(|&i| scene.forecasts[i]).collect();
         let sub = Scene {
             map: scene.map,
             forecasts: &near,
@@ -737,6 +739,177 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     }
 }
 
+/// Checks the inputs of [`Manager::step`].
+fn check_step_input(
+    now: f64,
+    measured: &State,
+    goal: &Vec3,
+    scene: &Scene<'_>,
+) -> Result<(), PlanError> {
+    check_finite("now", now)?;
+    measured.validate("state")?;
+    check_finite_vec("goal", goal)?;
+    scene.check_in_bounds("goal", goal)?;
+    scene.check_static_free("goal", goal, 0.0)
+}
+
+/// What one cycle carries from step to step of [`Manager::step`].
+struct Cycle {
+    /// The replan start ([`Manager::replan_start`]).
+    start: State,
+    /// Whether the replan start was re-anchored on the measured state.
+    reanchored: bool,
+    /// The ranking weights of `J`.
+    weights: RankingWeights,
+    /// The solves' deadline ([`ManagerParams::enforce_budget`]).
+    deadline: Option<Instant>,
+    /// Whether FwdExplore runs this cycle ([`ManagerParams::explore_period_cycles`]).
+    explore: bool,
+    /// The cycle's events, in order.
+    events: Vec<Event>,
+    /// Trajectories dropped by the safety pass, with what they were (`"branch"` or
+    /// `"candidate"`): the fallback may brake along them.
+    rejected: Vec<(&'static str, PolyTraj)>,
+}
+
+/// What [`fwd_explore`] found (empty when the cycle does not explore).
+#[derive(Default)]
+struct Explored {
+    /// The explored trajectories, solved cold and checked, in the frontend's order.
+    candidates: Vec<Candidate>,
+    /// The frontend's report (`None` if it failed or did not run).
+    frontend: Option<FrontendReport>,
+    /// The frontend's error, if it failed.
+    frontend_error: Option<String>,
+    /// Whether the straight guide was explored ([`ManagerParams::straight_guide_when_empty`]).
+    straight_guide: bool,
+}
+
+/// FwdExplore (Algorithm 1, line 8): the frontend's paths from the replan start (its first
+/// [`ManagerParams::max_explored_paths`]), each solved cold from the path and checked, in
+/// parallel.
+fn fwd_explore<F: PathFrontend, B: TrajectoryBackend>(
+    frontend: &F,
+    rng: &mut Rng,
+    query: &PathQuery,
+    solver: &Solver<'_, '_, B>,
+    spans: &mut Spans,
+) -> Explored {
+    let params = solver.params;
+    let mut explored = Explored::default();
+    let search = spans.time(Span::Frontend, || frontend.search(query, solver.scene, rng));
+    let mut paths = match search {
+        Ok(mut result) => {
+            let path_count = result.paths.len();
+            result.paths.truncate(params.max_explored_paths);
+            explored.frontend = Some(FrontendReport {
+                name: frontend.name().to_string(),
+                path_count,
+                explored_count: result.paths.len(),
+                stats: result.stats,
+            });
+            result.paths
+        }
+        Err(e) => {
+            explored.frontend_error = Some(e.to_string());
+            Vec::new()
+        }
+    };
+    if paths.is_empty() && params.straight_guide_when_empty {
+        // Beyond the paper: never explore empty-handed. The frontend's cones are conservative (an
+        // obstacle's whole sweep over the horizon), so in crowded moments it may find no path
+        // while a trajectory that passes behind an obstacle exists; the straight guide lets the
+        // backend look for it in time.
+        let reach = query.horizon_s * query.limits.v_max;
+        let end = straight_end(&query.start.p, &query.goal, reach);
+        if let Ok(g) = GuidePath::new(vec![query.start.p, end]) {
+            paths.push(g);
+            explored.straight_guide = true;
+        }
+    }
+    explored.candidates = paths
+        .par_iter()
+        .map(|p| {
+            let cold = solver.solve_with(InitialGuess::Guide(p), params.cold_max_evaluations);
+            solver.repaired(cold)
+        })
+        .collect();
+    explored
+}
+
+/// The named spans of a cycle that [`Spans`] times.
+#[derive(Debug, Clone, Copy)]
+enum Span {
+    /// The frontend search ([`CycleTiming::frontend_ms`]).
+    Frontend,
+    /// Homotopy checks, safety checks outside the parallel solves, and the fallback's
+    /// ([`CycleTiming::checker_ms`]).
+    Checks,
+}
+
+/// The span recorder of one cycle: the one place [`Manager::step`]'s [`CycleTiming`] is filled,
+/// from named spans timed here and from the solves' own statistics (each parallel solve measures
+/// its solve and safety check, carried in its [`Candidate`]).
+struct Spans {
+    started: Instant,
+    timing: CycleTiming,
+}
+
+impl Spans {
+    fn start() -> Self {
+        Spans {
+            started: Instant::now(),
+            timing: CycleTiming::default(),
+        }
+    }
+
+    /// Runs `f`, adding its wall time to `span`.
+    fn time<T>(&mut self, span: Span, f: impl FnOnce() -> T) -> T {
+        let t = Instant::now();
+        let out = f();
+        let elapsed = ms(t.elapsed());
+        match span {
+            Span::Frontend => self.timing.frontend_ms += elapsed,
+            Span::Checks => self.timing.checker_ms += elapsed,
+        }
+        out
+    }
+
+    /// Adds one solved candidate (both solves of a repair attempt); `cold`: a solve from a
+    /// frontend path.
+    fn solved(&mut self, cand: &Candidate, cold: bool) {
+        let timing = &mut self.timing;
+        timing.checker_ms += ms(cand.check_time);
+        if cand.repaired {
+            timing.repair_count += 1;
+        }
+        let other = cand.other_solve.map(|(solve, evaluations, check)| {
+            timing.checker_ms += ms(check);
+            (solve, evaluations)
+        });
+        let this = cand
+            .result
+            .as_ref()
+            .ok()
+            .map(|(s, _)| (s.stats.elapsed, s.stats.evaluation_count));
+        for (solve, evaluations) in other.into_iter().chain(this) {
+            timing.backend_ms += ms(solve);
+            timing.solve_count += 1;
+            timing.evaluations += evaluations;
+            if cold {
+                timing.cold_backend_ms += ms(solve);
+                timing.cold_solve_count += 1;
+            }
+        }
+    }
+
+    /// The cycle's timing, with the wall time since [`Spans::start`].
+    fn finish(mut self) -> CycleTiming {
+        self.timing.wall_ms = ms(self.started.elapsed());
+        self.timing
+    }
+}
+
 /// The event of a trajectory dropped by the safety check with `verdict`.
 fn dropped_collision(id: Option<BranchId>, verdict: &SafetyVerdict, limits: &Limits) -> Event {
     Event::DroppedCollision {
@@ -765,6 +938,21 @@ struct Solver<'s, 'a, B> {
 }
 
 impl<B: TrajectoryBackend> Solver<'_, '_, B> {
+    /// FwdMarch (Algorithm 1, line 6): the main branch re-solved from the replan start,
+    /// warm-started from its trajectory (its free terminal moves on toward the goal as the goal
+    /// guidance surface shrinks), with [`ManagerParams::warm_max_evaluations`].
+    fn fwd_march(&self, traj: &PolyTraj) -> Candidate {
+        let budget = self.params.warm_max_evaluations;
+        self.repaired(self.solve_with(InitialGuess::WarmStart(traj), budget))
+    }
+
+    /// BwdReplan (Algorithm 1, line 7): a sub-branch re-anchored at the replan start,
+    /// warm-started from its trajectory, with [`ManagerParams::sub_branch_max_evaluations`].
+    fn bwd_replan(&self, traj: &PolyTraj) -> Candidate {
+        let budget = (self.params.sub_branch_max_evaluations).or(self.params.warm_max_evaluations);
+        self.repaired(self.solve_with(InitialGuess::WarmStart(traj), budget))
+    }
+
     /// `cand` again, warm-started from its own trajectory, if it failed the safety check by at
     /// most `repair_margin_m` and the re-solve passes; otherwise `cand` unchanged.
     fn repaired(&self, cand: Candidate) -> Candidate {
@@ -831,35 +1019,6 @@ impl<B: TrajectoryBackend> Solver<'_, '_, B> {
                     other_solve: None,
                     repaired: false,
                 }
-            }
-        }
-    }
-}
-
-impl CycleTiming {
-    fn add(&mut self, cand: &Candidate, cold: bool) {
-        self.checker_ms += ms(cand.check_time);
-        if cand.repaired {
-            self.repair_count += 1;
-        }
-        if let Some((solve, evaluations, check)) = cand.other_solve {
-            self.checker_ms += ms(check);
-            self.backend_ms += ms(solve);
-            self.evaluations += evaluations;
-            self.solve_count += 1;
-            if cold {
-                self.cold_backend_ms += ms(solve);
-                self.cold_solve_count += 1;
-            }
-        }
-        if let Ok((s, _)) = &cand.result {
-            let solve = ms(s.stats.elapsed);
-            self.backend_ms += solve;
-            self.solve_count += 1;
-            self.evaluations += s.stats.evaluation_count;
-            if cold {
-                self.cold_backend_ms += solve;
-                self.cold_solve_count += 1;
             }
         }
     }

@@ -28,37 +28,34 @@ pub struct ManagerParams {
     /// obstacle's whole sweep over the horizon — so in crowded moments it can find no path while a
     /// trajectory passing behind an obstacle exists in space-time. Default `true`.
     pub straight_guide_when_empty: bool,
-    /// Evaluation budget of a warm-started re-solve (FwdMarch, BwdReplan); `None`: the backend's
-    /// own. The branch is refined again next cycle, so a re-solve need not converge fully.
-    /// Default 100 (beyond the paper): on E4 seeds 0–2 (with `explore_period_cycles = 3`) the
-    /// flights took 29.5 / 32.2 / 30.4 s with it and 29.4 / 31.2 / 30.8 s without, at a median
-    /// cycle of 3.9 instead of 8.4 ms; a budget of 50 cost 10–20 % of flight time (34–37 s).
+    /// Evaluation budget (cost evaluations) of a warm-started re-solve (FwdMarch, BwdReplan);
+    /// `None`: the backend's own. The branch is refined again next cycle, so a re-solve need not
+    /// converge fully. Default 100 (beyond the paper): flight times as without a cap at about
+    /// half the median cycle, while 50 costs flight time (measurements in ARCHITECTURE.md,
+    /// "Exploration period and warm budget").
     pub warm_max_evaluations: Option<usize>,
     /// Evaluation budget of a sub-branch's re-solve (BwdReplan); `None`: the same as
     /// [`ManagerParams::warm_max_evaluations`]. A sub-branch is refined again every cycle and only
     /// needs to be good enough to challenge the main branch, so it can take a smaller share of
     /// the cycle than the main branch's FwdMarch, which the vehicle flies.
-    /// Default 50 (beyond the paper): the cycle bench's median fell from 2.26 to 1.44 ms. It
-    /// costs a little flight time: E4 seeds 0–7 (single flights, reproducible mode) took 28.99 s
-    /// on average against 28.60 s with 100 (per seed 28.77 / 29.21 / 28.17 / 28.19 / 29.66 /
-    /// 32.65 / 27.89 / 27.39 s against 27.70 / 28.80 / 28.70 / 27.60 / 28.40 / 32.50 / 27.90 /
-    /// 27.40 s); 70 gave 29.08 s, and 50 with a main-branch budget of 150 29.34 s.
+    /// Default 50 (beyond the paper): a shorter cycle for about 1 % more flight time
+    /// (measurements in ARCHITECTURE.md, "Exploration period and warm budget").
     pub sub_branch_max_evaluations: Option<usize>,
     /// Evaluation budget of a cold solve from a frontend path (FwdExplore); `None`: the backend's
     /// own.
     pub cold_max_evaluations: Option<usize>,
     /// Run FwdExplore (the frontend and the cold solves) every this many cycles, and in every cycle
     /// that starts with fewer than two kept branches or without a main branch. 1: every cycle (the
-    /// paper's Algorithm 1). Default 3 (beyond the paper): the kept branches carry the explored
-    /// classes from cycle to cycle, so exploring every third cycle loses little — on E4 seeds
-    /// 0–2 the flights took 29.4 / 31.2 / 30.8 s against 31.7 / 32.1 / 29.6 s exploring every
-    /// cycle, while the median cycle fell from ~97 ms to ~8 ms (the frontend on E4's point-cloud
-    /// ESDF is most of an exploring cycle). With history off every cycle explores.
+    /// paper's Algorithm 1). At least 1. Default 3 (beyond the paper): the kept branches carry
+    /// the explored classes from cycle to cycle, so exploring every third cycle costs little
+    /// flight time while most cycles skip the frontend, which on E4's point-cloud ESDF is most of
+    /// an exploring cycle (measurements in ARCHITECTURE.md, "Exploration period and warm
+    /// budget"). With history off every cycle explores.
     pub explore_period_cycles: usize,
     /// A trajectory (kept branch or new candidate) that fails the safety check by at most this
     /// much (m) — or only on the speed and acceleration limits — is re-solved once, warm-started
     /// from itself with the cold budget ([`ManagerParams::cold_max_evaluations`]); the re-solve
-    /// replaces it if it passes (the issue's "dropped or repaired").
+    /// replaces it if it passes (a narrowly unsafe trajectory is repaired rather than dropped).
     /// The penalties are soft and a solve may stop on its budget, so a few millimetres of
     /// violation are common in cold solves (E3). `0` switches repairs off. Default 0.05 m.
     pub repair_margin_m: f64,
@@ -261,8 +258,8 @@ impl ReanchorParams {
 #[serde(deny_unknown_fields, default)]
 pub struct SafetyParams {
     /// Largest time step (s) between checked instants where the clearance does not prove a larger
-    /// one safe. The issue asks for ≤ 0.05 s or a proven step; the check always uses the proven
-    /// step (the clearance divided by a bound on how fast it can shrink) and never exceeds this.
+    /// one safe: the check always uses the proven step (the clearance divided by a bound on how
+    /// fast it can shrink) and never exceeds this. Default 0.05 s.
     pub max_step_s: f64,
     /// Smallest step (s): where the clearance is within `min_step_s` of reaching zero the check
     /// samples at this step (bounded work; at 10 m/s a 1 ms step moves 1 cm).
@@ -276,8 +273,8 @@ pub struct SafetyParams {
     /// A branch is infeasible if its speed or acceleration exceeds the limits by more than this
     /// fraction. Default 0.1 (the backends' soft penalties overshoot by well under 1 %).
     pub limit_tolerance: f64,
-    /// Also check the straight braking manoeuvre (at `a_max`) that follows a trajectory ending in
-    /// motion: the vehicle must be able to stop safely after the plan ends. Default `true`
+    /// Also check the straight braking manoeuvre ([`crate::brake_straight`], at 0.9·`a_max`) that
+    /// follows a trajectory ending in motion: the vehicle must be able to stop safely after the plan ends. Default `true`
     /// (beyond the paper: UTF-MINCO's free terminal velocity otherwise lets a branch end at full
     /// speed in front of an obstacle).
     pub braking_tail: bool,

@@ -94,7 +94,10 @@ pub enum Event {
         /// The branch it was equivalent to (kept, lower `J`).
         kept: BranchId,
     },
-    /// A branch (or a new candidate, `id = None`) failed the safety check and was dropped.
+    /// A branch (or a new candidate, `id = None`) failed the safety check and was dropped: a
+    /// collision (with the static map, the map bounds or a forecast), a braking tail that is not
+    /// clear, or a speed or acceleration beyond the limits — the fields say which. Despite its
+    /// name it covers all three.
     DroppedCollision {
         /// The branch, or `None` for a candidate from the frontend.
         id: Option<BranchId>,

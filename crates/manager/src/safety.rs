@@ -10,12 +10,12 @@
 //! not only at the samples (up to the `min_step_s` floor near contact, where it samples densely).
 //!
 //! A trajectory that ends moving is also checked for what comes after it: braking straight along
-//! its final velocity at `a_max` must stay clear ([`SafetyParams::braking_tail`]). A free-terminal
+//! its final velocity ([`crate::brake_straight`], at 0.9·`a_max`) must stay clear ([`SafetyParams::braking_tail`]). A free-terminal
 //! trajectory can otherwise end at full speed just in front of an obstacle, and a vehicle whose
 //! replanning then fails has nowhere to go.
 
 use serde::{Deserialize, Serialize};
-use trust_core::{Aabb, Limits, Piece, PolyTraj, Scene, Vec3};
+use trust_core::{Aabb, Limits, Piece, PolyTraj, Scene, Vec3, bernstein_points};
 
 use crate::SafetyParams;
 use crate::brake::brake_straight;
@@ -64,8 +64,8 @@ pub struct SafetyVerdict {
     pub max_accel: f64,
     /// Speed or acceleration above the limits by more than the tolerance.
     pub over_limits: bool,
-    /// The trajectory itself was clear but stopping after its end (straight braking at `a_max`)
-    /// would not be ([`SafetyParams::braking_tail`]).
+    /// The trajectory itself was clear but stopping after its end (straight braking,
+    /// [`crate::brake_straight`], at 0.9·`a_max`) would not be ([`SafetyParams::braking_tail`]).
     pub braking_tail_violated: bool,
     /// Instants checked.
     pub sample_count: usize,
@@ -78,68 +78,46 @@ impl SafetyVerdict {
     }
 }
 
-/// Bernstein (Bézier) control points of a polynomial given by its monomial coefficients `b` on
-/// `x ∈ [0, 1]` (degree `b.len() − 1`, at most 5): `P_i = Σ_{k ≤ i} C(i,k)/C(n,k) · b_k`. The curve
-/// lies in their convex hull.
-pub fn bernstein_points(b: &[Vec3], out: &mut Vec<Vec3>) {
-    out.clear();
-    let n = b.len().saturating_sub(1);
-    for i in 0..=n {
-        let mut p = Vec3::zeros();
-        for (k, bk) in b.iter().enumerate().take(i + 1) {
-            p += bk * (binomial(i, k) / binomial(n, k));
-        }
-        out.push(p);
-    }
-}
-
-fn binomial(n: usize, k: usize) -> f64 {
-    let mut r = 1.0;
-    for j in 0..k {
-        r = r * (n - j) as f64 / (j + 1) as f64;
-    }
-    r
-}
-
-/// An upper bound of the speed of one piece of duration `duration` (control points of its
-/// velocity).
-pub fn piece_speed_bound(piece: &Piece, duration: f64, scratch: &mut Vec<Vec3>) -> f64 {
+/// An upper bound of the speed of one piece of duration `duration`: the largest norm of its
+/// velocity's Bernstein control points ([`bernstein_points`]).
+pub(crate) fn piece_speed_bound(piece: &Piece, duration: f64) -> f64 {
     let mut b = [Vec3::zeros(); 5];
     let mut tk = 1.0;
     for (k, bk) in b.iter_mut().enumerate() {
         *bk = piece[k + 1] * ((k + 1) as f64 * tk);
         tk *= duration;
     }
-    bernstein_points(&b, scratch);
-    scratch.iter().map(|p| p.norm()).fold(0.0, f64::max)
+    bernstein_points(&b)
+        .iter()
+        .map(|p| p.norm())
+        .fold(0.0, f64::max)
 }
 
-/// A box containing one piece (control points of its position).
-pub fn piece_box(piece: &Piece, duration: f64, scratch: &mut Vec<Vec3>) -> Aabb {
+/// A box containing one piece of duration `duration`: the box of its position's Bernstein
+/// control points ([`bernstein_points`]).
+pub(crate) fn piece_box(piece: &Piece, duration: f64) -> Aabb {
     let mut b = [Vec3::zeros(); 6];
     let mut tk = 1.0;
     for (k, bk) in b.iter_mut().enumerate() {
         *bk = piece[k] * tk;
         tk *= duration;
     }
-    bernstein_points(&b, scratch);
-    Aabb::from_points(scratch).unwrap_or(Aabb {
+    Aabb::from_points(&bernstein_points(&b)).unwrap_or(Aabb {
         min: piece[0],
         max: piece[0],
     })
 }
 
 /// Speed bound and bounding box of the part of `traj` that overlaps `[from, until]` (whole pieces).
-pub fn window_bounds(traj: &PolyTraj, from: f64, until: f64) -> (f64, Aabb) {
-    let mut scratch = Vec::with_capacity(6);
+pub(crate) fn window_bounds(traj: &PolyTraj, from: f64, until: f64) -> (f64, Aabb) {
     let mut speed: f64 = 0.0;
     let mut bbox: Option<Aabb> = None;
     let mut t0 = traj.t_start();
     for (piece, &d) in traj.pieces().iter().zip(traj.durations()) {
         let t1 = t0 + d;
         if t1 >= from && t0 <= until {
-            speed = speed.max(piece_speed_bound(piece, d, &mut scratch));
-            let b = piece_box(piece, d, &mut scratch);
+            speed = speed.max(piece_speed_bound(piece, d));
+            let b = piece_box(piece, d);
             bbox = Some(bbox.map_or(b, |x| x.union(&b)));
         }
         t0 = t1;
@@ -165,8 +143,10 @@ pub fn window_bounds(traj: &PolyTraj, from: f64, until: f64) -> (f64, Aabb) {
 }
 
 /// Indices of the forecasts of `scene` that can come within `margin` of `region` at some time of
-/// `[from, until]` (swept boxes).
-pub fn forecasts_near(
+/// `[from, until]` (their swept boxes, [`trust_core::Forecast::aabb_over`]). A forecast whose swept
+/// box cannot be computed (a non-finite window) counts as near. The safety check and the
+/// manager's homotopy checks both filter the scene with it.
+pub(crate) fn forecasts_near(
     scene: &Scene<'_>,
     region: &Aabb,
     from: f64,
@@ -177,9 +157,10 @@ pub fn forecasts_near(
     out.clear();
     let region = region.inflated(margin);
     for (i, f) in scene.forecasts.iter().enumerate() {
-        if let Ok(b) = f.aabb_over(from, until.max(from))
-            && b.intersects(&region)
-        {
+        let near = f
+            .aabb_over(from, until.max(from))
+            .map_or(true, |b| b.intersects(&region));
+        if near {
             out.push(i);
         }
     }
@@ -257,6 +238,133 @@ fn check(
     verdict
 }
 
+/// The window one check covers: its time span (non-finite ends replaced), the forecasts that can
+/// reach the trajectory in it, and how fast each clearance can shrink there.
+struct Window {
+    from: f64,
+    until: f64,
+    /// Indices of the forecasts near the trajectory ([`forecasts_near`]).
+    near: Vec<usize>,
+    /// Bound of the static clearance's rate of decrease (m/s).
+    static_rate: f64,
+    /// Bound of the dynamic clearance's rate of decrease (m/s).
+    dynamic_rate: f64,
+}
+
+impl Window {
+    fn new(
+        traj: &PolyTraj,
+        scene: &Scene<'_>,
+        from: f64,
+        until: f64,
+        params: &SafetyParams,
+    ) -> Self {
+        let from = if from.is_finite() {
+            from
+        } else {
+            traj.t_start()
+        };
+        let until = if until.is_finite() {
+            until.max(from)
+        } else {
+            from
+        };
+        let (speed_bound, bbox) = window_bounds(traj, from, until);
+        let mut near = Vec::new();
+        forecasts_near(
+            scene,
+            &bbox,
+            from,
+            until,
+            params.dynamic_clearance_m,
+            &mut near,
+        );
+        let obstacle_rate = near
+            .iter()
+            .map(|&i| {
+                let f = &scene.forecasts[i];
+                f.v0.norm() + f.mu
+            })
+            .fold(0.0, f64::max);
+        let lipschitz = if scene.map.esdf().is_some() {
+            3f64.sqrt()
+        } else {
+            1.0
+        };
+        Window {
+            from,
+            until,
+            near,
+            static_rate: lipschitz * speed_bound,
+            dynamic_rate: speed_bound + obstacle_rate,
+        }
+    }
+
+    /// The static and dynamic margins (m) at `p` and time `t`, and the nearest forecast.
+    fn margins(&self, scene: &Scene<'_>, p: &Vec3, t: f64, params: &SafetyParams) -> Margins {
+        let static_m = scene.map.signed_distance(p) - params.static_clearance_m;
+        let (mut dynamic_m, mut nearest) = (f64::INFINITY, 0);
+        for &i in &self.near {
+            let d = scene.forecasts[i].signed_distance(p, t) - params.dynamic_clearance_m;
+            if d < dynamic_m {
+                dynamic_m = d;
+                nearest = i;
+            }
+        }
+        Margins {
+            static_m,
+            dynamic_m,
+            nearest,
+        }
+    }
+
+    /// The next instant after `t`: the proven step `margin / rate` where the trajectory is clear,
+    /// the small step where it is not (or may still be escaping an initial overlap), clamped to
+    /// `[min_step_s, max_step_s]` and to the window's end.
+    fn next(&self, t: f64, m: &Margins, inside: bool, params: &SafetyParams) -> f64 {
+        let violating = m.static_m.min(m.dynamic_m) < 0.0;
+        let proven = if inside || violating {
+            params.min_step_s.max(0.01f64.min(params.max_step_s))
+        } else {
+            let s = m.static_m / self.static_rate.max(1e-12);
+            let d = m.dynamic_m / self.dynamic_rate.max(1e-12);
+            s.min(d)
+        };
+        let step = proven.clamp(params.min_step_s, params.max_step_s);
+        (t + step).min(self.until)
+    }
+}
+
+/// Clearance margins at one instant.
+struct Margins {
+    /// To the static map (m, negative inside).
+    static_m: f64,
+    /// To the nearest forecast (m, negative inside; `∞` without forecasts).
+    dynamic_m: f64,
+    /// Index of the nearest forecast.
+    nearest: usize,
+}
+
+impl Margins {
+    /// What the vehicle at `p` hits, with the margin: the bounds, else the nearer of the static
+    /// map and the forecasts when a margin is negative (or NaN).
+    fn hit(&self, bounds: &Aabb, p: &Vec3) -> Option<(Hit, f64)> {
+        let margin = self.static_m.min(self.dynamic_m);
+        if !bounds.contains(p) {
+            Some((Hit::Bounds, -bounds.distance_to_point(p)))
+        } else if margin < 0.0 || margin.is_nan() {
+            let with = if self.static_m <= self.dynamic_m {
+                Hit::Static
+            } else {
+                Hit::Obstacle(self.nearest)
+            };
+            Some((with, margin))
+        } else {
+            None
+        }
+    }
+}
+
 fn check_window(
     traj: &PolyTraj,
     scene: &Scene<'_>,
@@ -266,46 +374,11 @@ fn check_window(
     params: &SafetyParams,
     full: bool,
 ) -> SafetyVerdict {
-    let from = if from.is_finite() {
-        from
-    } else {
-        traj.t_start()
-    };
-    let until = if until.is_finite() {
-        until.max(from)
-    } else {
-        from
-    };
-    let (speed_bound, bbox) = window_bounds(traj, from, until);
-    let mut near = Vec::new();
-    forecasts_near(
-        scene,
-        &bbox,
-        from,
-        until,
-        params.dynamic_clearance_m,
-        &mut near,
-    );
-    let obstacle_rate = near
-        .iter()
-        .map(|&i| {
-            let f = &scene.forecasts[i];
-            f.v0.norm() + f.mu
-        })
-        .fold(0.0, f64::max);
-    let lipschitz = if scene.map.esdf().is_some() {
-        3f64.sqrt()
-    } else {
-        1.0
-    };
-    let static_rate = lipschitz * speed_bound;
-    let dynamic_rate = speed_bound + obstacle_rate;
+    let window = Window::new(traj, scene, from, until, params);
     let bounds = scene.map.bounds();
-
     let (max_speed, max_accel) = traj.max_speed_and_acceleration(16);
     let tol = 1.0 + params.limit_tolerance;
     let over_limits = max_speed > limits.v_max * tol || max_accel > limits.a_max * tol;
-
     let mut verdict = SafetyVerdict {
         safe: true,
         min_static_margin_m: f64::INFINITY,
@@ -318,6 +391,7 @@ fn check_window(
         braking_tail_violated: false,
         sample_count: 0,
     };
+    let (from, until) = (window.from, window.until);
     let max_samples = ((until - from) / params.min_step_s).ceil().min(1e7) as usize + 2;
     let mut t = from;
     let mut previous = f64::NEG_INFINITY;
@@ -325,41 +399,24 @@ fn check_window(
     for _ in 0..max_samples {
         verdict.sample_count += 1;
         let p = traj.position(t);
-        let static_margin = scene.map.signed_distance(&p) - params.static_clearance_m;
-        let (mut dynamic_margin, mut nearest) = (f64::INFINITY, 0);
-        for &i in &near {
-            let d = scene.forecasts[i].signed_distance(&p, t) - params.dynamic_clearance_m;
-            if d < dynamic_margin {
-                dynamic_margin = d;
-                nearest = i;
-            }
-        }
-        verdict.min_static_margin_m = verdict.min_static_margin_m.min(static_margin);
-        verdict.min_dynamic_margin_m = verdict.min_dynamic_margin_m.min(dynamic_margin);
-        let margin = static_margin.min(dynamic_margin);
-        let hit = if !bounds.contains(&p) {
-            Some((Hit::Bounds, -bounds.distance_to_point(&p)))
-        } else if margin < 0.0 || margin.is_nan() {
-            let with = if static_margin <= dynamic_margin {
-                Hit::Static
-            } else {
-                Hit::Obstacle(nearest)
-            };
-            Some((with, margin))
-        } else {
-            None
-        };
-        match hit {
-            Some((with, m)) => {
+        let m = window.margins(scene, &p, t, params);
+        verdict.min_static_margin_m = verdict.min_static_margin_m.min(m.static_m);
+        verdict.min_dynamic_margin_m = verdict.min_dynamic_margin_m.min(m.dynamic_m);
+        match m.hit(bounds, &p) {
+            Some((with, margin)) => {
                 // Escaping an overlap present at the start: allowed while the clearance grows.
-                let escaping = inside && with != Hit::Bounds && m >= previous - 1e-9;
+                let escaping = inside && with != Hit::Bounds && margin >= previous - 1e-9;
                 if !escaping {
                     verdict.safe = false;
                     if verdict.violation.is_none() {
                         verdict.violation = Some(Violation {
                             t,
                             with,
-                            margin_m: if m.is_nan() { f64::NEG_INFINITY } else { m },
+                            margin_m: if margin.is_nan() {
+                                f64::NEG_INFINITY
+                            } else {
+                                margin
+                            },
                         });
                     }
                     if !full {
@@ -369,23 +426,14 @@ fn check_window(
                 } else {
                     verdict.escaping = true;
                 }
-                previous = m;
+                previous = margin;
             }
             None => inside = false,
         }
         if t >= until {
             break;
         }
-        let violating = static_margin.min(dynamic_margin) < 0.0;
-        let proven = if inside || violating {
-            params.min_step_s.max(0.01f64.min(params.max_step_s))
-        } else {
-            let s = static_margin / static_rate.max(1e-12);
-            let d = dynamic_margin / dynamic_rate.max(1e-12);
-            s.min(d)
-        };
-        let step = proven.clamp(params.min_step_s, params.max_step_s);
-        t = (t + step).min(until);
+        t = window.next(t, &m, inside, params);
     }
     if over_limits {
         verdict.safe = false;
@@ -421,10 +469,9 @@ mod tests {
             Vec3::new(0.5, 0.2, -1.0),
             Vec3::new(-0.3, 0.1, 0.2),
         ];
-        let mut scratch = Vec::new();
         let d = 1.7;
-        let vmax = piece_speed_bound(&piece, d, &mut scratch);
-        let bbox = piece_box(&piece, d, &mut scratch);
+        let vmax = piece_speed_bound(&piece, d);
+        let bbox = piece_box(&piece, d);
         for k in 0..=200 {
             let s = d * k as f64 / 200.0;
             assert!(eval_piece(&piece, 1, s).norm() <= vmax + 1e-12);

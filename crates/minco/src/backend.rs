@@ -49,4 +49,4 @@ pub use objective::{MincoObjective, UtfMincoObjective};
 pub use params::{MincoParams, PieceParams, SolverParams, UtfMincoParams};
 pub use solve::{solve_status, validate_request};
 pub use time_map::{positive_time, positive_time_inverse};
-pub use utf_minco::{UtfMinco, guidance_radius};
+pub use utf_minco::UtfMinco;

@@ -138,7 +138,8 @@ impl BandedMatrix {
     }
 
     /// Whether the matrix currently holds valid LU factors.
-    pub fn is_factorized(&self) -> bool {
+    #[cfg(test)]
+    pub(crate) fn is_factorized(&self) -> bool {
         self.factorized
     }
 

@@ -21,7 +21,7 @@
 //!   original fixed-terminal MINCO, the baseline of Table Sim-A-2), both
 //!   [`trust_core::TrajectoryBackend`]s solved with `trust-lbfgs`, and their objectives as
 //!   functions of the decision vector ([`UtfMincoObjective`], [`MincoObjective`]).
-//! - [`scenes`]: the deterministic E2 scenes (design.md §5) used by the tests, the benchmarks
+//! - [`scenes`]: the deterministic E2 scenes used by the tests, the benchmarks
 //!   and `examples/e2_compare.rs`.
 //!
 //! # Performance
@@ -149,6 +149,13 @@
 //! solution.traj.for_each_sample(0.01, |t, s| assert!(scene.clearance(&s.p, t) >= 0.0))?;
 //! # Ok::<(), trust_core::PlanError>(())
 //! ```
+//!
+//! # Changelog
+//!
+//! - `backend::guidance_radius(start, goal, horizon_s, &limits)` moved to
+//!   `trust_core::guidance_radius(start, goal, horizon_s, v_max)`, shared with DEV-PRM's goal
+//!   guidance surface; the Bernstein control points of the fused integration come from
+//!   `trust_core::bernstein_points` (same values, bit for bit).
 #![warn(missing_docs)]
 
 pub mod backend;

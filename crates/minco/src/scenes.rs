@@ -1,4 +1,4 @@
-//! Deterministic scenes for experiment E2 (design.md §5; paper Sec. IV-B, Table Sim-A-2 and Figs.
+//! Deterministic scenes for experiment E2 (paper Sec. IV-B, Table Sim-A-2 and Figs.
 //! Sim-A-2-1 / Sim-A-2-2): a 50 × 20 × 10 m map crossed from `(1, 10, 5)` to `(49, 10, 5)` at the
 //! paper's limits (`v_max = 10 m/s`, `a_max = 15 m/s²`).
 //!

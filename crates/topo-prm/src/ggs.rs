@@ -24,16 +24,12 @@ pub enum Terminal {
     },
 }
 
-/// `r_des = ‖start − goal‖ − horizon_s·v_max` (Algorithm 2, line 1); may be negative.
-pub fn ggs_radius(start: &Vec3, goal: &Vec3, horizon_s: f64, v_max: f64) -> f64 {
-    (start - goal).norm() - horizon_s * v_max
-}
-
 impl Terminal {
-    /// The GGS for this query, or the goal point when `r_des <= 0` or is not finite.
+    /// The GGS for this query ([`trust_core::guidance_radius`]), or the goal point when
+    /// `r_des = 0` (the goal within reach, or non-finite input).
     pub fn goal_guidance_surface(start: &Vec3, goal: &Vec3, horizon_s: f64, v_max: f64) -> Self {
-        let r = ggs_radius(start, goal, horizon_s, v_max);
-        if r.is_finite() && r > 0.0 {
+        let r = trust_core::guidance_radius(start, goal, horizon_s, v_max);
+        if r > 0.0 {
             Terminal::Surface {
                 center: *goal,
                 radius: r,

@@ -63,6 +63,12 @@
 //! }
 //! # Ok::<(), trust_core::PlanError>(())
 //! ```
+//!
+//! # Changelog
+//!
+//! - `ggs::ggs_radius` is gone: the GGS radius is `trust_core::guidance_radius` (clamped at 0,
+//!   shared with UTF-MINCO); `straight::straight_end` is a re-export of
+//!   `trust_core::straight_end` (shared with the manager's straight guide).
 #![warn(missing_docs)]
 
 pub mod astar;

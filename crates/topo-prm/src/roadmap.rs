@@ -307,7 +307,8 @@ impl<'o, 'm> RoadmapBuilder<'o, 'm> {
     }
 
     /// Samples waiting for a second guard ([`RoadmapBuilder::add_persistent_sample`]).
-    pub fn pending_count(&self) -> usize {
+    #[cfg(test)]
+    pub(crate) fn pending_count(&self) -> usize {
         self.pending.len()
     }
 

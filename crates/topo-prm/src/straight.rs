@@ -16,19 +16,9 @@ use crate::prm::check_or_trivial_answer;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct StraightLine;
 
-/// The end of the straight guide: `start + (goal − start)·min(1, reach / ‖goal − start‖)`.
-pub fn straight_end(
-    start: &trust_core::Vec3,
-    goal: &trust_core::Vec3,
-    reach: f64,
-) -> trust_core::Vec3 {
-    let d = (goal - start).norm();
-    if !d.is_finite() || !reach.is_finite() || d <= reach || d <= 0.0 {
-        *goal
-    } else {
-        start + (goal - start) * (reach / d)
-    }
-}
+/// The end of the straight guide (defined in `trust-core`, shared with the manager's fallback
+/// guide).
+pub use trust_core::straight_end;
 
 impl PathFrontend for StraightLine {
     fn name(&self) -> &str {

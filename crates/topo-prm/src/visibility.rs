@@ -102,7 +102,8 @@ impl<'a> Obstacles<'a> {
 
     /// True if nothing (no cone box, no static shape box, no voxel map) meets `region`: every segment
     /// inside it is then clear.
-    pub fn region_is_empty(&self, region: &Aabb, scratch: &mut Vec<usize>) -> bool {
+    #[cfg(test)]
+    pub(crate) fn region_is_empty(&self, region: &Aabb, scratch: &mut Vec<usize>) -> bool {
         if self.cones.iter().any(|c| c.aabb().intersects(region)) {
             return false;
         }

@@ -12,8 +12,8 @@ use trust_core::{PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult, V
 
 use crate::prm::{ConeMode, PrmSetup, run};
 
-/// Parameters of [`Vprm`]. Defaults are Fast-Planner's (`topo_prm` launch parameters, see
-/// `reference/topo-prm.md`) unless stated otherwise.
+/// Parameters of [`Vprm`]. Defaults are Fast-Planner's (its `topo_prm` launch parameters) unless
+/// stated otherwise.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct VprmParams {

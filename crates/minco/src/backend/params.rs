@@ -32,8 +32,8 @@ impl Default for PieceParams {
     ///   better local minima among moving obstacles (mean `J` 165 vs 216, mean duration 7.5 vs
     ///   7.8 s; on E2 dynamic 7.7 s to the goal instead of 8.3 s stopping 4 m short). 6 m and 8 m
     ///   give the same quality; 12 m starts to cut corners between samples;
-    /// - `min_pieces = 2`, `max_pieces = 32`: at least one free waypoint; the cost stays within
-    ///   the O(n) budget of design.md §6;
+    /// - `min_pieces = 2`, `max_pieces = 32`: at least one free waypoint; the cost stays linear in
+    ///   the number of pieces;
     /// - `min_piece_duration_s = 0.02`: keeps MINCO's `T⁵` pivot above 3e-9 and gives a hover
     ///   (start on the goal) a non-degenerate duration when `H_t` pushes every duration down.
     fn default() -> Self {

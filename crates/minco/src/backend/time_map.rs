@@ -1,5 +1,5 @@
 //! The smooth positive map from an unconstrained variable `τ` to a duration (GCOPTER's rational
-//! map; `shared/reference/minco-lbfgs.md`, "Positive time").
+//! map for the total duration).
 
 /// `T(τ) = ½τ² + τ + 1` for `τ > 0` and `1 / (½τ² − τ + 1)` for `τ ≤ 0`, with `dT/dτ`.
 ///

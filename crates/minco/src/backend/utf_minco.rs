@@ -3,19 +3,12 @@
 
 use std::time::Instant;
 
-use trust_core::{Limits, PlanError, Scene, Solution, TrajRequest, TrajectoryBackend, Vec3};
+use trust_core::{PlanError, Scene, Solution, TrajRequest, TrajectoryBackend, guidance_radius};
 
 use super::init::initial_trajectory;
 use super::objective::UtfMincoObjective;
 use super::params::UtfMincoParams;
 use super::solve::{solve_and_package, validate_request};
-
-/// Radius `r_des = max(0, ‖p_s − p_g‖ − T_h·v_max)` of the goal guidance surface for a vehicle at
-/// `start` with horizon `horizon_s` (paper Algorithm 2, line 1); 0 for non-finite input.
-pub fn guidance_radius(start: &Vec3, goal: &Vec3, horizon_s: f64, limits: &Limits) -> f64 {
-    let r = (start - goal).norm() - horizon_s * limits.v_max;
-    if r.is_finite() { r.max(0.0) } else { 0.0 }
-}
 
 /// UTF-MINCO: minimizes `J = λ · [H_t, H_s, I_o, I_d, I_e]` (paper eq. design-of-J) over the
 /// inner waypoints, the free terminal position and velocity and the total duration
@@ -26,7 +19,7 @@ pub fn guidance_radius(start: &Vec3, goal: &Vec3, horizon_s: f64, limits: &Limit
 /// - Budget: `params.solver.max_evaluations` and the request's deadline (checked once per
 ///   iteration); the status says which stopped the solve.
 /// - Receding horizon: with [`TrajRequest::horizon_s`] the terminal is pulled to the goal
-///   guidance surface ([`guidance_radius`], [`crate::costs::TerminalCost::eval_objective`]) so the
+///   guidance surface ([`trust_core::guidance_radius`], [`crate::costs::TerminalCost::eval_objective`]) so the
 ///   trajectory spans about one horizon; the reported `H_s` is the paper's, toward the goal. Once
 ///   the goal is within the horizon (`r_des = 0`) the terminal-velocity weight is `α = 1`, so the
 ///   trajectory ends at rest on the goal (the paper ramps `α` only within `d_ε` of the goal, too
@@ -68,7 +61,7 @@ impl TrajectoryBackend for UtfMinco {
         let mut f =
             UtfMincoObjective::new(scene, &req.start, req.goal, req.limits, p, init.pieces())?;
         if let Some(horizon) = req.horizon_s {
-            let radius = guidance_radius(&req.start.p, &req.goal, horizon, &req.limits);
+            let radius = guidance_radius(&req.start.p, &req.goal, horizon, req.limits.v_max);
             if radius > 0.0 {
                 f.set_guidance_surface(radius);
             } else {

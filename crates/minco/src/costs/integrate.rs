@@ -92,7 +92,7 @@ impl Default for SampleGrad {
 /// [`Integrand::begin_piece`] and, if that returns `true`, [`Integrand::sample`] at each of the
 /// piece's `κ + 1` nodes. The two `begin` hooks receive the axis-aligned box of the sample
 /// positions (the only points where `L` is evaluated) and the time window, so that a term can do
-/// its broad phase there (design.md §6). Returning `false` from `begin_piece` promises that `L`
+/// its broad phase there. Returning `false` from `begin_piece` promises that `L`
 /// and its derivatives are zero at every node of that piece.
 pub trait Integrand {
     /// Called once per integration with the trajectory's time window and the box of all samples.
@@ -525,15 +525,7 @@ impl ScaledPiece {
     /// contains the whole piece, hence every node.
     #[inline(always)]
     fn bernstein_positions(&self) -> [Vec3; 6] {
-        let [p0, p1, p2, p3, p4, p5] = self.p;
-        [
-            p0,
-            p0 + p1 * 0.2,
-            p0 + p1 * 0.4 + p2 * 0.1,
-            p0 + p1 * 0.6 + p2 * 0.3 + p3 * 0.1,
-            p0 + p1 * 0.8 + p2 * 0.6 + p3 * 0.4 + p4 * 0.2,
-            p0 + p1 + p2 + p3 + p4 + p5,
-        ]
+        trust_core::bernstein_points(&self.p)
     }
 }
 

@@ -22,7 +22,7 @@ pub struct CostWeights {
 
 impl Default for CostWeights {
     /// - `time = 20`, `obstacle = feasibility = 1e4`, `energy = 1`: GCOPTER's defaults (time weight
-    ///   20, penalty weights 1e4, unit energy weight; `shared/reference/minco-lbfgs.md`).
+    ///   20, penalty weights 1e4, unit energy weight).
     /// - `terminal = 50`: ours (the paper gives no value). Ending 1 m short of the goal saves about
     ///   `1 m / v` of flight, worth `λ_t / v ≈ 2–3` at the paper's speeds; `λ_s` must exceed that
     ///   by a margin for the free terminal to reach a reachable goal, and stay far below the
@@ -109,8 +109,7 @@ pub struct PenaltyParams {
 }
 
 impl Default for PenaltyParams {
-    /// - `samples_per_piece = 16`, `smoothing = 1e-2`: GCOPTER's defaults (`κ = 16`, `μ = 1e−2`;
-    ///   `shared/reference/minco-lbfgs.md`).
+    /// - `samples_per_piece = 16`, `smoothing = 1e-2`: GCOPTER's defaults (`κ = 16`, `μ = 1e−2`).
     /// - `dynamic_clearance_m = static_clearance_m = 0.1`: ours. The penalty admits violations of
     ///   the order of `μ` at the optimum and is only evaluated at the samples; 0.1 m covers both at
     ///   the paper's speeds (sample spacing ≤ 0.3 m at 10 m/s with pieces of ≤ 0.5 s).

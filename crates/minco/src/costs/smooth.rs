@@ -9,8 +9,8 @@
 /// | `0 < x < mu` | `mu (r³ − r⁴/2)` | `r² (3 − 2r)` |
 /// | `x ≥ mu` | `x − mu/2` | `1` |
 ///
-/// This is GCOPTER's `smoothedL1` (facts in `shared/reference/minco-lbfgs.md`, "Penalty
-/// integration"); value, slope and curvature are continuous at `0` and `mu`.
+/// This is GCOPTER's `smoothedL1` (its penalty integration); value, slope and curvature are
+/// continuous at `0` and `mu`.
 ///
 /// ```
 /// use trust_minco::costs::smoothed_l1;

@@ -20,7 +20,7 @@
 //! 45 % (callgrind); on the representative benchmark problem, where nearly every node is active,
 //! it costs about the same as the generic path.
 
-use trust_core::{Aabb, Vec3};
+use trust_core::{Aabb, Vec3, bernstein_points};
 
 use super::{
     PieceContext, PieceIntegral, PieceRule, PiecewiseView, ScaledPiece, TrapezoidIntegrator,
@@ -251,11 +251,11 @@ fn flag_nodes(
     velocity.filled = false;
     acceleration.filled = false;
     let (v2_max, a2_max) = penalties.squared_limits();
-    if !within_by_hull(&bernstein_velocity(&piece.v), &piece.v, v2_max) {
+    if !within_by_hull(&bernstein_points(&piece.v), &piece.v, v2_max) {
         NodeColumns::evaluate(powers, &piece.v, velocity);
         NodeColumns::flag_norm_above(flags, velocity, v2_max * (1.0 - LIMIT_FILTER_MARGIN));
     }
-    if !within_by_hull(&bernstein_acceleration(&piece.a), &piece.a, a2_max) {
+    if !within_by_hull(&bernstein_points(&piece.a), &piece.a, a2_max) {
         NodeColumns::evaluate(powers, &piece.a, acceleration);
         NodeColumns::flag_norm_above(flags, acceleration, a2_max * (1.0 - LIMIT_FILTER_MARGIN));
     }
@@ -296,33 +296,6 @@ fn hull_norm_squared(points: &[Vec3]) -> f64 {
         max = max.max(n2);
     }
     max
-}
-
-/// Bernstein control points of the velocity `Σ_{e ≤ 4} V_e u^e` on `u ∈ [0, 1]`:
-/// `b_k = Σ_{e ≤ k} C(k, e)/C(4, e) V_e`.
-#[inline(always)]
-fn bernstein_velocity(v: &[Vec3; 5]) -> [Vec3; 5] {
-    let [v0, v1, v2, v3, v4] = *v;
-    [
-        v0,
-        v0 + v1 * 0.25,
-        v0 + v1 * 0.5 + v2 * (1.0 / 6.0),
-        v0 + v1 * 0.75 + v2 * 0.5 + v3 * 0.25,
-        v0 + v1 + v2 + v3 + v4,
-    ]
-}
-
-/// Bernstein control points of the acceleration `Σ_{e ≤ 3} A_e u^e` on `u ∈ [0, 1]`:
-/// `b_k = Σ_{e ≤ k} C(k, e)/C(3, e) A_e`.
-#[inline(always)]
-fn bernstein_acceleration(a: &[Vec3; 4]) -> [Vec3; 4] {
-    let [a0, a1, a2, a3] = *a;
-    [
-        a0,
-        a0 + a1 * (1.0 / 3.0),
-        a0 + a1 * (2.0 / 3.0) + a2 * (1.0 / 3.0),
-        a0 + a1 + a2 + a3,
-    ]
 }
 
 /// The flagged nodes of one piece: eqs. dI-a, dI-b and dI-c as in `integrate_piece`, for the
@@ -547,8 +520,8 @@ mod tests {
         ];
         let a = [v[0], v[1], v[2], v[3]];
         let (hv, ha) = (
-            hull_norm_squared(&bernstein_velocity(&v)),
-            hull_norm_squared(&bernstein_acceleration(&a)),
+            hull_norm_squared(&bernstein_points(&v)),
+            hull_norm_squared(&bernstein_points(&a)),
         );
         for k in 0..=100 {
             let u = k as f64 / 100.0;
