@@ -94,7 +94,7 @@ fn planner(paper: bool) -> Planner {
         params.warm_max_evaluations = None;
         params.sub_branch_max_evaluations = None;
     }
-    // As the simulator's presets fly it (`trust_sim::planner::closed_loop_backend`).
+    // As the simulator's presets fly it (`trust_world::planner::closed_loop_backend`).
     let mut backend = trust_minco::UtfMincoParams::default();
     backend.weights.time = 60.0;
     backend.weights.terminal = 60.0;
