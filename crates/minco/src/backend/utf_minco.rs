@@ -8,7 +8,7 @@ use trust_core::{Limits, PlanError, Scene, Solution, TrajRequest, TrajectoryBack
 use super::init::initial_trajectory;
 use super::objective::UtfMincoObjective;
 use super::params::UtfMincoParams;
-use super::solve::{solve_and_package, validate_request};
+use super::solve::{check_end_time, solve_and_package, validate_request};
 
 /// Radius `r_des = max(0, ‖p_s − p_g‖ − T_h·v_max)` of the goal guidance surface for a vehicle at
 /// `start` with horizon `horizon_s` (paper Algorithm 2, line 1); 0 for non-finite input.
@@ -32,7 +32,8 @@ pub fn guidance_radius(start: &Vec3, goal: &Vec3, horizon_s: f64, limits: &Limit
 ///   trajectory ends at rest on the goal (the paper ramps `α` only within `d_ε` of the goal, too
 ///   late to stop from full speed).
 /// - The returned trajectory starts at `req.start` (position, velocity, acceleration, time) and
-///   is finite; the cost breakdown is evaluated at it.
+///   is finite; the cost breakdown is evaluated at it, and [`trust_core::Solution::violations`]
+///   lists what it violates ([`trust_core::verify_trajectory`]: penetration, bounds, limits).
 #[derive(Debug, Clone, Default)]
 pub struct UtfMinco {
     params: UtfMincoParams,
@@ -65,6 +66,7 @@ impl TrajectoryBackend for UtfMinco {
         let p = &self.params;
         let init = initial_trajectory(&req.initial, &req.start, &req.limits, &p.pieces);
         init.check_duration(&req.initial, &req.limits)?;
+        check_end_time(req, init.total_duration)?;
         let mut f =
             UtfMincoObjective::new(scene, &req.start, req.goal, req.limits, p, init.pieces())?;
         if let Some(horizon) = req.horizon_s {
@@ -90,7 +92,8 @@ impl TrajectoryBackend for UtfMinco {
             &mut f,
             &mut x,
             &p.solver.capped(req.max_evaluations),
-            req.deadline,
+            req,
+            scene,
             started,
         )
     }
