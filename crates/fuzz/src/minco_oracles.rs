@@ -121,6 +121,12 @@ fn perturb<T: serde::Serialize + serde::de::DeserializeOwned>(
     Some((parsed, edited))
 }
 
+/// An ordinary number in `[lo, hi]` (never one of `Gen::num`'s adversarial values: the
+/// requests here must be valid so that an error can only come from the parameters).
+fn ordinary(g: &mut Gen, lo: f64, hi: f64) -> f64 {
+    lo + (hi - lo) * g.index(1001) as f64 / 1000.0
+}
+
 /// Longest run of ASCII digits in `s`.
 fn longest_digit_run(s: &str) -> usize {
     s.split(|c: char| !c.is_ascii_digit())
@@ -136,8 +142,8 @@ fn request<'a>(g: &mut Gen, guide: &'a GuidePath) -> TrajRequest<'a> {
         start: State::at_rest(0.0, start),
         goal,
         limits: Limits {
-            v_max: g.num(1.0, 10.0),
-            a_max: g.num(2.0, 15.0),
+            v_max: ordinary(g, 1.0, 10.0),
+            a_max: ordinary(g, 2.0, 15.0),
         },
         initial: InitialGuess::Guide(guide),
         deadline: Some(std::time::Instant::now() + std::time::Duration::from_millis(300)),
@@ -149,11 +155,11 @@ fn request<'a>(g: &mut Gen, guide: &'a GuidePath) -> TrajRequest<'a> {
 /// A start and goal in free space of `scene` (or `None` after a few tries).
 fn free_pair(g: &mut Gen, scene: &Scene<'_>) -> Option<GuidePath> {
     let b = *scene.map.bounds();
-    let mut pick = |g: &mut Gen| {
+    let pick = |g: &mut Gen| {
         for _ in 0..20 {
             let mut p = Vec3::zeros();
             for i in 0..3 {
-                p[i] = b.min[i] + (b.max[i] - b.min[i]) * g.num(0.05, 0.95).clamp(0.0, 1.0);
+                p[i] = b.min[i] + (b.max[i] - b.min[i]) * ordinary(g, 0.05, 0.95);
             }
             if scene.static_clearance(&p) > 0.3 {
                 return Some(p);
@@ -179,8 +185,7 @@ pub fn params_edges(g: &mut Gen, fx: &Fixtures) -> Outcome {
         return Outcome::Err;
     };
     let req = request(g, &guide);
-    let (built, edited): (Result<Box<dyn TrajectoryBackend>, _>, Vec<String>) = if g.chance(0.5)
-    {
+    let (built, edited): (Result<Box<dyn TrajectoryBackend>, _>, Vec<String>) = if g.chance(0.5) {
         let Some((p, e)) = perturb(g, &trust_minco::UtfMincoParams::default()) else {
             return Outcome::Err;
         };
@@ -251,8 +256,12 @@ pub fn violations_oracle(g: &mut Gen, fx: &Fixtures) -> Outcome {
         // A warm start that runs out of the map at speed.
         let mut piece = [Vec3::zeros(); 6];
         piece[0] = guide.points[0];
-        piece[1] = Vec3::new(g.num(-12.0, 12.0), g.num(-12.0, 12.0), g.num(-3.0, 3.0));
-        warm = PolyTraj::new(0.0, vec![g.num(0.5, 6.0)], vec![piece]);
+        piece[1] = Vec3::new(
+            ordinary(g, -12.0, 12.0),
+            ordinary(g, -12.0, 12.0),
+            ordinary(g, -3.0, 3.0),
+        );
+        warm = PolyTraj::new(0.0, vec![ordinary(g, 0.5, 6.0)], vec![piece]);
         match &warm {
             Ok(t) => req.initial = InitialGuess::WarmStart(t),
             Err(_) => return Outcome::Err,
@@ -315,7 +324,13 @@ fn check_violations(sol: &trust_core::Solution, scene: &Scene<'_>, limits: &Limi
         has(&|v| matches!(v, Violation::OverSpeed { .. })),
         has(&|v| matches!(v, Violation::OverAccel { .. })),
     ];
-    let names = ["static penetration", "dynamic penetration", "leaving the bounds", "over-speed", "over-acceleration"];
+    let names = [
+        "static penetration",
+        "dynamic penetration",
+        "leaving the bounds",
+        "over-speed",
+        "over-acceleration",
+    ];
     for k in 0..5 {
         if found[k] && !listed[k] {
             return Outcome::Wrong(format!(
@@ -331,7 +346,10 @@ fn check_violations(sol: &trust_core::Solution, scene: &Scene<'_>, limits: &Limi
                 depth_m > 0.0 && (scene.static_clearance(&p) + depth_m).abs() < 1e-6
             }
             Violation::DynamicPenetration {
-                forecast, depth_m, t, point,
+                forecast,
+                depth_m,
+                t,
+                point,
             } => {
                 let p = Vec3::new(point[0], point[1], point[2]);
                 scene

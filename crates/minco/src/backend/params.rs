@@ -86,7 +86,11 @@ impl PieceParams {
             return Err(PlanError::invalid(
                 format!("{prefix}.max_pieces"),
                 self.max_pieces,
-                format!("an integer >= min_pieces ({})", self.min_pieces),
+                format!(
+                    "an integer >= {prefix}.min_pieces ({}); lower {prefix}.min_pieces or raise \
+                     {prefix}.max_pieces",
+                    self.min_pieces
+                ),
             ));
         }
         check_range(
