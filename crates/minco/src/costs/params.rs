@@ -333,7 +333,8 @@ mod tests {
         // Issue 18: these were accepted and then broke the solve with an error about something
         // else ("cost at the start point = inf", "g[0] = NaN") or silently turned the
         // obstacle penalty off (`smoothing = 1e300`).
-        let cases: [(&str, fn(&mut PenaltyParams)); 6] = [
+        type Edit = fn(&mut PenaltyParams);
+        let cases: [(&str, Edit); 6] = [
             ("p.smoothing", |p| p.smoothing = 1e300),
             ("p.terminal_norm_epsilon", |p| {
                 p.terminal_norm_epsilon = 1e-300
