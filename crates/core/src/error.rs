@@ -157,6 +157,32 @@ pub fn check_scaled_vec(field: &str, v: &Vec3, quantity: Quantity) -> Result<(),
     Ok(())
 }
 
+/// Checks that `x` lies in the closed range `[lo, hi]` (in `unit`, `""` for a dimensionless
+/// number); NaN and infinities are outside. Parameter structs use it for ranges derived from the
+/// scale policy ([`crate::scale`]) that are narrower than a [`Quantity`]'s.
+///
+/// # Errors
+/// [`PlanError::Scale`] naming `field`, the value in scientific notation and the range.
+pub fn check_range(
+    field: &str,
+    x: f64,
+    lo: f64,
+    hi: f64,
+    unit: &'static str,
+) -> Result<(), PlanError> {
+    if x >= lo && x <= hi {
+        Ok(())
+    } else {
+        Err(PlanError::Scale(ScaleError {
+            field: field.to_owned(),
+            value: x,
+            lo,
+            hi,
+            unit,
+        }))
+    }
+}
+
 /// Checks that every component of `v` is finite.
 pub fn check_finite_vec(field: &str, v: &Vec3) -> Result<(), PlanError> {
     if v.iter().all(|c| c.is_finite()) {
@@ -194,5 +220,14 @@ mod tests {
         assert!(check_non_negative("x", -0.1).is_err());
         assert!(check_positive("x", 0.0).is_err());
         assert!(check_finite("x", f64::INFINITY).is_err());
+        assert!(check_range("x", 1.0, 0.0, 1.0, "m").is_ok());
+        let e = check_range("p.w", 1e300, 0.0, 1e6, "")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("p.w") && e.contains("1.0e300") && e.contains("1.0e6"),
+            "{e}"
+        );
+        assert!(check_range("x", f64::NAN, 0.0, 1.0, "m").is_err());
     }
 }

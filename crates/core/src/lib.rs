@@ -34,6 +34,33 @@
 //! [`PlanError::Count`]) naming the field, the value in scientific notation and the accepted
 //! range. Points outside the map bounds give [`PlanError::OutOfBounds`].
 //!
+//! # The backend contract
+//!
+//! [`TrajectoryBackend::optimize`] returns:
+//!
+//! - `Err(PlanError)` for invalid input or misuse only: a request, scene or parameter outside its
+//!   documented range, a start inside a static obstacle, a start or goal outside the bounds. The
+//!   error names the input that is wrong (the field path, e.g. `params.penalty.smoothing`,
+//!   `request.start.t`), its value in readable scientific notation and the accepted range. A
+//!   parameter accepted at construction never makes a solve fail with an error about something
+//!   else.
+//! - `Ok(Solution)` whenever the solve ran: a finite trajectory starting at the request's start
+//!   state, its cost breakdown and statistics. Not converging is a [`SolveStatus`], not an error.
+//!   **`Ok` does not mean safe.** Every solution carries [`Solution::violations`], the result of
+//!   [`verify_trajectory`] on the returned trajectory against the request's scene and limits:
+//!   each kind of violation (penetration of the static map, of each forecast, leaving the bounds
+//!   along each axis, over-speed, over-acceleration) is listed with its worst checked instant —
+//!   how deep or by how much, when and where. An empty list means none was found at instants
+//!   spaced at most [`VERIFY_STEP_S`] apart; a caller that needs a proof (the manager's safety
+//!   check) still checks with its own step.
+//!
+//! # Changelog
+//!
+//! - Issue 18: [`Solution::violations`] (with [`Violation`], [`verify_trajectory`],
+//!   [`Solution::is_clean`]) and [`check_range`]. Adding the field breaks code that builds a
+//!   `Solution` with a struct literal: add `violations: Vec::new()` (or the result of
+//!   [`verify_trajectory`]). Serialized solutions without the field still deserialize.
+//!
 //! ```
 //! use trust_core::{PolyTraj, Vec3};
 //!
@@ -53,12 +80,13 @@ mod solution;
 mod state;
 mod traits;
 mod traj;
+mod verify;
 
 pub use bernstein::bernstein_points;
 pub use curve::Curve;
 pub use error::{
-    PlanError, check_finite, check_finite_vec, check_non_negative, check_positive, check_scaled,
-    check_scaled_vec,
+    PlanError, check_finite, check_finite_vec, check_non_negative, check_positive, check_range,
+    check_scaled, check_scaled_vec,
 };
 pub use guidance::{guidance_radius, straight_end};
 pub use path::GuidePath;
@@ -70,6 +98,7 @@ pub use traits::{
     TrajectoryBackend,
 };
 pub use traj::{Derivative, MAX_DERIVATIVE_BOUND, Piece, PolyTraj, eval_piece};
+pub use verify::{VERIFY_MAX_SAMPLES, VERIFY_STEP_S, Violation, verify_trajectory};
 
 pub use trust_geometry::{Aabb, StaticMap, Vec3, scale};
 pub use trust_predict::{Forecast, ObstacleShape};

@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
-use crate::PolyTraj;
+use crate::{PolyTraj, Violation};
 
 /// The unweighted cost terms of paper eq. design-of-J and the weighted objective the backend minimized.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -92,6 +92,10 @@ pub struct SolveStats {
 }
 
 /// The result of [`crate::TrajectoryBackend::optimize`].
+///
+/// `Ok(Solution)` means the backend ran on valid input and returns a finite trajectory from the
+/// request's start; it does **not** mean the trajectory is safe or feasible. What it violates is
+/// in [`Solution::violations`] (see the [contract](crate#the-backend-contract)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Solution {
     /// The optimized trajectory (starts at the request's start state).
@@ -100,6 +104,20 @@ pub struct Solution {
     pub costs: CostBreakdown,
     /// Solve statistics.
     pub stats: SolveStats,
+    /// What the trajectory violates, from [`crate::verify_trajectory`] on the request's scene
+    /// and limits: empty when it keeps out of every obstacle and inside the bounds and limits at
+    /// every checked instant. (Added in issue 18; absent in older serialized solutions, which
+    /// deserialize with an empty list.)
+    #[serde(default)]
+    pub violations: Vec<Violation>,
+}
+
+impl Solution {
+    /// True if the post-solve verification found nothing: no penetration, inside the bounds,
+    /// within the limits at every checked instant.
+    pub fn is_clean(&self) -> bool {
+        self.violations.is_empty()
+    }
 }
 
 #[cfg(test)]

@@ -200,6 +200,7 @@ impl TrajRequest<'_> {
 ///                 elapsed: Duration::ZERO,
 ///                 status: SolveStatus::Converged,
 ///             },
+///             violations: Vec::new(),
 ///         })
 ///     }
 /// }
@@ -209,8 +210,16 @@ pub trait TrajectoryBackend: Send + Sync {
     /// Short name for reports (`"utf-minco"`, `"minco"`).
     fn name(&self) -> &str;
 
-    /// Optimizes a trajectory from `req.start`. A solve that does not converge returns `Ok` with its
-    /// status; `Err` is for invalid input.
+    /// Optimizes a trajectory from `req.start`.
+    ///
+    /// The contract (crate docs, [the backend contract](crate#the-backend-contract)):
+    /// - `Err` only for invalid input or misuse, naming the culprit field with its value and the
+    ///   accepted range;
+    /// - `Ok` whenever the solve ran, also when it did not converge (see
+    ///   [`crate::SolveStats::status`]); the trajectory is finite and starts at `req.start`;
+    /// - `Ok` does not hide anything: [`Solution::violations`] lists what the returned trajectory
+    ///   violates against `scene` and `req.limits` ([`crate::verify_trajectory`]); an
+    ///   implementation fills it by calling that function on the trajectory it returns.
     fn optimize(&self, req: &TrajRequest<'_>, scene: &Scene<'_>) -> Result<Solution, PlanError>;
 }
 

@@ -37,7 +37,7 @@
 //! #     fn name(&self) -> &str { "hold" }
 //! #     fn optimize(&self, r: &TrajRequest<'_>, _: &Scene<'_>) -> Result<Solution, PlanError> {
 //! #         Ok(Solution { traj: PolyTraj::hold(r.start.t, r.start.p, 1.0)?, costs: CostBreakdown::default(),
-//! #             stats: SolveStats { iteration_count: 0, evaluation_count: 0, elapsed: Default::default(), status: SolveStatus::Converged } })
+//! #             stats: SolveStats { iteration_count: 0, evaluation_count: 0, elapsed: Default::default(), status: SolveStatus::Converged }, violations: Vec::new() })
 //! #     }
 //! # }
 //! # struct Never;

@@ -437,6 +437,7 @@ impl TrajectoryBackend for Blind {
                 elapsed: std::time::Duration::ZERO,
                 status: SolveStatus::Converged,
             },
+            violations: Vec::new(),
         })
     }
 }

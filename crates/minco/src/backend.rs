@@ -46,7 +46,9 @@ mod utf_minco;
 pub use init::{InitialTrajectory, SpeedProfile, initial_trajectory, rest_to_rest_time};
 pub use minco_backend::Minco;
 pub use objective::{MincoObjective, UtfMincoObjective};
-pub use params::{MincoParams, PieceParams, SolverParams, UtfMincoParams};
+pub use params::{
+    MAX_MIN_PIECE_DURATION_S, MincoParams, PieceParams, SolverParams, UtfMincoParams,
+};
 pub use solve::{solve_status, validate_request};
 pub use time_map::{positive_time, positive_time_inverse};
 pub use utf_minco::UtfMinco;

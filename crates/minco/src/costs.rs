@@ -33,7 +33,10 @@ mod terminal;
 pub use dynamic::{DynamicObstacleTerm, ddf_violation, swept_box};
 pub use feasibility::{FeasibilityTerm, norm_violation};
 pub use integrate::{Integrand, PiecewiseView, SampleGrad, SampleState, TrapezoidIntegrator};
-pub use params::{CostWeights, PenaltyParams};
+pub use params::{
+    CostWeights, MAX_SAMPLES_PER_PIECE, MAX_SMOOTHING, MAX_WEIGHT, MIN_TIME_WEIGHT, PenaltyParams,
+    TERMINAL_NORM_EPSILON_RANGE,
+};
 pub use penalties::{BrakingTail, PenaltyIntegrals, PenaltyIntegrand, TAIL_RAMP_MPS};
 pub use smooth::{SmoothedL1, smoothed_l1};
 pub use static_map::StaticObstacleTerm;

@@ -42,7 +42,7 @@ impl InitialTrajectory {
                 format!("{} m/s, {} m/s²", sci(limits.v_max), sci(limits.a_max)),
                 format!(
                     "limits under which the {} m guide takes at most {} s (it takes {} s)",
-                    sci(path.length()),
+                    readable(path.length()),
                     sci(trust_core::scale::MAX_TIME_S),
                     sci(t)
                 ),
@@ -58,6 +58,15 @@ impl InitialTrajectory {
     /// Number of pieces `n`.
     pub fn pieces(&self) -> usize {
         self.waypoints.len() + 1
+    }
+}
+
+/// Three decimals for ordinary magnitudes, scientific notation otherwise (messages).
+fn readable(x: f64) -> String {
+    if (1e-3..1e6).contains(&x.abs()) {
+        format!("{x:.3}")
+    } else {
+        trust_core::scale::Sci(x).to_string()
     }
 }
 

@@ -239,7 +239,7 @@ impl<'a> UtfMincoObjective<'a> {
         pieces: usize,
     ) -> Result<Self, PlanError> {
         check_pieces(pieces)?;
-        params.validate("params")?;
+        params.validate_objective("params")?;
         Ok(Self {
             core: ObjectiveCore::new(
                 scene,
@@ -467,7 +467,7 @@ impl<'a> MincoObjective<'a> {
         pieces: usize,
     ) -> Result<Self, PlanError> {
         check_pieces(pieces)?;
-        params.validate("params")?;
+        params.validate_objective("params")?;
         let mut core = ObjectiveCore::new(
             scene,
             start,

@@ -1,10 +1,11 @@
 //! Parameters of the two backends.
 
 use serde::{Deserialize, Serialize};
-use trust_core::{PlanError, check_positive};
+use trust_core::scale::{MAX_TIME_S, MIN_POSITIVE, Quantity};
+use trust_core::{PlanError, check_range, check_scaled};
 use trust_lbfgs::LbfgsParams;
 
-use crate::costs::{CostWeights, PenaltyParams};
+use crate::costs::{CostWeights, MAX_WEIGHT, MIN_TIME_WEIGHT, PenaltyParams};
 
 /// How many pieces a trajectory gets and how short a piece may become.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -18,7 +19,8 @@ pub struct PieceParams {
     /// Most pieces (≥ `min_pieces`).
     pub max_pieces: usize,
     /// Lower bound of every piece duration (s): durations are `T_min + T(τ)` with the positive
-    /// map [`crate::backend::positive_time`].
+    /// map [`crate::backend::positive_time`]. Accepted: `[1e-9, 10]` s
+    /// ([`MAX_MIN_PIECE_DURATION_S`]).
     pub min_piece_duration_s: f64,
 }
 
@@ -46,12 +48,22 @@ impl Default for PieceParams {
     }
 }
 
+/// Largest accepted [`PieceParams::min_piece_duration_s`] (s): with at most
+/// [`crate::minco::MAX_PIECES`] = 1e5 pieces the floors add up to at most a tenth of the scale
+/// policy's longest duration (`MAX_TIME_S` = 1e7 s), so the trajectory's length is driven by
+/// the path and the limits, not by the floor. (Before issue 18 a floor of 1e6 s was accepted
+/// and the solve then failed with an error blaming `limits.v_max`.)
+pub const MAX_MIN_PIECE_DURATION_S: f64 = MAX_TIME_S / 10.0 / crate::minco::MAX_PIECES as f64;
+
 impl PieceParams {
-    /// Checks every field; errors name `{prefix}.{field}`.
+    /// Checks every field; errors name `{prefix}.{field}`. Accepted: `target_piece_length_m` a
+    /// positive length (`[1e-9, 1e6]` m), `1 ≤ min_pieces ≤ max_pieces ≤ MAX_PIECES`,
+    /// `min_piece_duration_s` in `[1e-9, 10]` s.
     pub fn validate(&self, prefix: &str) -> Result<(), PlanError> {
-        check_positive(
+        check_scaled(
             &format!("{prefix}.target_piece_length_m"),
             self.target_piece_length_m,
+            Quantity::PositiveLength,
         )?;
         if self.min_pieces == 0 {
             return Err(PlanError::invalid(
@@ -74,12 +86,19 @@ impl PieceParams {
             return Err(PlanError::invalid(
                 format!("{prefix}.max_pieces"),
                 self.max_pieces,
-                format!("an integer >= min_pieces ({})", self.min_pieces),
+                format!(
+                    "an integer >= {prefix}.min_pieces ({}); lower {prefix}.min_pieces or raise \
+                     {prefix}.max_pieces",
+                    self.min_pieces
+                ),
             ));
         }
-        check_positive(
+        check_range(
             &format!("{prefix}.min_piece_duration_s"),
             self.min_piece_duration_s,
+            MIN_POSITIVE,
+            MAX_MIN_PIECE_DURATION_S,
+            "s",
         )?;
         Ok(())
     }
@@ -187,12 +206,27 @@ pub struct UtfMincoParams {
 }
 
 impl UtfMincoParams {
-    /// Checks every field; errors name `{prefix}.{field}` (e.g. `params.weights.time`).
+    /// Checks every field; errors name `{prefix}.{field}` (e.g. `params.weights.time`). The
+    /// ranges are documented on [`CostWeights::validate`], [`PenaltyParams::validate`] and
+    /// [`PieceParams::validate`]; a backend also needs `weights.time ≥ 1e-6`
+    /// ([`crate::costs::MIN_TIME_WEIGHT`]).
     pub fn validate(&self, prefix: &str) -> Result<(), PlanError> {
+        self.validate_objective(prefix)?;
+        check_range(
+            &format!("{prefix}.weights.time"),
+            self.weights.time,
+            MIN_TIME_WEIGHT,
+            MAX_WEIGHT,
+            "",
+        )?;
+        self.solver.validate(&format!("{prefix}.solver"))
+    }
+
+    /// The checks an objective needs (weights, penalty, pieces; `λ_t = 0` allowed).
+    pub(crate) fn validate_objective(&self, prefix: &str) -> Result<(), PlanError> {
         self.weights.validate(&format!("{prefix}.weights"))?;
         self.penalty.validate(&format!("{prefix}.penalty"))?;
-        self.pieces.validate(&format!("{prefix}.pieces"))?;
-        self.solver.validate(&format!("{prefix}.solver"))
+        self.pieces.validate(&format!("{prefix}.pieces"))
     }
 }
 
@@ -212,12 +246,27 @@ pub struct MincoParams {
 }
 
 impl MincoParams {
-    /// Checks every field; errors name `{prefix}.{field}`.
+    /// Checks every field; errors name `{prefix}.{field}` (e.g. `params.weights.time`). The
+    /// ranges are documented on [`CostWeights::validate`], [`PenaltyParams::validate`] and
+    /// [`PieceParams::validate`]; a backend also needs `weights.time ≥ 1e-6`
+    /// ([`crate::costs::MIN_TIME_WEIGHT`]).
     pub fn validate(&self, prefix: &str) -> Result<(), PlanError> {
+        self.validate_objective(prefix)?;
+        check_range(
+            &format!("{prefix}.weights.time"),
+            self.weights.time,
+            MIN_TIME_WEIGHT,
+            MAX_WEIGHT,
+            "",
+        )?;
+        self.solver.validate(&format!("{prefix}.solver"))
+    }
+
+    /// The checks an objective needs (weights, penalty, pieces; `λ_t = 0` allowed).
+    pub(crate) fn validate_objective(&self, prefix: &str) -> Result<(), PlanError> {
         self.weights.validate(&format!("{prefix}.weights"))?;
         self.penalty.validate(&format!("{prefix}.penalty"))?;
-        self.pieces.validate(&format!("{prefix}.pieces"))?;
-        self.solver.validate(&format!("{prefix}.solver"))
+        self.pieces.validate(&format!("{prefix}.pieces"))
     }
 }
 

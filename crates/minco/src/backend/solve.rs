@@ -3,9 +3,10 @@
 
 use std::time::Instant;
 
+use trust_core::scale::Sci;
 use trust_core::{
     InitialGuess, PlanError, Scene, Solution, SolveStats, SolveStatus, TrajRequest, check_finite,
-    check_finite_vec,
+    check_finite_vec, verify_trajectory,
 };
 use trust_lbfgs::{Deadline, Lbfgs, Report, SplitObjective, Termination};
 
@@ -90,20 +91,26 @@ pub(crate) fn run_lbfgs<O: SplitCost>(
 }
 
 /// Runs [`run_lbfgs`] from `x`, re-evaluates at the returned point (the breakdown and the
-/// trajectory belong to it) and packages the [`Solution`] with its statistics since `started`.
+/// trajectory belong to it), verifies the trajectory against the request's scene and limits
+/// ([`verify_trajectory`]) and packages the [`Solution`] with its statistics since `started`.
 pub(crate) fn solve_and_package<O: SplitCost>(
     component: &str,
     objective: &mut O,
     x: &mut [f64],
     solver: &SolverParams,
-    deadline: Option<Instant>,
+    req: &TrajRequest<'_>,
+    scene: &Scene<'_>,
     started: Instant,
 ) -> Result<Solution, PlanError> {
-    let report = run_lbfgs(component, objective, x, solver, deadline)?;
+    let report = run_lbfgs(component, objective, x, solver, req.deadline)?;
     let mut g = vec![0.0; x.len()];
     objective.eval(x, &mut g);
+    let traj = objective
+        .trajectory()
+        .map_err(|e| blame_start_time(e, req))?;
+    let violations = verify_trajectory(&traj, scene, &req.limits);
     Ok(Solution {
-        traj: objective.trajectory()?,
+        traj,
         costs: objective.breakdown(),
         stats: SolveStats {
             iteration_count: report.iteration_count,
@@ -111,7 +118,49 @@ pub(crate) fn solve_and_package<O: SplitCost>(
             elapsed: started.elapsed(),
             status: solve_status(report.termination),
         },
+        violations,
     })
+}
+
+/// Checks that a trajectory of `duration` seconds from `req.start.t` ends inside the scale
+/// policy's times (`≤ 1e7` s); otherwise the culprit is `request.start.t`.
+pub(crate) fn check_end_time(req: &TrajRequest<'_>, duration: f64) -> Result<(), PlanError> {
+    let t_end = req.start.t + duration;
+    if t_end <= trust_core::scale::MAX_TIME_S {
+        return Ok(());
+    }
+    Err(blame_start_time(
+        PlanError::Scale(trust_core::scale::ScaleError {
+            field: "traj.t_end".into(),
+            value: t_end,
+            lo: -trust_core::scale::MAX_TIME_S,
+            hi: trust_core::scale::MAX_TIME_S,
+            unit: "s",
+        }),
+        req,
+    ))
+}
+
+/// A trajectory whose end time leaves the scale policy (`|t| ≤ 1e7` s) was started too close to
+/// the limit: the culprit is `request.start.t`, not the internal `traj.t_end`.
+pub(crate) fn blame_start_time(e: PlanError, req: &TrajRequest<'_>) -> PlanError {
+    match e {
+        PlanError::Scale(s) if s.field == "traj.t_end" => {
+            let duration = s.value - req.start.t;
+            PlanError::Scale(trust_core::scale::ScaleError {
+                field: format!(
+                    "request.start.t (the trajectory lasts {} s and would end at {} s)",
+                    Sci(duration),
+                    Sci(s.value)
+                ),
+                value: req.start.t,
+                lo: s.lo,
+                hi: s.hi - duration,
+                unit: "s",
+            })
+        }
+        other => other,
+    }
 }
 
 /// An objective as a [`SplitObjective`]: a gradient that cannot be computed is reported to the

@@ -8,7 +8,7 @@ use trust_core::{PlanError, Scene, Solution, TrajRequest, TrajectoryBackend, gui
 use super::init::initial_trajectory;
 use super::objective::UtfMincoObjective;
 use super::params::UtfMincoParams;
-use super::solve::{solve_and_package, validate_request};
+use super::solve::{check_end_time, solve_and_package, validate_request};
 
 /// UTF-MINCO: minimizes `J = λ · [H_t, H_s, I_o, I_d, I_e]` (paper eq. design-of-J) over the
 /// inner waypoints, the free terminal position and velocity and the total duration
@@ -25,7 +25,8 @@ use super::solve::{solve_and_package, validate_request};
 ///   trajectory ends at rest on the goal (the paper ramps `α` only within `d_ε` of the goal, too
 ///   late to stop from full speed).
 /// - The returned trajectory starts at `req.start` (position, velocity, acceleration, time) and
-///   is finite; the cost breakdown is evaluated at it.
+///   is finite; the cost breakdown is evaluated at it, and [`trust_core::Solution::violations`]
+///   lists what it violates ([`trust_core::verify_trajectory`]: penetration, bounds, limits).
 #[derive(Debug, Clone, Default)]
 pub struct UtfMinco {
     params: UtfMincoParams,
@@ -58,6 +59,7 @@ impl TrajectoryBackend for UtfMinco {
         let p = &self.params;
         let init = initial_trajectory(&req.initial, &req.start, &req.limits, &p.pieces);
         init.check_duration(&req.initial, &req.limits)?;
+        check_end_time(req, init.total_duration)?;
         let mut f =
             UtfMincoObjective::new(scene, &req.start, req.goal, req.limits, p, init.pieces())?;
         if let Some(horizon) = req.horizon_s {
@@ -83,7 +85,8 @@ impl TrajectoryBackend for UtfMinco {
             &mut f,
             &mut x,
             &p.solver.capped(req.max_evaluations),
-            req.deadline,
+            req,
+            scene,
             started,
         )
     }

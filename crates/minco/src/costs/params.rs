@@ -1,7 +1,25 @@
 //! Weights and shape parameters of the cost terms (paper eq. design-of-J).
 
 use serde::{Deserialize, Serialize};
-use trust_core::{PlanError, Vec3, check_finite_vec, check_non_negative, check_positive};
+use trust_core::scale::{MAX_LENGTH_M, MIN_POSITIVE, Quantity};
+use trust_core::{PlanError, Vec3, check_range, check_scaled};
+
+/// Largest accepted weight `λ` and terminal gain. The penalty weights' defaults are 1e4
+/// (GCOPTER); up to 1e6 every term of `J` stays finite and L-BFGS's relative tests stay
+/// meaningful on every accepted scene (probed on the E2 scenes: 1e8 and above still solve but
+/// `λ_t = 1e8` already squashes the trajectory to 0.16 s through the obstacles).
+pub const MAX_WEIGHT: f64 = 1.0e6;
+
+/// Largest accepted smoothing width `μ` of the penalties' smoothed max (m for the obstacle
+/// terms, a fraction of the squared limit for the feasibility term). The smoothed max grows like
+/// `x³/μ²` below `μ`: at `μ = 10` the E2 solves already ignored the obstacles (a 5.4 s
+/// trajectory straight through them with `I_o ≈ 1e-4`), so widths above 1 are rejected.
+pub const MAX_SMOOTHING: f64 = 1.0;
+
+/// Accepted range of the terminal norm's `ε` (m and m/s): below 1e-6 its square loses the
+/// difference that keeps the smoothed norm's gradient finite at the goal (probed: `1e-300`
+/// gave a NaN gradient at the start point), above [`MAX_LENGTH_M`] the norm overflows.
+pub const TERMINAL_NORM_EPSILON_RANGE: (f64, f64) = (1.0e-6, MAX_LENGTH_M);
 
 /// The weight vector `λ` of paper eq. design-of-J: `J = λ · [H_t, H_s, I_o, I_d, I_e]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -39,14 +57,26 @@ impl Default for CostWeights {
     }
 }
 
+/// Smallest time weight `λ_t` a backend accepts ([`crate::backend::UtfMincoParams::validate`];
+/// the objectives alone accept 0): with `λ_t = 0` nothing bounds the durations (the jerk energy
+/// alone falls like `1/T⁵`), and a solve with `λ_e = 1e20` ended with a 7e7 s piece, outside the
+/// scale policy. With `λ_t ≥ 1e-6` and `λ_e ≤ 1e6` the optimal duration of a 1e6 m path stays
+/// near `(5·λ_e·L²/λ_t)^(1/6) ≈ 1e4` s.
+pub const MIN_TIME_WEIGHT: f64 = 1.0e-6;
+
 impl CostWeights {
-    /// Every weight finite and `≥ 0`; the error names `{prefix}.{field}`.
+    /// Every weight in `[0, 1e6]` ([`MAX_WEIGHT`]); the error names `{prefix}.{field}`. (A
+    /// backend also needs `time ≥ 1e-6`, [`MIN_TIME_WEIGHT`].)
     pub fn validate(&self, prefix: &str) -> Result<(), PlanError> {
-        check_non_negative(&format!("{prefix}.time"), self.time)?;
-        check_non_negative(&format!("{prefix}.terminal"), self.terminal)?;
-        check_non_negative(&format!("{prefix}.obstacle"), self.obstacle)?;
-        check_non_negative(&format!("{prefix}.feasibility"), self.feasibility)?;
-        check_non_negative(&format!("{prefix}.energy"), self.energy)?;
+        for (name, w) in [
+            ("time", self.time),
+            ("terminal", self.terminal),
+            ("obstacle", self.obstacle),
+            ("feasibility", self.feasibility),
+            ("energy", self.energy),
+        ] {
+            check_range(&format!("{prefix}.{name}"), w, 0.0, MAX_WEIGHT, "")?;
+        }
         Ok(())
     }
 
@@ -139,65 +169,112 @@ impl Default for PenaltyParams {
 }
 
 impl PenaltyParams {
-    /// Checks every field; the error names `{prefix}.{field}`.
+    /// Checks every field; the error names `{prefix}.{field}`. Accepted ranges (derived from the
+    /// scale policy, [`trust_core::scale`], and probed on the E2 scenes):
+    ///
+    /// | field | accepted |
+    /// |---|---|
+    /// | `samples_per_piece`, `braking_tail_samples` | `[1, 1024]`, `[0, 1024]` |
+    /// | `smoothing` | `[1e-9, 1]` ([`MAX_SMOOTHING`]) |
+    /// | `dynamic_clearance_m`, `static_clearance_m` | `[0, 1e6]` m (a length) |
+    /// | `goal_radius_m`, `guidance_smoothing_m` | `[1e-9, 1e6]` m (a positive length) |
+    /// | `terminal_position_gains`, `terminal_velocity_gains` | each component `[0, 1e6]` |
+    /// | `terminal_norm_epsilon` | `[1e-6, 1e6]` ([`TERMINAL_NORM_EPSILON_RANGE`]) |
+    /// | `braking_tail_decel_fraction` | `(0, 1]` |
+    /// | `braking_tail_delay_s` | `[0, 1e7]` s (a duration) |
     pub fn validate(&self, prefix: &str) -> Result<(), PlanError> {
-        if self.samples_per_piece == 0 || self.samples_per_piece > 1024 {
-            return Err(PlanError::invalid(
-                format!("{prefix}.samples_per_piece"),
-                self.samples_per_piece,
-                "an integer in [1, 1024] (node tables are allocated per piece)",
-            ));
-        }
-        check_positive(&format!("{prefix}.smoothing"), self.smoothing)?;
-        check_non_negative(
-            &format!("{prefix}.dynamic_clearance_m"),
+        let field = |name: &str| format!("{prefix}.{name}");
+        check_count(
+            &field("samples_per_piece"),
+            self.samples_per_piece,
+            1,
+            MAX_SAMPLES_PER_PIECE,
+        )?;
+        check_range(
+            &field("smoothing"),
+            self.smoothing,
+            MIN_POSITIVE,
+            MAX_SMOOTHING,
+            "",
+        )?;
+        check_scaled(
+            &field("dynamic_clearance_m"),
             self.dynamic_clearance_m,
+            Quantity::Length,
         )?;
-        check_non_negative(
-            &format!("{prefix}.static_clearance_m"),
+        check_scaled(
+            &field("static_clearance_m"),
             self.static_clearance_m,
+            Quantity::Length,
         )?;
-        check_positive(&format!("{prefix}.goal_radius_m"), self.goal_radius_m)?;
+        check_scaled(
+            &field("goal_radius_m"),
+            self.goal_radius_m,
+            Quantity::PositiveLength,
+        )?;
         check_gains(
-            &format!("{prefix}.terminal_position_gains"),
+            &field("terminal_position_gains"),
             &self.terminal_position_gains,
         )?;
         check_gains(
-            &format!("{prefix}.terminal_velocity_gains"),
+            &field("terminal_velocity_gains"),
             &self.terminal_velocity_gains,
         )?;
-        check_positive(
-            &format!("{prefix}.terminal_norm_epsilon"),
+        let (lo, hi) = TERMINAL_NORM_EPSILON_RANGE;
+        check_range(
+            &field("terminal_norm_epsilon"),
             self.terminal_norm_epsilon,
+            lo,
+            hi,
+            "m",
         )?;
-        check_positive(
-            &format!("{prefix}.guidance_smoothing_m"),
+        check_scaled(
+            &field("guidance_smoothing_m"),
             self.guidance_smoothing_m,
+            Quantity::PositiveLength,
+        )?;
+        check_count(
+            &field("braking_tail_samples"),
+            self.braking_tail_samples,
+            0,
+            MAX_SAMPLES_PER_PIECE,
         )?;
         let fraction = self.braking_tail_decel_fraction;
         if !(fraction > 0.0 && fraction <= 1.0) {
             return Err(PlanError::invalid(
-                format!("{prefix}.braking_tail_decel_fraction"),
+                field("braking_tail_decel_fraction"),
                 fraction,
                 "a fraction of a_max in (0, 1]",
             ));
         }
-        check_non_negative(
-            &format!("{prefix}.braking_tail_delay_s"),
+        check_scaled(
+            &field("braking_tail_delay_s"),
             self.braking_tail_delay_s,
+            Quantity::Duration,
         )?;
         Ok(())
     }
 }
 
-fn check_gains(field: &str, gains: &Vec3) -> Result<(), PlanError> {
-    check_finite_vec(field, gains)?;
-    if gains.iter().any(|g| *g < 0.0) {
-        return Err(PlanError::invalid(
+/// Most samples per piece (`samples_per_piece`, `braking_tail_samples`): node tables are
+/// allocated per piece.
+pub const MAX_SAMPLES_PER_PIECE: usize = 1024;
+
+fn check_count(field: &str, n: usize, lo: usize, hi: usize) -> Result<(), PlanError> {
+    if (lo..=hi).contains(&n) {
+        Ok(())
+    } else {
+        Err(PlanError::invalid(
             field,
-            [gains.x, gains.y, gains.z],
-            "gains >= 0",
-        ));
+            n,
+            format!("an integer in [{lo}, {hi}]"),
+        ))
+    }
+}
+
+fn check_gains(field: &str, gains: &Vec3) -> Result<(), PlanError> {
+    for (axis, g) in ['x', 'y', 'z'].into_iter().zip(gains.iter()) {
+        check_range(&format!("{field}.{axis}"), *g, 0.0, MAX_WEIGHT, "")?;
     }
     Ok(())
 }
@@ -248,5 +325,42 @@ mod tests {
                 .to_string()
                 .contains("x.terminal_velocity_gains")
         );
+    }
+
+    #[test]
+    fn extreme_values_are_rejected_with_the_field_and_a_readable_number() {
+        // Issue 18: these were accepted and then broke the solve with an error about something
+        // else ("cost at the start point = inf", "g[0] = NaN") or silently turned the
+        // obstacle penalty off (`smoothing = 1e300`).
+        type Edit = fn(&mut PenaltyParams);
+        let cases: [(&str, Edit); 6] = [
+            ("p.smoothing", |p| p.smoothing = 1e300),
+            ("p.terminal_norm_epsilon", |p| {
+                p.terminal_norm_epsilon = 1e-300
+            }),
+            ("p.terminal_norm_epsilon", |p| {
+                p.terminal_norm_epsilon = 1e300
+            }),
+            ("p.dynamic_clearance_m", |p| p.dynamic_clearance_m = 1e300),
+            ("p.terminal_position_gains.y", |p| {
+                p.terminal_position_gains.y = f64::MAX
+            }),
+            ("p.braking_tail_samples", |p| {
+                p.braking_tail_samples = usize::MAX
+            }),
+        ];
+        for (field, edit) in cases {
+            let mut p = PenaltyParams::default();
+            edit(&mut p);
+            let e = p.validate("p").unwrap_err().to_string();
+            assert!(e.contains(field), "{field}: {e}");
+            assert!(e.len() < 200, "{e}");
+        }
+        let w = CostWeights {
+            time: 1e300,
+            ..CostWeights::default()
+        };
+        let e = w.validate("w").unwrap_err().to_string();
+        assert!(e.contains("w.time") && e.contains("1.0e300"), "{e}");
     }
 }
