@@ -73,6 +73,17 @@ pub const MAX_MEMORY: usize = 1024;
 /// Largest accepted [`LbfgsParams::past`]: the past costs are allocated up front.
 pub const MAX_PAST: usize = 65_536;
 
+/// Largest number of variables of one solver ([`crate::Lbfgs::new`]): 10⁶. The largest problem of
+/// the planner, a MINCO trajectory with `trust_geometry::scale::MAX_VERTEX_COUNT` = 10⁵ pieces, has
+/// `3·(10⁵ − 1) + 10⁵ ≈ 4·10⁵` variables; above the cap a request is a typed error, not a
+/// "capacity overflow" panic or a multi-terabyte allocation.
+pub const MAX_DIMENSION: usize = 1_000_000;
+
+/// Largest workspace of one solver in floats, `(2·memory + 6)·dimension + 3·memory + past`:
+/// 5·10⁷ floats (400 MB), enough for [`MAX_DIMENSION`] variables with the default 8 pairs
+/// (2.2·10⁷ floats) and for 1024 pairs up to 24 000 variables.
+pub const MAX_WORKSPACE_FLOATS: usize = 50_000_000;
+
 impl LbfgsParams {
     /// Checks every field's range; the error names the first offending field and its value.
     pub fn validate(&self) -> Result<(), LbfgsError> {
