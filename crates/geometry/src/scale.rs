@@ -210,6 +210,32 @@ pub fn check(field: &str, value: f64, quantity: Quantity) -> Result<f64, ScaleEr
     }
 }
 
+/// Checks `value` against an explicit closed range `[lo, hi]` in `unit`, for parameters whose unit
+/// is none of [`Quantity`]'s (a noise density in m²/s³, a dimensionless factor): the error has the
+/// same form as [`check`]'s.
+///
+/// # Errors
+/// A [`ScaleError`] naming `field` if `value` is NaN, infinite or outside `[lo, hi]`.
+pub fn check_range(
+    field: &str,
+    value: f64,
+    lo: f64,
+    hi: f64,
+    unit: &'static str,
+) -> Result<f64, ScaleError> {
+    if value >= lo && value <= hi {
+        Ok(value)
+    } else {
+        Err(ScaleError {
+            field: field.to_owned(),
+            value,
+            lo,
+            hi,
+            unit,
+        })
+    }
+}
+
 /// Checks every component of `v` against the range of `quantity`; the field name gets
 /// `.x`/`.y`/`.z` appended.
 ///
