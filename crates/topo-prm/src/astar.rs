@@ -16,13 +16,14 @@ use serde::{Deserialize, Serialize};
 
 use trust_core::{
     GuidePath, PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult, SearchStats, Vec3,
-    check_non_negative, check_positive,
 };
 
 use crate::ggs::Terminal;
 use crate::prm::check_or_trivial_answer;
+use crate::ranges;
 use crate::shortcut::shortcut;
 use crate::visibility::Obstacles;
+use trust_core::scale;
 
 /// Yaw directions of the first expansion (from the start, which has no heading).
 const START_YAW_COUNT: usize = 16;
@@ -83,7 +84,13 @@ impl SparseAStarParams {
     }
 
     fn budget(&self) -> Result<Duration, PlanError> {
-        check_positive("sparse_astar.step", self.step)?;
+        ranges::range(
+            "sparse_astar.step",
+            self.step,
+            ranges::MIN_RESOLUTION_M,
+            scale::MAX_LENGTH_M,
+            "m",
+        )?;
         if !(self.max_turn_deg.is_finite() && (0.0..=180.0).contains(&self.max_turn_deg)) {
             return Err(PlanError::invalid(
                 "sparse_astar.max_turn_deg",
@@ -105,11 +112,18 @@ impl SparseAStarParams {
                 "an integer in [1, 64] (MAX_TURN_BRANCHES; each expansion tries this many headings)",
             ));
         }
-        if self.max_expansions == 0 {
-            return Err(PlanError::invalid("sparse_astar.max_expansions", 0, ">= 1"));
-        }
-        check_non_negative("sparse_astar.clearance", self.clearance)?;
-        check_positive("sparse_astar.budget_ms", self.budget_ms)?;
+        ranges::count(
+            "sparse_astar.max_expansions",
+            self.max_expansions,
+            1,
+            ranges::MAX_EXPANSIONS,
+        )?;
+        ranges::quantity(
+            "sparse_astar.clearance",
+            self.clearance,
+            scale::Quantity::Length,
+        )?;
+        ranges::budget_ms("sparse_astar.budget_ms", self.budget_ms)?;
         Duration::try_from_secs_f64(self.budget_ms / 1000.0).map_err(|_| {
             PlanError::invalid(
                 "sparse_astar.budget_ms",

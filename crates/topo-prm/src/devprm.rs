@@ -35,6 +35,8 @@ use serde::{Deserialize, Serialize};
 use trust_core::{PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult, Vec3};
 
 use crate::prm::{ConeMode, GraphSearch, PrmSetup, SurfaceSampling, run};
+use crate::ranges;
+use trust_core::scale::{self, Quantity};
 
 /// Parameters of [`DevPrm`]. The V-PRM part defaults to Fast-Planner's values (see
 /// [`crate::VprmParams`]); the paper gives no values for the rest, so they are ours, as stated.
@@ -134,32 +136,43 @@ impl DevPrmParams {
     fn setup(&self) -> Result<PrmSetup, PlanError> {
         let shared = self.shared_setup();
         shared.check_shared("devprm")?;
-        if self.beam_width == 0 {
-            return Err(PlanError::invalid("devprm.beam_width", 0, ">= 1"));
-        }
+        ranges::count(
+            "devprm.stall_samples",
+            self.stall_samples,
+            0,
+            trust_core::scale::MAX_SAMPLE_COUNT,
+        )?;
+        ranges::count(
+            "devprm.beam_width",
+            self.beam_width,
+            1,
+            ranges::MAX_BEAM_WIDTH,
+        )?;
         if self.obstacle_aware_samples {
-            if self.slices == 0 {
-                return Err(PlanError::invalid("devprm.slices", 0, ">= 1"));
-            }
-            if self.samples_per_slice == 0 {
-                return Err(PlanError::invalid("devprm.samples_per_slice", 0, ">= 1"));
-            }
-            if !(self.surface_offset.is_finite() && self.surface_offset >= self.clearance) {
-                return Err(PlanError::invalid(
-                    "devprm.surface_offset",
-                    self.surface_offset,
-                    format!("a finite number >= devprm.clearance ({})", self.clearance),
-                ));
-            }
+            ranges::count("devprm.slices", self.slices, 1, ranges::MAX_SURFACE_SAMPLES)?;
+            ranges::count(
+                "devprm.samples_per_slice",
+                self.samples_per_slice,
+                1,
+                ranges::MAX_SURFACE_SAMPLES,
+            )?;
+            scale::check_count(
+                "devprm.slices * devprm.samples_per_slice",
+                self.slices as u128 * self.samples_per_slice as u128,
+                ranges::MAX_SURFACE_SAMPLES,
+            )?;
+            // At least the sample clearance (a surface sample must be a valid sample), at most a
+            // length of the scale policy.
+            ranges::range(
+                "devprm.surface_offset",
+                self.surface_offset,
+                self.clearance,
+                scale::MAX_LENGTH_M,
+                "m (lower end: devprm.clearance)",
+            )?;
         }
-        if let Some(h) = self.pdc_horizon_s
-            && !(h.is_finite() && h >= 0.0)
-        {
-            return Err(PlanError::invalid(
-                "devprm.pdc_horizon_s",
-                h,
-                "a finite number >= 0 (s), or none for the query horizon",
-            ));
+        if let Some(h) = self.pdc_horizon_s {
+            ranges::quantity("devprm.pdc_horizon_s", h, Quantity::Duration)?;
         }
         Ok(PrmSetup {
             stall_samples: self.stall_samples,

@@ -78,14 +78,29 @@ fn check_range(field: &str, (lo, hi): (f64, f64), positive: bool) -> Result<(), 
 impl SceneParams {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
+        use trust_core::scale::{self, Quantity};
         check_finite_vec("scene.size", &self.size)?;
         for i in 0..3 {
             check_positive("scene.size", self.size[i])?;
         }
+        scale::check_vec("scene.size", &self.size, Quantity::PositiveLength)?;
         check_range("scene.speed", self.speed, false)?;
+        scale::check("scene.speed.1", self.speed.1, Quantity::Rate)?;
         check_range("scene.radius", self.radius, true)?;
+        scale::check("scene.radius.1", self.radius.1, Quantity::Length)?;
         check_range("scene.mu", self.mu, false)?;
-        check_non_negative("scene.r_safe", self.r_safe)?;
+        scale::check("scene.mu.1", self.mu.1, Quantity::Rate)?;
+        scale::check("scene.r_safe", self.r_safe, Quantity::Length)?;
+        scale::check(
+            "scene.endpoint_clearance",
+            self.endpoint_clearance,
+            Quantity::Length,
+        )?;
+        scale::check(
+            "scene.horizon_s",
+            self.horizon_s,
+            Quantity::PositiveDuration,
+        )?;
         if !(0.0..=1.0).contains(&self.cylinder_fraction) {
             return Err(PlanError::invalid(
                 "scene.cylinder_fraction",

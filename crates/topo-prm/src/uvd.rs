@@ -16,9 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use trust_core::{
-    Aabb, Curve, HomotopyChecker, PlanError, Scene, Vec3, check_non_negative, check_positive,
-};
+use trust_core::{Aabb, Curve, HomotopyChecker, PlanError, Scene, Vec3, check_positive};
 
 use crate::gjk::{Hull, separated_along};
 use crate::visibility::{Obstacles, forecast_cones};
@@ -723,10 +721,11 @@ impl Default for UvdParams {
 impl UvdParams {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
-        check_positive("uvd.resolution", self.resolution)?;
-        check_non_negative("uvd.clearance", self.clearance)?;
+        use trust_core::scale::{self, Quantity};
+        scale::check("uvd.resolution", self.resolution, Quantity::PositiveLength)?;
+        scale::check("uvd.clearance", self.clearance, Quantity::Length)?;
         if let Some(h) = self.pdc_horizon_s {
-            check_positive("uvd.pdc_horizon_s", h)?;
+            scale::check("uvd.pdc_horizon_s", h, Quantity::PositiveDuration)?;
             if self.freeze_forecasts {
                 return Err(PlanError::invalid(
                     "uvd.freeze_forecasts",
