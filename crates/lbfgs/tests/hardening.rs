@@ -88,7 +88,7 @@ fn large_memory_times_dimension_is_a_workspace_error_naming_both() {
     assert!(!has_long_digit_run(&msg), "{msg}");
     // Below the workspace cap the same memory is fine.
     assert!(Lbfgs::new(20_000, params).is_ok());
-    assert!(MAX_WORKSPACE_FLOATS >= (2 * 8 + 6) * MAX_DIMENSION + 3 * 8 + 3);
+    const { assert!(MAX_WORKSPACE_FLOATS >= (2 * 8 + 6) * MAX_DIMENSION + 3 * 8 + 3) };
 }
 
 /// True if `s` has a run of more than 17 decimal digits (an unreadable number).
