@@ -47,6 +47,9 @@ pub struct StaticMap {
     bvh: Bvh,
     esdf: Option<Esdf>,
     default_resolution: f64,
+    /// Largest coordinate magnitude of the shapes' boxes: the distance functions round at a few
+    /// ulps of it, and line of sight widens its broad phase by as much.
+    shape_coord_max: f64,
 }
 
 /// Prefixes the field name of an error with `prefix` (e.g. `shapes[3].`).
@@ -108,6 +111,7 @@ impl StaticMap {
             bvh: Bvh::new(),
             esdf: None,
             default_resolution: DEFAULT_RESOLUTION,
+            shape_coord_max: 0.0,
         })
     }
 
@@ -134,6 +138,14 @@ impl StaticMap {
             self.shapes.push(s);
         }
         let leaves: Vec<_> = self.shapes.iter().map(|s| to_p_aabb(&s.aabb())).collect();
+        self.shape_coord_max = self
+            .shapes
+            .iter()
+            .map(|s| {
+                let b = s.aabb();
+                b.min.amax().max(b.max.amax())
+            })
+            .fold(0.0, f64::max);
         self.bvh = Bvh::from_leaves(BvhBuildStrategy::default(), &leaves);
         Ok(self)
     }
@@ -332,9 +344,10 @@ impl StaticMap {
         if self.shapes.is_empty() {
             return true;
         }
-        // Inflated by a few ulps too, so that a shape the segment touches within rounding is a
-        // candidate (the exact tests below are conservative at that scale).
-        let ulps = 8.0 * f64::EPSILON * (a.amax() + b.amax());
+        // Inflated by a few ulps of the segment's and the shapes' coordinates too, so that a shape
+        // the segment touches within the rounding of the distance functions is a candidate (the
+        // exact tests below are conservative at that scale).
+        let ulps = 8.0 * f64::EPSILON * (a.amax() + b.amax() + self.shape_coord_max);
         let query = to_p_aabb(&Aabb::from_segment(a, b).inflated(clearance + ulps));
         let mut candidates = self.bvh.intersect_aabb(&query);
         // Each shape sees only the part of the segment inside its box inflated by the clearance

@@ -82,8 +82,14 @@ pub(crate) fn segment_blocked(shape: &Shape, a: &Vec3, b: &Vec3, clearance: f64)
     // surface is blocked at clearance 0, like the zero-length segment at that point, although
     // GJK stops up to ~1e-8 m above 0 for a segment leaving a cylinder tangentially.
     let end = shape.signed_distance(a).min(shape.signed_distance(b));
-    if end.is_nan() || end <= 0.0 || end < clearance {
+    let tol = contact_tolerance(shape, a, b);
+    if end.is_nan() || end <= tol || end < clearance {
         return true;
+    }
+    if a == b {
+        // A point: its exact distance decides (GJK on a degenerate segment could err either way
+        // within its tolerance, and then a segment from this point could be clearer than it).
+        return false;
     }
     let decided = match shape {
         Shape::Cylinder(c) => cylinder_verdict(c, a, b, clearance),

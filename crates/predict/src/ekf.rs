@@ -279,7 +279,13 @@ impl CvEkf {
             .cholesky()
             .map(|c| c.inverse())
             .ok_or_else(|| PredictError::Numerical {
-                what: "innovation covariance is not positive definite".into(),
+                what: format!(
+                    "innovation covariance is not positive definite (position std {} m against \
+                     ekf.meas_std = {} m; ekf.init_vel_std, ekf.accel_psd and the time since the \
+                     last measurement drive the former)",
+                    scale::Sci(self.position_std()),
+                    scale::Sci(self.params.meas_std)
+                ),
             })?;
         let pht: Matrix6x3<f64> = self.cov.fixed_view::<6, 3>(0, 0).into_owned();
         let k = pht * s_inv;
@@ -408,7 +414,8 @@ impl CvEkf {
                 scale::MAX_LENGTH_M,
                 format!(
                     "r_safe = {}, ekf.sigma_scale = {}, position std = {} m (ekf.meas_std, \
-                     ekf.accel_psd and the time since the last measurement drive it)",
+                     ekf.init_vel_std, ekf.accel_psd and the time since the last measurement \
+                     drive it)",
                     scale::Sci(r_safe),
                     scale::Sci(self.params.sigma_scale),
                     scale::Sci(self.position_std())

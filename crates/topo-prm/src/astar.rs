@@ -105,13 +105,13 @@ impl SparseAStarParams {
                 "a number in [0, 90]",
             ));
         }
-        if self.turn_branches == 0 || self.turn_branches > MAX_TURN_BRANCHES {
-            return Err(PlanError::invalid(
-                "sparse_astar.turn_branches",
-                self.turn_branches,
-                "an integer in [1, 64] (MAX_TURN_BRANCHES; each expansion tries this many headings)",
-            ));
-        }
+        // Each expansion tries this many headings.
+        ranges::count(
+            "sparse_astar.turn_branches",
+            self.turn_branches,
+            1,
+            MAX_TURN_BRANCHES,
+        )?;
         ranges::count(
             "sparse_astar.max_expansions",
             self.max_expansions,

@@ -114,7 +114,10 @@ impl SceneParams {
             return Err(PlanError::invalid(
                 "scene.margin",
                 self.margin,
-                "less than half the smallest box size",
+                format!(
+                    "less than half the smallest component of scene.size = {:?}",
+                    [self.size.x, self.size.y, self.size.z]
+                ),
             ));
         }
         check_positive("scene.horizon_s", self.horizon_s)?;
@@ -205,7 +208,8 @@ pub fn random_dynamic_scene(
             return Err(PlanError::invalid(
                 format!("scene obstacle {i}"),
                 PLACEMENT_ATTEMPTS,
-                "a placement that keeps start and goal free (reduce sizes or endpoint_clearance)",
+                "a placement that keeps start and goal free (reduce scene.radius, scene.r_safe or \
+                 scene.endpoint_clearance, or enlarge scene.size)",
             ));
         };
         forecasts.push(f);

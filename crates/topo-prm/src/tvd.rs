@@ -110,7 +110,7 @@ fn check_sample_count(what: &str, span: f64, dt: f64) -> Result<(), PlanError> {
     }
     Err(PlanError::invalid(
         what,
-        scale::Sci(span),
+        span,
         format!(
             "a span of at most {} s at tvd.dt_s = {} s ({MAX_SAMPLES} samples, tvd::MAX_SAMPLES); \
              compare shorter trajectories or raise tvd.dt_s",
