@@ -253,3 +253,24 @@ fn count_and_grid_errors_print_readable_numbers() {
         .unwrap_or(0);
     assert!(longest_digit_run <= 17, "{msg}");
 }
+
+#[test]
+fn segment_clear_at_a_point_the_sdf_calls_touching_a_far_reaching_box_is_blocked() {
+    // Fuzz (params::geometry::segment_clear_at_contact): a box reaching z = -1e6 rounds its
+    // distance at ~1e-10 m, so a point 2e-11 m above its top is at distance 0 — touching — but
+    // the broad phase, widened by the segment's ulps only, missed the box and called the
+    // zero-length segment there clear.
+    use trust_geometry::AaBox;
+    let bx = AaBox::new(
+        Vec3::new(-16.94189701270734, 8.33464692706599, -1e6),
+        Vec3::new(15.502680238787654, 12.724988403958179, 4.068994616835775),
+    )
+    .unwrap();
+    let bounds = Aabb::new(Vec3::new(-20.0, -20.0, 0.0), Vec3::new(20.0, 20.0, 8.0)).unwrap();
+    let map = StaticMap::from_shapes(bounds, vec![bx.into()]).unwrap();
+    let p = Vec3::new(-0.6618626225788837, 8.503699502489226, 4.068994616858216);
+    assert!(map.signed_distance(&p) <= 0.0);
+    for len in [0.0, 1e-12, 1e-9, 1e-6] {
+        assert!(!map.segment_clear(&p, &(p + Vec3::z() * len), 0.0), "{len}");
+    }
+}

@@ -16,20 +16,25 @@ use crate::LbfgsError;
 #[serde(deny_unknown_fields, default)]
 pub struct LbfgsParams {
     /// Number of correction pairs (s, y) kept in memory (`mem_size`). Must be >= 1.
+    /// Accepted: `[1, 1024]` ([`MAX_MEMORY`]); with the dimension, the workspace is capped by [`MAX_WORKSPACE_FLOATS`].
     pub memory: usize,
     /// Gradient tolerance: stop with [`crate::Termination::Converged`] when
     /// `‖g‖∞ / max(1, ‖x‖∞) <= g_epsilon`. Finite and >= 0; 0 stops only on an exactly zero gradient.
     pub g_epsilon: f64,
     /// Distance, in iterations, of the cost-decrease test (`past`); 0 disables that test.
+    /// Accepted: `[0, 65536]` ([`MAX_PAST`]).
     pub past: usize,
     /// Cost-decrease tolerance: stop with [`crate::Termination::CostStalled`] when
     /// `|f_{k−past} − f_k| / max(1, |f_k|) <= delta`. Finite and >= 0.
     pub delta: f64,
     /// Maximum number of iterations (accepted steps); 0 means unlimited.
+    /// Accepted: any.
     pub max_iterations: usize,
     /// Maximum number of cost evaluations, the one at the start point included; 0 means unlimited.
+    /// Accepted: any.
     pub max_evaluations: usize,
     /// Maximum number of trial points in one line search. Must be >= 1.
+    /// Accepted: `≥ 1`.
     pub max_linesearch: usize,
     /// Smallest step the line search may try. Finite and >= 0.
     pub min_step: f64,

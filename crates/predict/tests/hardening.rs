@@ -201,3 +201,14 @@ fn ekf_at_the_edges_of_its_accepted_params_forecasts_or_names_its_params() {
         }
     }
 }
+
+#[test]
+fn pdc_horizon_past_the_time_limit_names_horizon_not_t_end() {
+    // Fuzz (params::predict::Forecast+Pdc): `Pdc::new(f, 1.00001e7)` failed on "`t_end` =
+    // 1.00001e7 is outside the accepted range", a name the caller never used.
+    let f = Forecast::sphere(Vec3::zeros(), Vec3::zeros(), 0.0, 0.5, 0.1, 0.2).unwrap();
+    let e = f.pdc(1.00001e7).unwrap_err().to_string();
+    assert!(e.contains("horizon"), "{e}");
+    assert!(!e.contains("`t_end`"), "{e}");
+    assert!(f.pdc(1e7).is_ok());
+}

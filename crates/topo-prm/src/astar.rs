@@ -35,19 +35,26 @@ const HEADING_SECTORS: f64 = 8.0;
 #[serde(deny_unknown_fields, default)]
 pub struct SparseAStarParams {
     /// Expansion step (m). Ours: 1.0.
+    /// Accepted: `[1e-3, 1e6]` m ([`crate::ranges::MIN_RESOLUTION_M`]).
     pub step: f64,
     /// Largest yaw change per step (degrees). Ours: 45.
+    /// Accepted: `[0, 180]`.
     pub max_turn_deg: f64,
     /// Yaw directions per expansion, spread evenly over `±max_turn_deg` (1 = straight on only). Ours: 5.
+    /// Accepted: `[1, 64]` ([`MAX_TURN_BRANCHES`]).
     pub turn_branches: usize,
     /// Pitch offset of the climbing and descending expansions (degrees; 0 = level flight only).
     /// Ours: 30.
+    /// Accepted: `[0, 90]`.
     pub climb_deg: f64,
     /// Nodes and edges keep this distance from obstacles (m). Ours: 0.3, the PRMs' sample clearance.
+    /// Accepted: `[0, 1e6]` m.
     pub clearance: f64,
     /// Time budget (ms, monotonic clock). Ours: 5, the PRMs' default budget.
+    /// Accepted: `(0, 6e5]` ms ([`crate::ranges::MAX_BUDGET_MS`]).
     pub budget_ms: f64,
     /// Expansion budget. Ours: 20 000.
+    /// Accepted: `[1, 1e6]` ([`crate::ranges::MAX_EXPANSIONS`]).
     pub max_expansions: usize,
     /// Avoid the predictive directional cones of all forecasts. Default `true`.
     pub pdc: bool,

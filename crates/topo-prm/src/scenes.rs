@@ -19,22 +19,31 @@ use trust_core::{
 #[serde(deny_unknown_fields, default)]
 pub struct SceneParams {
     /// Size of the box `[0, size]` (m). Paper: 20 × 20 × 10.
+    /// Accepted: each component in `[1e-9, 1e6]` m, more than twice `margin`.
     pub size: Vec3,
     /// Obstacle speed range (m/s). Ours: 0.5–3.
+    /// Accepted: `0 ≤ lo ≤ hi ≤ 1e4` m/s.
     pub speed: (f64, f64),
     /// Obstacle size `r_o` range (m). Ours: 0.5–1.5.
+    /// Accepted: `0 < lo ≤ hi ≤ 1e6` m.
     pub radius: (f64, f64),
     /// Uncertainty growth `mu` range (m/s). Ours: 0.1–0.3.
+    /// Accepted: `0 ≤ lo ≤ hi ≤ 1e4` m/s.
     pub mu: (f64, f64),
     /// Safety margin `r_safe` of every forecast (m). Ours: 0.
+    /// Accepted: `[0, 1e6]` m.
     pub r_safe: f64,
     /// Probability that an obstacle is a full-height vertical cylinder (else a sphere). Ours: 0.5.
+    /// Accepted: `[0, 1]`.
     pub cylinder_fraction: f64,
     /// Distance of start and goal from the box faces (m). Ours: 1.
+    /// Accepted: `≥ 0` and less than half the smallest `size` component.
     pub margin: f64,
     /// Start and goal keep at least this distance from every obstacle at the query time (m). Ours: 1.
+    /// Accepted: `[0, 1e6]` m.
     pub endpoint_clearance: f64,
     /// Planning horizon `T_h` of the query (s). Ours: 2 (the 18 m crossing at 10 m/s takes ~2 s).
+    /// Accepted: `[1e-9, 1e7]` s.
     pub horizon_s: f64,
     /// Vehicle limits of the query. Paper Sec. IV: 10 m/s, 15 m/s².
     pub limits: Limits,

@@ -390,3 +390,31 @@ fn every_params_field_at_its_extremes_is_rejected_with_its_name() {
         assert!(longest_digit_run(&e) <= 17, "{e}");
     }
 }
+
+#[test]
+fn sparse_astar_turn_branches_at_usize_max_prints_a_readable_number() {
+    // Fuzz (params::topo::frontends): the error printed 18446744073709551615.
+    let e = trust_topo_prm::SparseAStarParams {
+        turn_branches: usize::MAX,
+        ..trust_topo_prm::SparseAStarParams::default()
+    }
+    .validate()
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("sparse_astar.turn_branches"), "{e}");
+    assert!(longest_digit_run(&e) <= 17, "{e}");
+}
+
+#[test]
+fn scene_margin_against_a_small_scene_size_names_scene_size() {
+    // Fuzz (params::topo::SceneParams): shrinking `scene.size` blamed the valid `scene.margin`
+    // alone.
+    let e = trust_topo_prm::scenes::SceneParams {
+        size: Vec3::new(1e-3, 20.0, 10.0),
+        ..trust_topo_prm::scenes::SceneParams::default()
+    }
+    .validate()
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("scene.size"), "{e}");
+}
