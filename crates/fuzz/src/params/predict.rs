@@ -113,7 +113,7 @@ fn forecast_args(g: &mut Gen, _: &Fixtures) -> Outcome {
         min: Vec3::repeat(-30.0),
         max: Vec3::repeat(30.0),
     };
-    if (slices as u128) * (per_slice as u128) > 20_000
+    if (slices as u128) * (per_slice as u128) > 5_000
         && (slices as u128) * (per_slice as u128) <= 100_000
     {
         // Requested work (each sample is an iterative solve); the cap is checked below it.
