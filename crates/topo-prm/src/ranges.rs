@@ -1,7 +1,7 @@
 //! Accepted ranges of the parameter fields of this crate, derived from the scale policy
 //! (`trust_core::scale`): every params struct's `validate` checks its fields with these helpers, so
 //! that an accepted value never makes a later call fail on something else, return NaN, or run for
-//! longer than its budgets allow. Errors are [`PlanError::Scale`] or [`PlanError::Count`] naming the
+//! longer than its budgets allow. Errors are [`PlanError::InvalidInput`] naming the
 //! field path (`devprm.surface_offset`), the value in readable scientific notation and the range.
 
 use trust_core::scale::{self, Quantity};
@@ -33,13 +33,19 @@ pub const MAX_SURFACE_SAMPLES: usize = scale::MAX_SOLVED_SAMPLE_COUNT / 10;
 /// Largest accepted length ratio (a path this many times the shortest is dropped).
 pub const MAX_LENGTH_RATIO: f64 = 1.0e6;
 
-/// `x` finite and in the range of `q`.
-pub(crate) fn quantity(field: &str, x: f64, q: Quantity) -> Result<(), PlanError> {
-    scale::check(field, x, q)?;
-    Ok(())
+/// A count for [`PlanError::InvalidInput`]'s value: exact up to 10⁹, scientific above.
+struct CountValue(usize);
+
+impl std::fmt::Debug for CountValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", scale::SciCount(self.0 as u128))
+    }
 }
 
-/// `x` finite and in `[lo, hi]` (`unit` for the message).
+/// `x` finite and in `[lo, hi]` (`unit` for the message). The errors are
+/// [`PlanError::InvalidInput`] naming `field` (so that callers that re-prefix field paths, such
+/// as `trust-sim`'s scenario files, handle them like every other parameter error): "a finite
+/// number >= 0" / "> 0" below a lower end of 0 / `MIN_POSITIVE`, the range otherwise.
 pub(crate) fn range(
     field: &str,
     x: f64,
@@ -47,13 +53,35 @@ pub(crate) fn range(
     hi: f64,
     unit: &'static str,
 ) -> Result<(), PlanError> {
-    scale::check_range(field, x, lo, hi, unit)?;
-    Ok(())
+    if x >= lo && x <= hi {
+        return Ok(());
+    }
+    let below = !x.is_finite() || x < lo;
+    let expected = if below && lo == 0.0 {
+        "a finite number >= 0".to_owned()
+    } else if below && lo == scale::MIN_POSITIVE && x <= 0.0 {
+        "a finite number > 0".to_owned()
+    } else {
+        format!(
+            "a number in [{}, {}] {unit} (scale policy, trust_core::scale)",
+            scale::Sci(lo),
+            scale::Sci(hi)
+        )
+    };
+    Err(PlanError::invalid(field, x, expected))
 }
 
-/// Every component of `v` a length (`0 ≤ x ≤ MAX_LENGTH_M`).
+/// `x` finite and in the range of `q`.
+pub(crate) fn quantity(field: &str, x: f64, q: Quantity) -> Result<(), PlanError> {
+    let (lo, hi) = q.range();
+    range(field, x, lo, hi, q.unit())
+}
+
+/// Every component of `v` a length (`0 ≤ x ≤ MAX_LENGTH_M`); the field gets `.x`/`.y`/`.z`.
 pub(crate) fn lengths(field: &str, v: &Vec3) -> Result<(), PlanError> {
-    scale::check_vec(field, v, Quantity::Length)?;
+    for (i, axis) in ['x', 'y', 'z'].into_iter().enumerate() {
+        quantity(&format!("{field}.{axis}"), v[i], Quantity::Length)?;
+    }
     Ok(())
 }
 
@@ -62,7 +90,13 @@ pub(crate) fn count(field: &str, n: usize, lo: usize, cap: usize) -> Result<(), 
     if n < lo {
         return Err(PlanError::invalid(field, n, format!(">= {lo}")));
     }
-    scale::check_count(field, n as u128, cap)?;
+    if n > cap {
+        return Err(PlanError::invalid(
+            field,
+            CountValue(n),
+            format!("an integer in [{lo}, {}]", scale::SciCount(cap as u128)),
+        ));
+    }
     Ok(())
 }
 

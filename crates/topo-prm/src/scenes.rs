@@ -94,18 +94,18 @@ impl SceneParams {
         }
         scale::check_vec("scene.size", &self.size, Quantity::PositiveLength)?;
         check_range("scene.speed", self.speed, false)?;
-        scale::check("scene.speed.1", self.speed.1, Quantity::Rate)?;
+        crate::ranges::quantity("scene.speed.1", self.speed.1, Quantity::Rate)?;
         check_range("scene.radius", self.radius, true)?;
-        scale::check("scene.radius.1", self.radius.1, Quantity::Length)?;
+        crate::ranges::quantity("scene.radius.1", self.radius.1, Quantity::Length)?;
         check_range("scene.mu", self.mu, false)?;
-        scale::check("scene.mu.1", self.mu.1, Quantity::Rate)?;
-        scale::check("scene.r_safe", self.r_safe, Quantity::Length)?;
-        scale::check(
+        crate::ranges::quantity("scene.mu.1", self.mu.1, Quantity::Rate)?;
+        crate::ranges::quantity("scene.r_safe", self.r_safe, Quantity::Length)?;
+        crate::ranges::quantity(
             "scene.endpoint_clearance",
             self.endpoint_clearance,
             Quantity::Length,
         )?;
-        scale::check(
+        crate::ranges::quantity(
             "scene.horizon_s",
             self.horizon_s,
             Quantity::PositiveDuration,

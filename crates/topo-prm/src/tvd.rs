@@ -33,9 +33,9 @@ pub fn chord_clear(scene: &Scene<'_>, p: &Vec3, q: &Vec3, t: f64, clearance: f64
 /// outside the scale policy's times; [`PlanError::InvalidInput`] naming the span `t_hi − t_lo` if
 /// it needs more than [`MAX_SAMPLES`] samples at this step.
 pub fn sample_times(t_lo: f64, t_hi: f64, dt: f64) -> Result<Vec<f64>, PlanError> {
-    scale::check("tvd.dt_s", dt, Quantity::PositiveDuration)?;
-    scale::check("t_lo", t_lo, Quantity::Time)?;
-    scale::check("t_hi", t_hi, Quantity::Time)?;
+    crate::ranges::quantity("tvd.dt_s", dt, Quantity::PositiveDuration)?;
+    crate::ranges::quantity("t_lo", t_lo, Quantity::Time)?;
+    crate::ranges::quantity("t_hi", t_hi, Quantity::Time)?;
     let span = (t_hi - t_lo).max(0.0);
     check_sample_count("t_hi − t_lo", span, dt)?;
     let steps = (span / dt).floor();
@@ -69,7 +69,7 @@ pub fn equivalent_with_clearance(
     dt: f64,
     clearance: f64,
 ) -> Result<bool, PlanError> {
-    scale::check("tvd.clearance", clearance, Quantity::Length)?;
+    crate::ranges::quantity("tvd.clearance", clearance, Quantity::Length)?;
     let (Some((a0, a1)), Some((b0, b1))) = (a.time_span(), b.time_span()) else {
         return Err(PlanError::Unsupported {
             component: "tvd".into(),
@@ -81,7 +81,7 @@ pub fn equivalent_with_clearance(
     // The scene may have been built without `Scene::new` (its fields are public): check its
     // forecasts as every other component does.
     Scene::new(scene.map, scene.forecasts, scene.t0)?;
-    scale::check("tvd.dt_s", dt, Quantity::PositiveDuration)?;
+    crate::ranges::quantity("tvd.dt_s", dt, Quantity::PositiveDuration)?;
     let t_lo = a0.max(b0);
     let t_hi = a1.min(b1).max(t_lo);
     // A long common span (a long hold) needs many samples: name the curves, not the step.
@@ -147,8 +147,8 @@ impl Default for TvdParams {
 impl TvdParams {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
-        scale::check("tvd.dt_s", self.dt_s, Quantity::PositiveDuration)?;
-        scale::check("tvd.clearance", self.clearance, Quantity::Length)?;
+        crate::ranges::quantity("tvd.dt_s", self.dt_s, Quantity::PositiveDuration)?;
+        crate::ranges::quantity("tvd.clearance", self.clearance, Quantity::Length)?;
         Ok(())
     }
 }

@@ -724,11 +724,11 @@ impl Default for UvdParams {
 impl UvdParams {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
-        use trust_core::scale::{self, Quantity};
-        scale::check("uvd.resolution", self.resolution, Quantity::PositiveLength)?;
-        scale::check("uvd.clearance", self.clearance, Quantity::Length)?;
+        use trust_core::scale::Quantity;
+        crate::ranges::quantity("uvd.resolution", self.resolution, Quantity::PositiveLength)?;
+        crate::ranges::quantity("uvd.clearance", self.clearance, Quantity::Length)?;
         if let Some(h) = self.pdc_horizon_s {
-            scale::check("uvd.pdc_horizon_s", h, Quantity::PositiveDuration)?;
+            crate::ranges::quantity("uvd.pdc_horizon_s", h, Quantity::PositiveDuration)?;
             if self.freeze_forecasts {
                 return Err(PlanError::invalid(
                     "uvd.freeze_forecasts",
