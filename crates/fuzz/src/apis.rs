@@ -933,6 +933,9 @@ pub fn all() -> Vec<Api> {
         api!("params::backends", 3, params_backends),
         api!("params::ekf+lbfgs+scenes", 20, params_misc),
     ]
+    .into_iter()
+    .chain(crate::params::apis())
+    .collect()
 }
 
 // ---------------------------------------------------------------- parameters (every params struct)
@@ -992,7 +995,8 @@ fn mutate<T: serde::Serialize + serde::de::DeserializeOwned>(g: &mut Gen, params
     serde_json::from_value(v).ok()
 }
 
-fn valid_query(g: &mut Gen, map: &StaticMap) -> PathQuery {
+/// A query with start and goal inside `map`'s bounds (5–95 %), at rest, default limits.
+pub fn valid_query(g: &mut Gen, map: &StaticMap) -> PathQuery {
     let b = map.bounds();
     let p = |g: &mut Gen| {
         let mut v = Vec3::zeros();

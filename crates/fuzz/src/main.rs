@@ -9,6 +9,7 @@
 
 mod apis;
 mod inputs;
+mod params;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};

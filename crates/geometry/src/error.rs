@@ -2,7 +2,7 @@
 
 use thiserror::Error;
 
-use crate::scale::{self, CountError, Quantity, ScaleError, Sci};
+use crate::scale::{self, CountError, Quantity, ScaleError, Sci, SciCount};
 
 /// Invalid input to a constructor or builder of this crate.
 ///
@@ -11,7 +11,7 @@ use crate::scale::{self, CountError, Quantity, ScaleError, Sci};
 #[non_exhaustive]
 pub enum GeometryError {
     /// A number that must be finite was NaN or infinite.
-    #[error("{field} must be finite, got {value}")]
+    #[error("{field} must be finite, got {}", Sci(*.value))]
     NonFinite {
         /// Name of the field (e.g. `"sphere.center.x"`).
         field: String,
@@ -61,8 +61,13 @@ pub enum GeometryError {
     },
     /// A voxel grid would exceed [`crate::MAX_VOXELS`] voxels.
     #[error(
-        "voxel grid of {nx} x {ny} x {nz} = {count} voxels exceeds the limit of {limit}; \
-         use a coarser resolution or smaller bounds"
+        "voxel grid of {} x {} x {} = {} voxels exceeds the limit of {}; \
+         use a coarser resolution or smaller bounds",
+        SciCount(*.nx as u128),
+        SciCount(*.ny as u128),
+        SciCount(*.nz as u128),
+        SciCount(*.count),
+        SciCount(*.limit as u128)
     )]
     GridTooLarge {
         /// Voxels along x.
@@ -77,7 +82,11 @@ pub enum GeometryError {
         limit: usize,
     },
     /// Voxel grid data whose length does not match its dimensions.
-    #[error("{field} has length {len}, expected {expected} (= nx * ny * nz)")]
+    #[error(
+        "{field} has length {}, expected {} (= nx * ny * nz)",
+        SciCount(*.len as u128),
+        SciCount(*.expected as u128)
+    )]
     LengthMismatch {
         /// Name of the field.
         field: String,

@@ -48,7 +48,7 @@ pub use esdf::{
     voxel_index,
 };
 pub use map::{DEFAULT_RESOLUTION, MAX_TRACE_STEPS, StaticMap};
-pub use scale::{CountError, Quantity, ScaleError, Sci};
+pub use scale::{CountError, Quantity, ScaleError, Sci, SciCount};
 pub use shapes::{
     AaBox, Cylinder, CylinderSdf, Shape, Sphere, box_sdf, cylinder_sdf,
     cylinder_sdf_with_size_gradient, sphere_sdf,

@@ -47,6 +47,9 @@ pub struct StaticMap {
     bvh: Bvh,
     esdf: Option<Esdf>,
     default_resolution: f64,
+    /// Largest coordinate magnitude of the shapes' boxes: the distance functions round at a few
+    /// ulps of it, and line of sight widens its broad phase by as much.
+    shape_coord_max: f64,
 }
 
 /// Prefixes the field name of an error with `prefix` (e.g. `shapes[3].`).
@@ -108,6 +111,7 @@ impl StaticMap {
             bvh: Bvh::new(),
             esdf: None,
             default_resolution: DEFAULT_RESOLUTION,
+            shape_coord_max: 0.0,
         })
     }
 
@@ -134,6 +138,14 @@ impl StaticMap {
             self.shapes.push(s);
         }
         let leaves: Vec<_> = self.shapes.iter().map(|s| to_p_aabb(&s.aabb())).collect();
+        self.shape_coord_max = self
+            .shapes
+            .iter()
+            .map(|s| {
+                let b = s.aabb();
+                b.min.amax().max(b.max.amax())
+            })
+            .fold(0.0, f64::max);
         self.bvh = Bvh::from_leaves(BvhBuildStrategy::default(), &leaves);
         Ok(self)
     }
@@ -306,12 +318,16 @@ impl StaticMap {
     ///   with `clearance == 0` counts as blocked.
     /// * ESDF: conservative sphere tracing on the interpolated field — from each sample the
     ///   tracer advances by `(d - clearance) / L` with `L = 2√3` bounding the slope of the
-    ///   interpolant, so no point in between can fall below the clearance. It gives up (returns
-    ///   `false`) if the segment stays within `resolution / 1000` of the clearance level or needs
-    ///   more than `min(64 + 64 * length / resolution, MAX_TRACE_STEPS)` steps.
-    /// * A zero-length segment is [`StaticMap::is_free`] of its point. Negative clearances are
-    ///   treated as 0; a NaN clearance, a non-finite end point or one outside the scale policy
-    ///   ([`crate::scale`]: a coordinate beyond [`crate::scale::MAX_COORD_M`]) gives `false`.
+    ///   interpolant, so no point in between can fall below the clearance. Every sample, the end
+    ///   point included, must be more than `resolution / 1000` above the clearance level (so a
+    ///   segment touching the zero level at clearance 0 is blocked); the tracer gives up (returns
+    ///   `false`) after `min(64 + 64 * length / resolution, MAX_TRACE_STEPS)` steps.
+    /// * Every length follows these rules, zero included: a zero-length segment is the point
+    ///   `a` tested as a segment, so touching at clearance 0 is blocked for a segment of 0 m,
+    ///   1 µm or 1 km alike (whereas [`StaticMap::is_free`], a point query, accepts a distance
+    ///   exactly equal to the clearance). Negative clearances are treated as 0; a NaN clearance,
+    ///   a non-finite end point or one outside the scale policy ([`crate::scale`]: a coordinate
+    ///   beyond [`crate::scale::MAX_COORD_M`]) gives `false`.
     pub fn segment_clear(&self, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
         if clearance.is_nan()
             || !crate::scale::position_in_scale(a)
@@ -320,9 +336,6 @@ impl StaticMap {
             return false;
         }
         let clearance = clearance.max(0.0);
-        if a == b {
-            return self.is_free(a, clearance);
-        }
         if let Some(e) = &self.esdf
             && !esdf_segment_clear(e, a, b, clearance)
         {
@@ -331,9 +344,10 @@ impl StaticMap {
         if self.shapes.is_empty() {
             return true;
         }
-        // Inflated by a few ulps too, so that a shape the segment touches within rounding is a
-        // candidate (the exact tests below are conservative at that scale).
-        let ulps = 8.0 * f64::EPSILON * (a.amax() + b.amax());
+        // Inflated by a few ulps of the segment's and the shapes' coordinates too, so that a shape
+        // the segment touches within the rounding of the distance functions is a candidate (the
+        // exact tests below are conservative at that scale).
+        let ulps = 8.0 * f64::EPSILON * (a.amax() + b.amax() + self.shape_coord_max);
         let query = to_p_aabb(&Aabb::from_segment(a, b).inflated(clearance + ulps));
         let mut candidates = self.bvh.intersect_aabb(&query);
         // Each shape sees only the part of the segment inside its box inflated by the clearance
@@ -366,27 +380,30 @@ impl StaticMap {
 /// [`StaticMap::segment_clear`]).
 fn esdf_segment_clear(esdf: &Esdf, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
     let len = (b - a).norm();
-    if !(len.is_finite() && len > 0.0) {
+    if !len.is_finite() {
         return false;
     }
     let res = esdf.resolution();
     let margin = res * 1e-3;
     // Saturating float-to-int conversion; NaN (impossible here) would give 0 steps.
     let max_steps = ((64.0 + 64.0 * len / res) as usize).min(MAX_TRACE_STEPS);
-    let dir = (b - a) / len;
+    // A zero-length segment is its one sample `b = a` (the loop ends at once: `t >= len`).
+    let dir = if len > 0.0 {
+        (b - a) / len
+    } else {
+        Vec3::zeros()
+    };
     let mut t = 0.0;
     for _ in 0..=max_steps {
         let p = if t >= len { *b } else { a + dir * t };
-        let d = esdf.signed_distance(&p);
-        if d < clearance {
+        // The same test at every sample, the end point included, so that the verdict does not
+        // depend on the segment's length as it shrinks to a point.
+        let slack = esdf.signed_distance(&p) - clearance;
+        if slack.is_nan() || slack < margin {
             return false;
         }
         if t >= len {
             return true;
-        }
-        let slack = d - clearance;
-        if slack.is_nan() || slack < margin {
-            return false;
         }
         t += slack / ESDF_LIPSCHITZ;
     }

@@ -77,6 +77,20 @@ pub(crate) fn segment_shape_distance(shape: &Shape, a: &Vec3, b: &Vec3) -> f64 {
 /// cylinder's rim band or a box's rounded edges). The closed-form answers agree with GJK's
 /// (property test `closed_form_segment_tests_agree_with_gjk`); they are ~10× cheaper.
 pub(crate) fn segment_blocked(shape: &Shape, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
+    // An end point closer than the clearance, or touching, decides at once and exactly (the
+    // segment's distance is at most its ends'): a segment of any length from a point on the
+    // surface is blocked at clearance 0, like the zero-length segment at that point, although
+    // GJK stops up to ~1e-8 m above 0 for a segment leaving a cylinder tangentially.
+    let end = shape.signed_distance(a).min(shape.signed_distance(b));
+    let tol = contact_tolerance(shape, a, b);
+    if end.is_nan() || end <= tol || end < clearance {
+        return true;
+    }
+    if a == b {
+        // A point: its exact distance decides (GJK on a degenerate segment could err either way
+        // within its tolerance, and then a segment from this point could be clearer than it).
+        return false;
+    }
     let decided = match shape {
         Shape::Cylinder(c) => cylinder_verdict(c, a, b, clearance),
         Shape::AaBox(bx) => box_verdict(bx, a, b, clearance),
@@ -84,8 +98,21 @@ pub(crate) fn segment_blocked(shape: &Shape, a: &Vec3, b: &Vec3, clearance: f64)
     };
     decided.unwrap_or_else(|| {
         let d = segment_shape_distance(shape, a, b);
-        !(d > 0.0 && d >= clearance)
+        // GJK converges slowly on a segment tangent to a curved surface and stops a little
+        // above 0: a distance within `1e-9` of the shape's size is contact, as in the closed
+        // forms, so that a segment touching a shape at clearance 0 is blocked whatever its
+        // length and direction.
+        !(d > contact_tolerance(shape, a, b) && d >= clearance)
     })
+}
+
+/// Distances at or below this count as contact: `1e-9` relative to the shape's size and the
+/// magnitude of the coordinates (GJK's own accuracy is about `1e-10` relative).
+fn contact_tolerance(shape: &Shape, a: &Vec3, b: &Vec3) -> f64 {
+    let bx = shape.aabb();
+    let size = (bx.max - bx.min).amax();
+    let coords = a.amax().max(b.amax()).max(bx.min.amax()).max(bx.max.amax());
+    1e-9 * (1.0 + size) + 8.0 * f64::EPSILON * coords
 }
 
 /// Squared distance from the origin to the 2-D segment `[(ax, ay), (bx, by)]`.

@@ -148,6 +148,21 @@ impl fmt::Display for Sci {
     }
 }
 
+/// A count for messages: exact up to 10⁹, scientific notation above (`3.2e31`, never 31 digits).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SciCount(pub u128);
+
+impl fmt::Display for SciCount {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0 <= 1_000_000_000 {
+            write!(f, "{}", self.0)
+        } else {
+            // Rounded to the f64 nearest the count: these counts are far above any cap.
+            write!(f, "{}", Sci(self.0 as f64))
+        }
+    }
+}
+
 /// A number outside the scale policy (see the [module documentation](self)).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("`{field}` = {value} is outside the accepted range [{lo}, {hi}] {unit} (scale policy, trust_geometry::scale)", value = Sci(*.value), lo = Sci(*.lo), hi = Sci(*.hi))]
@@ -166,7 +181,7 @@ pub struct ScaleError {
 
 /// A count (of samples, points, pieces, ...) above its cap.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("`{field}` = {count} exceeds the cap of {cap} (scale policy, trust_geometry::scale)")]
+#[error("`{field}` = {} exceeds the cap of {} (scale policy, trust_geometry::scale)", SciCount(*.count), SciCount(*.cap as u128))]
 pub struct CountError {
     /// Name of the count.
     pub field: String,
@@ -191,6 +206,32 @@ pub fn check(field: &str, value: f64, quantity: Quantity) -> Result<f64, ScaleEr
             lo,
             hi,
             unit: quantity.unit(),
+        })
+    }
+}
+
+/// Checks `value` against an explicit closed range `[lo, hi]` in `unit`, for parameters whose unit
+/// is none of [`Quantity`]'s (a noise density in m²/s³, a dimensionless factor): the error has the
+/// same form as [`check`]'s.
+///
+/// # Errors
+/// A [`ScaleError`] naming `field` if `value` is NaN, infinite or outside `[lo, hi]`.
+pub fn check_range(
+    field: &str,
+    value: f64,
+    lo: f64,
+    hi: f64,
+    unit: &'static str,
+) -> Result<f64, ScaleError> {
+    if value >= lo && value <= hi {
+        Ok(value)
+    } else {
+        Err(ScaleError {
+            field: field.to_owned(),
+            value,
+            lo,
+            hi,
+            unit,
         })
     }
 }
@@ -243,6 +284,18 @@ mod tests {
         assert_eq!(Sci(0.0).to_string(), "0");
         assert_eq!(Sci(f64::NAN).to_string(), "NaN");
         assert_eq!(Sci(f64::MAX).to_string(), "1.7976931348623157e308");
+        assert_eq!(SciCount(1_000_000_000).to_string(), "1000000000");
+        assert_eq!(SciCount(10u128.pow(31)).to_string(), "1.0e31");
+        assert_eq!(SciCount(u128::MAX).to_string(), "3.402823669209385e38");
+    }
+
+    #[test]
+    fn count_errors_have_no_31_digit_integers() {
+        // Issue 18: a UVD point count of 1e30 was printed as a 31-digit integer.
+        let e = check_count("uvd matched points", 10u128.pow(30), MAX_SAMPLE_COUNT).unwrap_err();
+        let msg = e.to_string();
+        assert!(msg.contains("1.0e30"), "{msg}");
+        assert!(!msg.contains("1000000000000"), "{msg}");
     }
 
     #[test]

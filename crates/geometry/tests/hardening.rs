@@ -132,3 +132,145 @@ fn voxel_grid_above_the_cap_is_an_error_before_allocating() {
         .unwrap_err();
     assert!(matches!(e, GeometryError::GridTooLarge { .. }), "{e:?}");
 }
+
+/// A point on the surface of each shape kind (sphere, cylinder side and cap rim, box face, edge and
+/// corner) with the outward direction there.
+fn touching_points() -> Vec<(Shape, Vec3, Vec3)> {
+    use trust_geometry::{AaBox, Cylinder};
+    let sphere = Sphere::new(Vec3::new(3.0, 2.0, 2.0), 1.5).unwrap();
+    let cyl = Cylinder::new(Vec3::new(-5.0, 4.0, 4.0), 1.0, 2.0).unwrap();
+    let bx = AaBox::new(Vec3::new(6.0, -8.0, 1.0), Vec3::new(9.0, -5.0, 4.0)).unwrap();
+    let x = Vec3::x();
+    let diag2 = Vec3::new(1.0, 0.0, 1.0).normalize();
+    let diag3 = Vec3::new(1.0, 1.0, 1.0).normalize();
+    vec![
+        (sphere.into(), Vec3::new(4.5, 2.0, 2.0), x),
+        (cyl.into(), Vec3::new(-4.0, 4.0, 4.0), x),
+        (cyl.into(), Vec3::new(-5.0, 4.0, 6.0), Vec3::z()),
+        (cyl.into(), Vec3::new(-4.0, 4.0, 6.0), diag2),
+        (bx.into(), Vec3::new(9.0, -6.5, 2.5), x),
+        (bx.into(), Vec3::new(9.0, -6.5, 4.0), diag2),
+        (bx.into(), Vec3::new(9.0, -5.0, 4.0), diag3),
+    ]
+}
+
+#[test]
+fn segment_clear_at_clearance_0_touching_is_blocked_for_every_length() {
+    // Issue 18: a zero-length segment touching a sphere at clearance 0 was clear (it fell back to
+    // `is_free`, which accepts distance == clearance) while a 1 µm segment there was blocked.
+    let bounds = Aabb::new(Vec3::new(-20.0, -20.0, 0.0), Vec3::new(20.0, 20.0, 8.0)).unwrap();
+    for (shape, p, out) in touching_points() {
+        let map = StaticMap::from_shapes(bounds, vec![shape]).unwrap();
+        assert!(map.signed_distance(&p).abs() < 1e-12, "{shape:?} at {p:?}");
+        for len in [0.0, 1e-12, 1e-9, 1e-6, 1e-3, 1.0] {
+            for dir in [out, -out, out.cross(&Vec3::new(0.3, 0.5, 0.7)).normalize()] {
+                assert!(
+                    !map.segment_clear(&p, &(p + dir * len), 0.0),
+                    "{shape:?}: segment of {len} m from the touching point {p:?} along {dir:?} \
+                     reported clear"
+                );
+                assert!(!map.segment_clear(&(p + dir * len), &p, 0.0));
+            }
+        }
+        // Just outside: clear for 0 m and for a tiny segment leading away, alike.
+        let q = p + out * 1e-3;
+        for len in [0.0, 1e-9, 1e-6] {
+            assert!(
+                map.segment_clear(&q, &(q + out * len), 0.0),
+                "{shape:?}: {len} m at 1 mm outside reported blocked"
+            );
+        }
+    }
+}
+
+#[test]
+fn esdf_segment_clear_is_consistent_between_zero_and_tiny_lengths() {
+    // Issue 18 (ESDF side): the tracer demanded `resolution / 1000` of slack at its first sample
+    // but none at a zero-length segment's point, so a point at the zero level was clear as a
+    // 0 m segment and blocked as a 1 µm one.
+    // A wall three voxels thick, so that the field goes negative inside it.
+    let bounds = Aabb::new(Vec3::new(-10.0, -10.0, 0.0), Vec3::new(10.0, 10.0, 5.0)).unwrap();
+    let mut cloud = Vec::new();
+    for i in 0..50 {
+        for j in 0..4 {
+            for k in 0..12 {
+                cloud.push(Vec3::new(
+                    1.8 + 0.2 * f64::from(j),
+                    -3.0 + 0.1 * f64::from(i),
+                    0.2 * f64::from(k),
+                ));
+            }
+        }
+    }
+    let map = StaticMap::new(bounds)
+        .unwrap()
+        .with_point_cloud(&cloud, 0.25)
+        .unwrap();
+    let esdf = map.esdf().unwrap();
+    // Walk from free space towards the wall of points at x = 2 and find the zero level.
+    let (mut lo, mut hi) = (Vec3::new(0.0, -1.0, 1.0), Vec3::new(2.2, -1.0, 1.0));
+    assert!(esdf.signed_distance(&lo) > 0.0 && esdf.signed_distance(&hi) < 0.0);
+    for _ in 0..200 {
+        let mid = (lo + hi) * 0.5;
+        if esdf.signed_distance(&mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    for p in [lo, hi] {
+        assert!(esdf.signed_distance(&p).abs() < 1e-9);
+        for len in [0.0, 1e-12, 1e-9, 1e-6] {
+            assert!(
+                !map.segment_clear(&p, &(p + Vec3::new(-len, 0.0, 0.0)), 0.0),
+                "{len} m at the zero level reported clear"
+            );
+        }
+    }
+    // Points along the approach: the 0 m verdict equals the 1e-9 m verdict at every clearance.
+    for k in 0..=400 {
+        let p = Vec3::new(0.005 * f64::from(k), -1.0, 1.0);
+        for clearance in [0.0, 0.1, 0.5] {
+            let point = map.segment_clear(&p, &p, clearance);
+            let tiny = map.segment_clear(&p, &(p - Vec3::new(1e-9, 0.0, 0.0)), clearance);
+            assert_eq!(point, tiny, "at {p:?}, clearance {clearance}");
+        }
+    }
+}
+
+#[test]
+fn count_and_grid_errors_print_readable_numbers() {
+    // Issue 18: ESDF voxel counts and UVD point counts were 31–32-digit integers.
+    let dims = [usize::MAX / 4, usize::MAX / 4, 3];
+    let msg = trust_geometry::checked_voxel_count(dims)
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("e18") && msg.contains("e37"), "{msg}");
+    let longest_digit_run = msg
+        .split(|c: char| !c.is_ascii_digit())
+        .map(str::len)
+        .max()
+        .unwrap_or(0);
+    assert!(longest_digit_run <= 17, "{msg}");
+}
+
+#[test]
+fn segment_clear_at_a_point_the_sdf_calls_touching_a_far_reaching_box_is_blocked() {
+    // Fuzz (params::geometry::segment_clear_at_contact): a box reaching z = -1e6 rounds its
+    // distance at ~1e-10 m, so a point 2e-11 m above its top is at distance 0 — touching — but
+    // the broad phase, widened by the segment's ulps only, missed the box and called the
+    // zero-length segment there clear.
+    use trust_geometry::AaBox;
+    let bx = AaBox::new(
+        Vec3::new(-16.94189701270734, 8.33464692706599, -1e6),
+        Vec3::new(15.502680238787654, 12.724988403958179, 4.068994616835775),
+    )
+    .unwrap();
+    let bounds = Aabb::new(Vec3::new(-20.0, -20.0, 0.0), Vec3::new(20.0, 20.0, 8.0)).unwrap();
+    let map = StaticMap::from_shapes(bounds, vec![bx.into()]).unwrap();
+    let p = Vec3::new(-0.6618626225788837, 8.503699502489226, 4.068994616858216);
+    assert!(map.signed_distance(&p) <= 0.0);
+    for len in [0.0, 1e-12, 1e-9, 1e-6] {
+        assert!(!map.segment_clear(&p, &(p + Vec3::z() * len), 0.0), "{len}");
+    }
+}

@@ -68,6 +68,6 @@ mod vector;
 pub use error::LbfgsError;
 pub use line_search::SplitObjective;
 pub use monitor::{Deadline, FnMonitor, Monitor, Progress, monitor_fn};
-pub use params::{LbfgsParams, MAX_MEMORY, MAX_PAST};
+pub use params::{LbfgsParams, MAX_DIMENSION, MAX_MEMORY, MAX_PAST, MAX_WORKSPACE_FLOATS};
 pub use report::{LineSearchFailure, Report, Termination};
 pub use solver::{Lbfgs, minimize};

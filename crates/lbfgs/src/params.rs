@@ -15,20 +15,25 @@ use crate::LbfgsError;
 #[serde(deny_unknown_fields, default)]
 pub struct LbfgsParams {
     /// Number of correction pairs (s, y) kept in memory (`mem_size`). Must be >= 1.
+    /// Accepted: `[1, 1024]` ([`MAX_MEMORY`]); with the dimension, the workspace is capped by [`MAX_WORKSPACE_FLOATS`].
     pub memory: usize,
     /// Gradient tolerance: stop with [`crate::Termination::Converged`] when
     /// `‖g‖∞ / max(1, ‖x‖∞) <= g_epsilon`. Finite and >= 0; 0 stops only on an exactly zero gradient.
     pub g_epsilon: f64,
     /// Distance, in iterations, of the cost-decrease test (`past`); 0 disables that test.
+    /// Accepted: `[0, 65536]` ([`MAX_PAST`]).
     pub past: usize,
     /// Cost-decrease tolerance: stop with [`crate::Termination::CostStalled`] when
     /// `|f_{k−past} − f_k| / max(1, |f_k|) <= delta`. Finite and >= 0.
     pub delta: f64,
     /// Maximum number of iterations (accepted steps); 0 means unlimited.
+    /// Accepted: any.
     pub max_iterations: usize,
     /// Maximum number of cost evaluations, the one at the start point included; 0 means unlimited.
+    /// Accepted: any.
     pub max_evaluations: usize,
     /// Maximum number of trial points in one line search. Must be >= 1.
+    /// Accepted: `≥ 1`.
     pub max_linesearch: usize,
     /// Smallest step the line search may try. Finite and >= 0.
     pub min_step: f64,
@@ -71,6 +76,17 @@ pub const MAX_MEMORY: usize = 1024;
 
 /// Largest accepted [`LbfgsParams::past`]: the past costs are allocated up front.
 pub const MAX_PAST: usize = 65_536;
+
+/// Largest number of variables of one solver ([`crate::Lbfgs::new`]): 10⁶. The largest problem of
+/// the planner, a MINCO trajectory with `trust_geometry::scale::MAX_VERTEX_COUNT` = 10⁵ pieces, has
+/// `3·(10⁵ − 1) + 10⁵ ≈ 4·10⁵` variables; above the cap a request is a typed error, not a
+/// "capacity overflow" panic or a multi-terabyte allocation.
+pub const MAX_DIMENSION: usize = 1_000_000;
+
+/// Largest workspace of one solver in floats, `(2·memory + 6)·dimension + 3·memory + past`:
+/// 5·10⁷ floats (400 MB), enough for [`MAX_DIMENSION`] variables with the default 8 pairs
+/// (2.2·10⁷ floats) and for 1024 pairs up to 24 000 variables.
+pub const MAX_WORKSPACE_FLOATS: usize = 50_000_000;
 
 impl LbfgsParams {
     /// Checks every field's range; the error names the first offending field and its value.

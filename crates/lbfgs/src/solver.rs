@@ -34,11 +34,15 @@ pub struct Lbfgs {
 impl Lbfgs {
     /// A solver for `dimension` variables; validates `params` and allocates
     /// `(2·memory + 6)·dimension + 3·memory + past` floats.
+    ///
+    /// # Errors
+    /// [`LbfgsError::InvalidParam`] for invalid `params`, [`LbfgsError::ZeroDimension`],
+    /// [`LbfgsError::DimensionTooLarge`] above [`crate::MAX_DIMENSION`] variables, and
+    /// [`LbfgsError::WorkspaceTooLarge`] when the buffers would exceed
+    /// [`crate::MAX_WORKSPACE_FLOATS`] — checked before anything is allocated.
     pub fn new(dimension: usize, params: LbfgsParams) -> Result<Self, LbfgsError> {
         params.validate()?;
-        if dimension == 0 {
-            return Err(LbfgsError::ZeroDimension);
-        }
+        check_workspace(dimension, &params)?;
         Ok(Self {
             memory: CorrectionMemory::new(dimension, params.memory),
             g: vec![0.0; dimension],
@@ -323,6 +327,33 @@ struct End {
 fn is_descent(d: &[f64], g: &[f64]) -> bool {
     let slope = dot(g, d);
     slope < 0.0 && slope.is_finite() && all_finite(d)
+}
+
+/// Checks `dimension` against [`crate::MAX_DIMENSION`] and the workspace of a solver for it
+/// against [`crate::MAX_WORKSPACE_FLOATS`] (`params` already validated).
+fn check_workspace(dimension: usize, params: &LbfgsParams) -> Result<(), LbfgsError> {
+    if dimension == 0 {
+        return Err(LbfgsError::ZeroDimension);
+    }
+    if dimension > crate::MAX_DIMENSION {
+        return Err(LbfgsError::DimensionTooLarge {
+            dimension,
+            cap: crate::MAX_DIMENSION,
+        });
+    }
+    // In f64: exact for these magnitudes (memory ≤ 1024, past ≤ 65 536, dimension ≤ 1e6).
+    let (n, m) = (dimension as f64, params.memory as f64);
+    let floats = (2.0 * m + 6.0) * n + 3.0 * m + params.past as f64;
+    if floats > crate::MAX_WORKSPACE_FLOATS as f64 {
+        return Err(LbfgsError::WorkspaceTooLarge {
+            dimension,
+            memory: params.memory,
+            past: params.past,
+            floats,
+            cap: crate::MAX_WORKSPACE_FLOATS,
+        });
+    }
+    Ok(())
 }
 
 /// Minimizes `f` from `x` with `params`, leaving the solution in `x`: a one-shot

@@ -30,6 +30,11 @@ use crate::error::{check_finite, check_non_negative, check_positive, check_vec};
 use crate::{Forecast, ObstacleShape, PredictError};
 use trust_geometry::scale::{self, Quantity};
 
+/// Largest accepted [`EkfParams::accel_psd`] (m²/s³).
+pub const MAX_ACCEL_PSD: f64 = 1.0e6;
+/// Largest accepted [`EkfParams::sigma_scale`] (dimensionless).
+pub const MAX_SIGMA_SCALE: f64 = 100.0;
+
 /// Parameters of [`CvEkf`] and of the growth rate it reports.
 ///
 /// The paper gives no values; the defaults describe the simulator's obstacle sensing (a position
@@ -38,11 +43,14 @@ use trust_geometry::scale::{self, Quantity};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EkfParams {
-    /// Measurement noise standard deviation `σ` per axis (m), `> 0`. Default 0.1 m: the position
+    /// Measurement noise standard deviation `σ` per axis (m), accepted in `[1e-9, 1e6]` m
+    /// (`scale::MIN_POSITIVE`..`scale::MAX_LENGTH_M`). Default 0.1 m: the position
     /// noise of the simulator's obstacle sensor (`trust-sim`) and of the acceptance test in this
     /// crate.
     pub meas_std: f64,
-    /// Spectral density `q` of the white acceleration (m²/s³), `≥ 0`. Default 0.02: Bar-Shalom et
+    /// Spectral density `q` of the white acceleration (m²/s³), accepted in `[0, 1e6]` m²/s³
+    /// ([`MAX_ACCEL_PSD`]: a velocity standard deviation of 1000 m/s after one second, far above
+    /// any obstacle the scale policy's `1e4` m/s admits). Default 0.02: Bar-Shalom et
     /// al. (2001, Sec. 6.2.2) choose `q` so that `√(q·T)` matches the velocity change over a time
     /// `T`; 0.02 m²/s³ is a nearly-constant-velocity target (~0.14 m/s change per second), and
     /// stronger manoeuvres are left to `mu_min`. Larger `q` tracks manoeuvres faster but gives
@@ -50,14 +58,18 @@ pub struct EkfParams {
     /// after 2 s on a constant-velocity target is 0.089 m/s at `q = 0.02`, 0.125 at 0.05, 0.33 at 0.5
     /// (measured over 200 seeds).
     pub accel_psd: f64,
-    /// Initial velocity standard deviation per axis (m/s), `> 0` (the filter starts at rest).
+    /// Initial velocity standard deviation per axis (m/s), accepted in `[1e-9, 1e4]` m/s
+    /// (`scale::MIN_POSITIVE`..`scale::MAX_SPEED_M_S`; the filter starts at rest).
     /// Default 3 m/s: above the obstacle speeds of the paper's scenarios (Sec. IV).
     pub init_vel_std: f64,
-    /// Multiplier `k` on the RMS error norms `√tr P` in `mu` and the position margin, `≥ 0`.
+    /// Multiplier `k` on the RMS error norms `√tr P` in `mu` and the position margin
+    /// (dimensionless), accepted in `[0, 100]` ([`MAX_SIGMA_SCALE`]: 100 standard deviations is far
+    /// beyond any confidence level).
     /// Default 2: for an isotropic covariance `√tr P = √3·σ`, so `2·√tr P ≈ 3.46σ`, the 99 %
     /// quantile of the norm of a 3-D Gaussian error (chi distribution with 3 degrees of freedom).
     pub sigma_scale: f64,
-    /// Floor added to `mu` for unmodelled manoeuvres (m/s), `≥ 0`. Default 0.2 m/s =
+    /// Floor added to `mu` for unmodelled manoeuvres (m/s), accepted in `[0, 1e4]` m/s
+    /// (`scale::MAX_SPEED_M_S`). Default 0.2 m/s =
     /// [`EkfParams::mu_for_manoeuvre`]`(0.2 m/s², 2 s)`: an acceleration of 0.2 m/s² sustained over
     /// a 2 s horizon.
     pub mu_min: f64,
@@ -92,13 +104,19 @@ impl EkfParams {
     /// The first invalid field, with its value.
     pub fn validate(&self) -> Result<(), PredictError> {
         check_positive("ekf.meas_std", self.meas_std, Quantity::PositiveLength)?;
-        check_non_negative("ekf.accel_psd", self.accel_psd, Quantity::Length)?;
+        scale::check_range("ekf.accel_psd", self.accel_psd, 0.0, MAX_ACCEL_PSD, "m²/s³")?;
         check_positive(
             "ekf.init_vel_std",
             self.init_vel_std,
             Quantity::PositiveSpeed,
         )?;
-        check_non_negative("ekf.sigma_scale", self.sigma_scale, Quantity::Length)?;
+        scale::check_range(
+            "ekf.sigma_scale",
+            self.sigma_scale,
+            0.0,
+            MAX_SIGMA_SCALE,
+            "(dimensionless)",
+        )?;
         check_non_negative("ekf.mu_min", self.mu_min, Quantity::Rate)?;
         Ok(())
     }
@@ -194,7 +212,25 @@ impl CvEkf {
     pub fn predict(&mut self, dt: f64) -> Result<(), PredictError> {
         check_non_negative("dt", dt, Quantity::Duration)?;
         // The filter time stays inside the scale policy, which bounds the covariance's growth.
-        scale::check("filter time + dt", self.t + dt, Quantity::Time)?;
+        if !Quantity::Time.accepts(self.t + dt) {
+            return Err(PredictError::Derived {
+                what: "filter time + dt".into(),
+                value: self.t + dt,
+                limit: scale::MAX_TIME_S,
+                cause: format!(
+                    "dt = {} s from the filter time {} s leaves the scale policy's times; \
+                     lower dt",
+                    scale::Sci(dt),
+                    scale::Sci(self.t)
+                ),
+            });
+        }
+        self.propagate(dt, "dt")
+    }
+
+    /// The prediction step over `dt ≥ 0` (the filter time and `self.t + dt` inside the scale
+    /// policy); `culprit` names the caller's input that set `dt`, for the error.
+    fn propagate(&mut self, dt: f64, culprit: &str) -> Result<(), PredictError> {
         let mut f = Matrix6::identity();
         f.fixed_view_mut::<3, 3>(0, 3)
             .copy_from(&(Matrix3::identity() * dt));
@@ -216,7 +252,8 @@ impl CvEkf {
                 value: f64::INFINITY,
                 limit: f64::MAX,
                 cause: format!(
-                    "the estimate (velocity std {}, accel_psd {}) cannot be propagated by dt = {}",
+                    "the estimate (velocity std {} m/s from ekf.init_vel_std, ekf.accel_psd = {} \
+                     m²/s³) cannot be propagated over {} s ({culprit})",
                     scale::Sci(self.velocity_std()),
                     scale::Sci(self.params.accel_psd),
                     scale::Sci(dt)
@@ -242,7 +279,13 @@ impl CvEkf {
             .cholesky()
             .map(|c| c.inverse())
             .ok_or_else(|| PredictError::Numerical {
-                what: "innovation covariance is not positive definite".into(),
+                what: format!(
+                    "innovation covariance is not positive definite (position std {} m against \
+                     ekf.meas_std = {} m; ekf.init_vel_std, ekf.accel_psd and the time since the \
+                     last measurement drive the former)",
+                    scale::Sci(self.position_std()),
+                    scale::Sci(self.params.meas_std)
+                ),
             })?;
         let pht: Matrix6x3<f64> = self.cov.fixed_view::<6, 3>(0, 0).into_owned();
         let k = pht * s_inv;
@@ -284,7 +327,9 @@ impl CvEkf {
             check_vec("measurement", z, Quantity::Position)?;
         }
         let saved = self.clone();
-        self.predict(t - self.t)?;
+        // `t` and the filter time are both inside the scale policy, so `t − filter time ≤ 2e7` s
+        // keeps the covariance finite; errors name `t`, the input (step takes no `dt`).
+        self.propagate(t - self.t, "t − filter time")?;
         if let Some(z) = &z
             && let Err(e) = self.update(z)
         {
@@ -351,9 +396,13 @@ impl CvEkf {
                 mu,
                 scale::MAX_SPEED_M_S,
                 format!(
-                    "ekf.sigma_scale = {}, velocity std = {} m/s, ekf.mu_min = {}",
+                    "ekf.sigma_scale = {}, velocity std = {} m/s (it grows from \
+                     ekf.init_vel_std = {} m/s with ekf.accel_psd = {} m²/s³ over the time \
+                     since the last measurement), ekf.mu_min = {} m/s",
                     scale::Sci(self.params.sigma_scale),
                     scale::Sci(self.velocity_std()),
+                    scale::Sci(self.params.init_vel_std),
+                    scale::Sci(self.params.accel_psd),
                     scale::Sci(self.params.mu_min)
                 ),
             );
@@ -365,7 +414,8 @@ impl CvEkf {
                 scale::MAX_LENGTH_M,
                 format!(
                     "r_safe = {}, ekf.sigma_scale = {}, position std = {} m (ekf.meas_std, \
-                     ekf.accel_psd and the time since the last measurement drive it)",
+                     ekf.init_vel_std, ekf.accel_psd and the time since the last measurement \
+                     drive it)",
                     scale::Sci(r_safe),
                     scale::Sci(self.params.sigma_scale),
                     scale::Sci(self.position_std())

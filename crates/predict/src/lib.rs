@@ -53,7 +53,7 @@ mod error;
 mod forecast;
 pub mod pdc;
 
-pub use ekf::{CvEkf, EkfParams};
+pub use ekf::{CvEkf, EkfParams, MAX_ACCEL_PSD, MAX_SIGMA_SCALE};
 pub use error::PredictError;
 pub use forecast::{Forecast, ObstacleShape};
 pub use pdc::{CLEAR_TOLERANCE, Pdc, frame_along, round_cone_sdf};

@@ -97,7 +97,23 @@ impl Pdc {
     /// [`PredictError`] if the forecast is invalid or `horizon` is non-finite or negative.
     pub fn new(forecast: &Forecast, horizon: f64) -> Result<Self, PredictError> {
         check_non_negative("horizon", horizon, Quantity::Duration)?;
-        Self::over_window(forecast, forecast.t0, forecast.t0 + horizon)
+        forecast.validate()?;
+        let t_end = forecast.t0 + horizon;
+        if !Quantity::Time.accepts(t_end) {
+            // Name the input, not the window end it drove out of the policy.
+            return Err(PredictError::Derived {
+                what: "forecast.t0 + horizon".into(),
+                value: t_end,
+                limit: trust_geometry::scale::MAX_TIME_S,
+                cause: format!(
+                    "horizon = {} s from forecast.t0 = {} s ends beyond the scale policy's \
+                     times; shorten the horizon",
+                    trust_geometry::scale::Sci(horizon),
+                    trust_geometry::scale::Sci(forecast.t0)
+                ),
+            });
+        }
+        Self::over_window(forecast, forecast.t0, t_end)
     }
 
     /// The PDC over an arbitrary window `[t_start, t_end]` (e.g. from the planning time, later than

@@ -2,8 +2,8 @@
 //! f64, each named after the bug.
 
 use trust_predict::{
-    Aabb, CvEkf, EkfParams, Forecast, ObstacleShape, Pdc, PredictError, Vec3, convex,
-    round_cone_sdf,
+    Aabb, CvEkf, EkfParams, Forecast, MAX_ACCEL_PSD, MAX_SIGMA_SCALE, ObstacleShape, Pdc,
+    PredictError, Vec3, convex, round_cone_sdf,
 };
 
 #[test]
@@ -95,7 +95,7 @@ fn ekf_forecast_blames_the_filter_parameters_not_r_safe() {
     // Issue 11: an estimate that left the policy was reported as a bad forecast field.
     let params = EkfParams {
         init_vel_std: 1e4,
-        sigma_scale: 1e6,
+        sigma_scale: MAX_SIGMA_SCALE,
         ..EkfParams::default()
     };
     let ekf = CvEkf::new(0.0, Vec3::zeros(), params).unwrap();
@@ -114,4 +114,101 @@ fn ekf_time_cannot_run_past_the_policy() {
     }
     assert!(ekf.time() <= 1e7);
     assert!(ekf.covariance().iter().all(|x| x.is_finite()));
+}
+
+#[test]
+fn cv_ekf_step_names_t_not_dt_which_it_does_not_take() {
+    // Issue 18: a step from t = -1e7 to t = 1e7 failed on "`dt` = 2.0e7 is outside the accepted
+    // range", a field `step` does not take. Both times are inside the policy: the step succeeds.
+    let mut ekf = CvEkf::new(-1e7, Vec3::zeros(), EkfParams::default()).unwrap();
+    ekf.step(1e7, Some(Vec3::new(1.0, 0.0, 0.0))).unwrap();
+    assert!(ekf.state().iter().all(|x| x.is_finite()));
+    // A time out of the policy is named `t`.
+    let e = ekf.step(2e7, None).unwrap_err().to_string();
+    assert!(e.contains("`t`") && !e.contains("dt"), "{e}");
+    // `predict`, which takes `dt`, names `dt` (and the filter time it started from).
+    let e = ekf.predict(5e6).unwrap_err().to_string();
+    assert!(e.contains("dt"), "{e}");
+}
+
+#[test]
+fn ekf_params_errors_carry_each_fields_own_unit() {
+    // Issue 18: accel_psd (m²/s³) and sigma_scale (dimensionless) were reported in metres.
+    let e = EkfParams {
+        accel_psd: -1.0,
+        ..EkfParams::default()
+    }
+    .validate()
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("ekf.accel_psd") && e.contains("m²/s³"), "{e}");
+    assert!(!e.contains("] m "), "{e}");
+    let e = EkfParams {
+        sigma_scale: 1e300,
+        ..EkfParams::default()
+    }
+    .validate()
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("ekf.sigma_scale") && e.contains("dimensionless"),
+        "{e}"
+    );
+    assert!(e.contains("1.0e300"), "{e}");
+    let e = EkfParams {
+        init_vel_std: 1e5,
+        ..EkfParams::default()
+    }
+    .validate()
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("ekf.init_vel_std") && e.contains("m/s"), "{e}");
+}
+
+#[test]
+fn ekf_at_the_edges_of_its_accepted_params_forecasts_or_names_its_params() {
+    // Every accepted corner: the filter runs, and a forecast either succeeds or names the EKF
+    // parameters that drove the growth rate / margin out of the policy (never another field).
+    let corners = |lo: f64, hi: f64| [lo, hi];
+    for meas_std in corners(1e-9, 1e6) {
+        for accel_psd in corners(0.0, MAX_ACCEL_PSD) {
+            for init_vel_std in corners(1e-9, 1e4) {
+                for sigma_scale in corners(0.0, MAX_SIGMA_SCALE) {
+                    let params = EkfParams {
+                        meas_std,
+                        accel_psd,
+                        init_vel_std,
+                        sigma_scale,
+                        mu_min: 1e4,
+                        inflate_by_position_std: true,
+                    };
+                    let mut ekf = CvEkf::new(0.0, Vec3::zeros(), params).unwrap();
+                    for k in 1..=10 {
+                        let t = f64::from(k) * 1e6;
+                        ekf.step(t, (k % 3 != 0).then(|| Vec3::new(1.0, 2.0, 3.0)))
+                            .unwrap();
+                    }
+                    assert!(ekf.covariance().iter().all(|x| x.is_finite()));
+                    match ekf.forecast(ObstacleShape::Sphere, 0.5, 0.1) {
+                        Ok(f) => assert!(f.validate().is_ok()),
+                        Err(e) => {
+                            let msg = e.to_string();
+                            assert!(msg.contains("ekf."), "{msg}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn pdc_horizon_past_the_time_limit_names_horizon_not_t_end() {
+    // Fuzz (params::predict::Forecast+Pdc): `Pdc::new(f, 1.00001e7)` failed on "`t_end` =
+    // 1.00001e7 is outside the accepted range", a name the caller never used.
+    let f = Forecast::sphere(Vec3::zeros(), Vec3::zeros(), 0.0, 0.5, 0.1, 0.2).unwrap();
+    let e = f.pdc(1.00001e7).unwrap_err().to_string();
+    assert!(e.contains("horizon"), "{e}");
+    assert!(!e.contains("`t_end`"), "{e}");
+    assert!(f.pdc(1e7).is_ok());
 }

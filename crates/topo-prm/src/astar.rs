@@ -16,13 +16,14 @@ use serde::{Deserialize, Serialize};
 
 use trust_core::{
     GuidePath, PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult, SearchStats, Vec3,
-    check_non_negative, check_positive,
 };
 
 use crate::ggs::Terminal;
 use crate::prm::check_or_trivial_answer;
+use crate::ranges;
 use crate::shortcut::shortcut;
 use crate::visibility::Obstacles;
+use trust_core::scale;
 
 /// Yaw directions of the first expansion (from the start, which has no heading).
 const START_YAW_COUNT: usize = 16;
@@ -34,19 +35,26 @@ const HEADING_SECTORS: f64 = 8.0;
 #[serde(deny_unknown_fields, default)]
 pub struct SparseAStarParams {
     /// Expansion step (m). Ours: 1.0.
+    /// Accepted: `[1e-3, 1e6]` m ([`crate::ranges::MIN_RESOLUTION_M`]).
     pub step: f64,
     /// Largest yaw change per step (degrees). Ours: 45.
+    /// Accepted: `[0, 180]`.
     pub max_turn_deg: f64,
     /// Yaw directions per expansion, spread evenly over `±max_turn_deg` (1 = straight on only). Ours: 5.
+    /// Accepted: `[1, 64]` ([`MAX_TURN_BRANCHES`]).
     pub turn_branches: usize,
     /// Pitch offset of the climbing and descending expansions (degrees; 0 = level flight only).
     /// Ours: 30.
+    /// Accepted: `[0, 90]`.
     pub climb_deg: f64,
     /// Nodes and edges keep this distance from obstacles (m). Ours: 0.3, the PRMs' sample clearance.
+    /// Accepted: `[0, 1e6]` m.
     pub clearance: f64,
     /// Time budget (ms, monotonic clock). Ours: 5, the PRMs' default budget.
+    /// Accepted: `(0, 6e5]` ms ([`crate::ranges::MAX_BUDGET_MS`]).
     pub budget_ms: f64,
     /// Expansion budget. Ours: 20 000.
+    /// Accepted: `[1, 1e6]` ([`crate::ranges::MAX_EXPANSIONS`]).
     pub max_expansions: usize,
     /// Avoid the predictive directional cones of all forecasts. Default `true`.
     pub pdc: bool,
@@ -83,7 +91,13 @@ impl SparseAStarParams {
     }
 
     fn budget(&self) -> Result<Duration, PlanError> {
-        check_positive("sparse_astar.step", self.step)?;
+        ranges::range(
+            "sparse_astar.step",
+            self.step,
+            ranges::MIN_RESOLUTION_M,
+            scale::MAX_LENGTH_M,
+            "m",
+        )?;
         if !(self.max_turn_deg.is_finite() && (0.0..=180.0).contains(&self.max_turn_deg)) {
             return Err(PlanError::invalid(
                 "sparse_astar.max_turn_deg",
@@ -98,18 +112,25 @@ impl SparseAStarParams {
                 "a number in [0, 90]",
             ));
         }
-        if self.turn_branches == 0 || self.turn_branches > MAX_TURN_BRANCHES {
-            return Err(PlanError::invalid(
-                "sparse_astar.turn_branches",
-                self.turn_branches,
-                "an integer in [1, 64] (MAX_TURN_BRANCHES; each expansion tries this many headings)",
-            ));
-        }
-        if self.max_expansions == 0 {
-            return Err(PlanError::invalid("sparse_astar.max_expansions", 0, ">= 1"));
-        }
-        check_non_negative("sparse_astar.clearance", self.clearance)?;
-        check_positive("sparse_astar.budget_ms", self.budget_ms)?;
+        // Each expansion tries this many headings.
+        ranges::count(
+            "sparse_astar.turn_branches",
+            self.turn_branches,
+            1,
+            MAX_TURN_BRANCHES,
+        )?;
+        ranges::count(
+            "sparse_astar.max_expansions",
+            self.max_expansions,
+            1,
+            ranges::MAX_EXPANSIONS,
+        )?;
+        ranges::quantity(
+            "sparse_astar.clearance",
+            self.clearance,
+            scale::Quantity::Length,
+        )?;
+        ranges::budget_ms("sparse_astar.budget_ms", self.budget_ms)?;
         Duration::try_from_secs_f64(self.budget_ms / 1000.0).map_err(|_| {
             PlanError::invalid(
                 "sparse_astar.budget_ms",

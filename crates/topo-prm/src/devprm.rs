@@ -35,6 +35,8 @@ use serde::{Deserialize, Serialize};
 use trust_core::{PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult, Vec3};
 
 use crate::prm::{ConeMode, GraphSearch, PrmSetup, SurfaceSampling, run};
+use crate::ranges;
+use trust_core::scale::{self, Quantity};
 
 /// Parameters of [`DevPrm`]. The V-PRM part defaults to Fast-Planner's values (see
 /// [`crate::VprmParams`]); the paper gives no values for the rest, so they are ours, as stated.
@@ -47,14 +49,19 @@ pub struct DevPrmParams {
     /// seeds 0–2 the closed loop fell back to braking 1–18 times per flight and took 32–35 s;
     /// with (1, 10, 5) and [`DevPrmParams::pdc_horizon_s`] = 2 s, E3 gives 3–6 paths and E4 flies
     /// in 29–31 s without a fallback, at about 3× the frontend time.
+    /// Accepted: each component in `[0, 1e6]` m.
     pub inflate: Vec3,
     /// Samples closer than this to an obstacle (static or PDC) are rejected (m). Fast-Planner: 0.3.
+    /// Accepted: `[0, 1e6]` m.
     pub clearance: f64,
     /// Resolution (m): edge threshold and UVD/shortcut step. Fast-Planner: 0.1.
+    /// Accepted: `[1e-3, 1e6]` m ([`crate::ranges::MIN_RESOLUTION_M`]).
     pub resolution: f64,
     /// Time budget `t_max` of the roadmap construction (ms). Fast-Planner's 5 ms (E1 uses 20 ms).
+    /// Accepted: `(0, 6e5]` ms ([`crate::ranges::MAX_BUDGET_MS`]).
     pub budget_ms: f64,
     /// Random-sample budget `N_max`. Fast-Planner's 2000.
+    /// Accepted: `[0, 1e6]` (`scale::MAX_SAMPLE_COUNT`).
     pub max_samples: usize,
     /// Random sampling stops early after this many consecutive samples in free space that added
     /// neither a guard nor a connector; `0` switches the stop off (only `budget_ms` and `max_samples`
@@ -63,18 +70,25 @@ pub struct DevPrmParams {
     /// estimating the part of the free space no guard sees), extended to connectors because the
     /// homotopy classes live in them. Ours: 200 (the guards see an estimated 99.5 % of the sampling
     /// region, and the last 200 samples brought no new connector, i.e. no candidate class).
+    /// Accepted: `[0, 1e6]` (`scale::MAX_SAMPLE_COUNT`).
     pub stall_samples: usize,
     /// Width of the beam search (partial paths kept per level). Ours: 16.
+    /// Accepted: `[1, 1024]` ([`crate::ranges::MAX_BEAM_WIDTH`]).
     pub beam_width: usize,
     /// The search stops after this many raw paths. Fast-Planner: 300.
+    /// Accepted: `[1, 1e5]` ([`crate::ranges::MAX_PATH_COUNT`]).
     pub max_raw_paths: usize,
     /// Raw paths kept (shortest first) for shortcutting. Fast-Planner: 25.
+    /// Accepted: `[1, 1e5]` ([`crate::ranges::MAX_PATH_COUNT`]).
     pub keep_raw_paths: usize,
     /// At most this many paths are returned. Fast-Planner: 6.
+    /// Accepted: `[1, 1e5]` ([`crate::ranges::MAX_PATH_COUNT`]).
     pub max_paths: usize,
     /// Paths longer than this times the shortest are dropped. Fast-Planner: 5.5.
+    /// Accepted: `[1, 1e6]` ([`crate::ranges::MAX_LENGTH_RATIO`]).
     pub length_ratio: f64,
     /// The search stops after this many partial-path expansions. Ours: 100 000.
+    /// Accepted: `[1, 1e6]` ([`crate::ranges::MAX_EXPANSIONS`]).
     pub max_expansions: usize,
     /// Test visibility against the PDCs of all forecasts (enhancement 1). Default `true`.
     pub pdc: bool,
@@ -82,16 +96,20 @@ pub struct DevPrmParams {
     /// The paper builds the PDC "over a short time horizon" without a value. Ours: 2 s (E1's
     /// horizon): over the manager's 4 s horizon the cones of E3's EKF forecasts (growing at
     /// 0.56 m/s) fill the corridor; the backend still avoids the obstacles over the whole horizon.
+    /// Accepted: `[0, 1e7]` s, or `None`.
     pub pdc_horizon_s: Option<f64>,
     /// Insert obstacle-aware samples on PDC surfaces before random sampling (enhancement 2; needs
     /// `pdc`). Default `true`.
     pub obstacle_aware_samples: bool,
     /// Slices along each PDC's predicted velocity. Ours: 3 (start, middle and end of the horizon).
+    /// Accepted: `≥ 1` with `slices · samples_per_slice ≤ 1e4` ([`crate::ranges::MAX_SURFACE_SAMPLES`]).
     pub slices: usize,
     /// Samples on each slice. Ours: 8 (every 45°).
+    /// Accepted: `≥ 1` with `slices · samples_per_slice ≤ 1e4`.
     pub samples_per_slice: usize,
     /// Signed distance of the obstacle-aware samples from the PDC surface (m); must be at least
     /// `clearance`. Ours: 0.5 (the 0.3 m clearance plus two resolutions).
+    /// Accepted: `[clearance, 1e6]` m.
     pub surface_offset: f64,
     /// End paths on the goal guidance surface (enhancement 3). Default `true`.
     pub goal_guidance_surface: bool,
@@ -134,32 +152,43 @@ impl DevPrmParams {
     fn setup(&self) -> Result<PrmSetup, PlanError> {
         let shared = self.shared_setup();
         shared.check_shared("devprm")?;
-        if self.beam_width == 0 {
-            return Err(PlanError::invalid("devprm.beam_width", 0, ">= 1"));
-        }
+        ranges::count(
+            "devprm.stall_samples",
+            self.stall_samples,
+            0,
+            trust_core::scale::MAX_SAMPLE_COUNT,
+        )?;
+        ranges::count(
+            "devprm.beam_width",
+            self.beam_width,
+            1,
+            ranges::MAX_BEAM_WIDTH,
+        )?;
         if self.obstacle_aware_samples {
-            if self.slices == 0 {
-                return Err(PlanError::invalid("devprm.slices", 0, ">= 1"));
-            }
-            if self.samples_per_slice == 0 {
-                return Err(PlanError::invalid("devprm.samples_per_slice", 0, ">= 1"));
-            }
-            if !(self.surface_offset.is_finite() && self.surface_offset >= self.clearance) {
-                return Err(PlanError::invalid(
-                    "devprm.surface_offset",
-                    self.surface_offset,
-                    format!("a finite number >= devprm.clearance ({})", self.clearance),
-                ));
-            }
+            ranges::count("devprm.slices", self.slices, 1, ranges::MAX_SURFACE_SAMPLES)?;
+            ranges::count(
+                "devprm.samples_per_slice",
+                self.samples_per_slice,
+                1,
+                ranges::MAX_SURFACE_SAMPLES,
+            )?;
+            scale::check_count(
+                "devprm.slices * devprm.samples_per_slice",
+                self.slices as u128 * self.samples_per_slice as u128,
+                ranges::MAX_SURFACE_SAMPLES,
+            )?;
+            // At least the sample clearance (a surface sample must be a valid sample), at most a
+            // length of the scale policy.
+            ranges::range(
+                "devprm.surface_offset",
+                self.surface_offset,
+                self.clearance,
+                scale::MAX_LENGTH_M,
+                "m (lower end: devprm.clearance)",
+            )?;
         }
-        if let Some(h) = self.pdc_horizon_s
-            && !(h.is_finite() && h >= 0.0)
-        {
-            return Err(PlanError::invalid(
-                "devprm.pdc_horizon_s",
-                h,
-                "a finite number >= 0 (s), or none for the query horizon",
-            ));
+        if let Some(h) = self.pdc_horizon_s {
+            ranges::quantity("devprm.pdc_horizon_s", h, Quantity::Duration)?;
         }
         Ok(PrmSetup {
             stall_samples: self.stall_samples,

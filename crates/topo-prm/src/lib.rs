@@ -76,6 +76,7 @@ pub mod devprm;
 pub mod ggs;
 pub mod gjk;
 mod prm;
+pub mod ranges;
 pub mod roadmap;
 pub mod sampling;
 pub mod scenes;

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use trust_core::{
     Aabb, GuidePath, PathQuery, PlanError, Rng, Scene, SearchResult, SearchStats, Vec3,
-    check_finite, check_finite_vec, check_non_negative, check_positive,
+    check_finite, check_finite_vec, check_non_negative,
 };
 
 use crate::ggs::Terminal;
@@ -141,40 +141,44 @@ impl PrmSetup {
     /// Checks the fields V-PRM and DEV-PRM share (errors name `prefix.field`); the planners check
     /// their own fields.
     pub(crate) fn check_shared(&self, prefix: &str) -> Result<(), PlanError> {
-        let inflate = &self.inflate;
-        check_finite_vec(&format!("{prefix}.inflate"), inflate)?;
-        if inflate.iter().any(|x| *x < 0.0) {
-            return Err(PlanError::invalid(
-                format!("{prefix}.inflate"),
-                [inflate.x, inflate.y, inflate.z],
-                "non-negative components",
-            ));
-        }
-        check_non_negative(&format!("{prefix}.clearance"), self.clearance)?;
-        check_positive(&format!("{prefix}.resolution"), self.resolution)?;
-        check_positive(&format!("{prefix}.budget_ms"), self.budget_ms)?;
+        use crate::ranges;
+        use trust_core::scale::{MAX_LENGTH_M, MAX_SAMPLE_COUNT, Quantity};
+        let field = |name: &str| format!("{prefix}.{name}");
+        ranges::lengths(&field("inflate"), &self.inflate)?;
+        ranges::quantity(&field("clearance"), self.clearance, Quantity::Length)?;
+        ranges::range(
+            &field("resolution"),
+            self.resolution,
+            ranges::MIN_RESOLUTION_M,
+            MAX_LENGTH_M,
+            "m",
+        )?;
+        ranges::budget_ms(&field("budget_ms"), self.budget_ms)?;
         self.budget(prefix)?;
-        for (name, value) in [
-            ("max_raw_paths", self.max_raw_paths),
-            ("keep_raw_paths", self.keep_raw_paths),
-            ("max_paths", self.max_paths),
-            ("max_expansions", self.max_expansions),
+        ranges::count(&field("max_samples"), self.max_samples, 0, MAX_SAMPLE_COUNT)?;
+        for (name, value, cap) in [
+            ("max_raw_paths", self.max_raw_paths, ranges::MAX_PATH_COUNT),
+            (
+                "keep_raw_paths",
+                self.keep_raw_paths,
+                ranges::MAX_PATH_COUNT,
+            ),
+            ("max_paths", self.max_paths, ranges::MAX_PATH_COUNT),
+            (
+                "max_expansions",
+                self.max_expansions,
+                ranges::MAX_EXPANSIONS,
+            ),
         ] {
-            if value == 0 {
-                return Err(PlanError::invalid(
-                    format!("{prefix}.{name}"),
-                    value,
-                    ">= 1",
-                ));
-            }
+            ranges::count(&field(name), value, 1, cap)?;
         }
-        if !(self.length_ratio.is_finite() && self.length_ratio >= 1.0) {
-            return Err(PlanError::invalid(
-                format!("{prefix}.length_ratio"),
-                self.length_ratio,
-                "a finite number >= 1",
-            ));
-        }
+        ranges::range(
+            &field("length_ratio"),
+            self.length_ratio,
+            1.0,
+            ranges::MAX_LENGTH_RATIO,
+            "(dimensionless)",
+        )?;
         Ok(())
     }
 }

@@ -19,22 +19,31 @@ use trust_core::{
 #[serde(deny_unknown_fields, default)]
 pub struct SceneParams {
     /// Size of the box `[0, size]` (m). Paper: 20 × 20 × 10.
+    /// Accepted: each component in `[1e-9, 1e6]` m, more than twice `margin`.
     pub size: Vec3,
     /// Obstacle speed range (m/s). Ours: 0.5–3.
+    /// Accepted: `0 ≤ lo ≤ hi ≤ 1e4` m/s.
     pub speed: (f64, f64),
     /// Obstacle size `r_o` range (m). Ours: 0.5–1.5.
+    /// Accepted: `0 < lo ≤ hi ≤ 1e6` m.
     pub radius: (f64, f64),
     /// Uncertainty growth `mu` range (m/s). Ours: 0.1–0.3.
+    /// Accepted: `0 ≤ lo ≤ hi ≤ 1e4` m/s.
     pub mu: (f64, f64),
     /// Safety margin `r_safe` of every forecast (m). Ours: 0.
+    /// Accepted: `[0, 1e6]` m.
     pub r_safe: f64,
     /// Probability that an obstacle is a full-height vertical cylinder (else a sphere). Ours: 0.5.
+    /// Accepted: `[0, 1]`.
     pub cylinder_fraction: f64,
     /// Distance of start and goal from the box faces (m). Ours: 1.
+    /// Accepted: `≥ 0` and less than half the smallest `size` component.
     pub margin: f64,
     /// Start and goal keep at least this distance from every obstacle at the query time (m). Ours: 1.
+    /// Accepted: `[0, 1e6]` m.
     pub endpoint_clearance: f64,
     /// Planning horizon `T_h` of the query (s). Ours: 2 (the 18 m crossing at 10 m/s takes ~2 s).
+    /// Accepted: `[1e-9, 1e7]` s.
     pub horizon_s: f64,
     /// Vehicle limits of the query. Paper Sec. IV: 10 m/s, 15 m/s².
     pub limits: Limits,
@@ -78,14 +87,29 @@ fn check_range(field: &str, (lo, hi): (f64, f64), positive: bool) -> Result<(), 
 impl SceneParams {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
+        use trust_core::scale::{self, Quantity};
         check_finite_vec("scene.size", &self.size)?;
         for i in 0..3 {
             check_positive("scene.size", self.size[i])?;
         }
+        scale::check_vec("scene.size", &self.size, Quantity::PositiveLength)?;
         check_range("scene.speed", self.speed, false)?;
+        crate::ranges::quantity("scene.speed.1", self.speed.1, Quantity::Rate)?;
         check_range("scene.radius", self.radius, true)?;
+        crate::ranges::quantity("scene.radius.1", self.radius.1, Quantity::Length)?;
         check_range("scene.mu", self.mu, false)?;
-        check_non_negative("scene.r_safe", self.r_safe)?;
+        crate::ranges::quantity("scene.mu.1", self.mu.1, Quantity::Rate)?;
+        crate::ranges::quantity("scene.r_safe", self.r_safe, Quantity::Length)?;
+        crate::ranges::quantity(
+            "scene.endpoint_clearance",
+            self.endpoint_clearance,
+            Quantity::Length,
+        )?;
+        crate::ranges::quantity(
+            "scene.horizon_s",
+            self.horizon_s,
+            Quantity::PositiveDuration,
+        )?;
         if !(0.0..=1.0).contains(&self.cylinder_fraction) {
             return Err(PlanError::invalid(
                 "scene.cylinder_fraction",
@@ -99,7 +123,10 @@ impl SceneParams {
             return Err(PlanError::invalid(
                 "scene.margin",
                 self.margin,
-                "less than half the smallest box size",
+                format!(
+                    "less than half the smallest component of scene.size = {:?}",
+                    [self.size.x, self.size.y, self.size.z]
+                ),
             ));
         }
         check_positive("scene.horizon_s", self.horizon_s)?;
@@ -190,7 +217,8 @@ pub fn random_dynamic_scene(
             return Err(PlanError::invalid(
                 format!("scene obstacle {i}"),
                 PLACEMENT_ATTEMPTS,
-                "a placement that keeps start and goal free (reduce sizes or endpoint_clearance)",
+                "a placement that keeps start and goal free (reduce scene.radius, scene.r_safe or \
+                 scene.endpoint_clearance, or enlarge scene.size)",
             ));
         };
         forecasts.push(f);

@@ -9,9 +9,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use trust_core::{
-    Curve, HomotopyChecker, PlanError, Scene, Vec3, check_non_negative, check_positive,
-};
+use trust_core::scale::{self, Quantity};
+use trust_core::{Curve, HomotopyChecker, PlanError, Scene, Vec3};
 
 /// Upper bound on the number of sampled times of one comparison.
 pub const MAX_SAMPLES: usize = 1_000_000;
@@ -28,17 +27,18 @@ pub fn chord_clear(scene: &Scene<'_>, p: &Vec3, q: &Vec3, t: f64, clearance: f64
 }
 
 /// The sampled times of a TVD comparison: `t_lo, t_lo + dt, …` and always `t_hi`.
+///
+/// # Errors
+/// [`PlanError::Scale`] naming `tvd.dt_s` for a step outside `[1e-9, 1e7]` s, `t_lo` / `t_hi`
+/// outside the scale policy's times; [`PlanError::InvalidInput`] naming the span `t_hi − t_lo` if
+/// it needs more than [`MAX_SAMPLES`] samples at this step.
 pub fn sample_times(t_lo: f64, t_hi: f64, dt: f64) -> Result<Vec<f64>, PlanError> {
-    check_positive("tvd.dt_s", dt)?;
+    crate::ranges::quantity("tvd.dt_s", dt, Quantity::PositiveDuration)?;
+    crate::ranges::quantity("t_lo", t_lo, Quantity::Time)?;
+    crate::ranges::quantity("t_hi", t_hi, Quantity::Time)?;
     let span = (t_hi - t_lo).max(0.0);
+    check_sample_count("t_hi − t_lo", span, dt)?;
     let steps = (span / dt).floor();
-    if !steps.is_finite() || steps >= MAX_SAMPLES as f64 {
-        return Err(PlanError::invalid(
-            "tvd.dt_s",
-            dt,
-            format!("a step giving at most {MAX_SAMPLES} samples over {span} s"),
-        ));
-    }
     let steps = steps as usize;
     let mut times: Vec<f64> = (0..=steps).map(|k| t_lo + k as f64 * dt).collect();
     if t_lo + steps as f64 * dt < t_hi {
@@ -69,7 +69,7 @@ pub fn equivalent_with_clearance(
     dt: f64,
     clearance: f64,
 ) -> Result<bool, PlanError> {
-    check_non_negative("tvd.clearance", clearance)?;
+    crate::ranges::quantity("tvd.clearance", clearance, Quantity::Length)?;
     let (Some((a0, a1)), Some((b0, b1))) = (a.time_span(), b.time_span()) else {
         return Err(PlanError::Unsupported {
             component: "tvd".into(),
@@ -78,8 +78,18 @@ pub fn equivalent_with_clearance(
                 .into(),
         });
     };
+    // The scene may have been built without `Scene::new` (its fields are public): check its
+    // forecasts as every other component does.
+    Scene::new(scene.map, scene.forecasts, scene.t0)?;
+    crate::ranges::quantity("tvd.dt_s", dt, Quantity::PositiveDuration)?;
     let t_lo = a0.max(b0);
     let t_hi = a1.min(b1).max(t_lo);
+    // A long common span (a long hold) needs many samples: name the curves, not the step.
+    check_sample_count(
+        "common time span of the two trajectories",
+        (t_hi - t_lo).max(0.0),
+        dt,
+    )?;
     for t in sample_times(t_lo, t_hi, dt)? {
         let (Some(p), Some(q)) = (a.position_at_time(t), b.position_at_time(t)) else {
             return Ok(false);
@@ -91,15 +101,36 @@ pub fn equivalent_with_clearance(
     Ok(true)
 }
 
+/// `Ok` if a span of `span` s sampled every `dt` s needs fewer than [`MAX_SAMPLES`] samples; the
+/// error names `what` (the span), with the step and the longest span it allows.
+fn check_sample_count(what: &str, span: f64, dt: f64) -> Result<(), PlanError> {
+    let steps = (span / dt).floor();
+    if steps.is_finite() && steps < MAX_SAMPLES as f64 {
+        return Ok(());
+    }
+    Err(PlanError::invalid(
+        what,
+        span,
+        format!(
+            "a span of at most {} s at tvd.dt_s = {} s ({MAX_SAMPLES} samples, tvd::MAX_SAMPLES); \
+             compare shorter trajectories or raise tvd.dt_s",
+            scale::Sci(dt * (MAX_SAMPLES - 1) as f64),
+            scale::Sci(dt)
+        ),
+    ))
+}
+
 /// Parameters of the [`Tvd`] checker.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TvdParams {
-    /// Time step between compared instants (s). The paper samples `t_c` without giving a step; our
+    /// Time step between compared instants (s), accepted in `[1e-9, 1e7]` s (the scale policy's
+    /// positive durations). The paper samples `t_c` without giving a step; our
     /// default 0.05 s lets an obstacle at 3 m/s (the fastest in experiment E1) move 0.15 m between
     /// checks, half of Fast-Planner's 0.3 m sampling clearance.
     pub dt_s: f64,
-    /// A chord is blocked if it comes closer than this to an obstacle (m). Default 0: the paper's
+    /// A chord is blocked if it comes closer than this to an obstacle (m), accepted in `[0, 1e6]` m.
+    /// Default 0: the paper's
     /// condition `τ₁(t_c)τ₂(t_c) ∩ O(t_c) = ∅`.
     pub clearance: f64,
 }
@@ -116,8 +147,8 @@ impl Default for TvdParams {
 impl TvdParams {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
-        check_positive("tvd.dt_s", self.dt_s)?;
-        check_non_negative("tvd.clearance", self.clearance)?;
+        crate::ranges::quantity("tvd.dt_s", self.dt_s, Quantity::PositiveDuration)?;
+        crate::ranges::quantity("tvd.clearance", self.clearance, Quantity::Length)?;
         Ok(())
     }
 }

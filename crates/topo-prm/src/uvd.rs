@@ -16,9 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use trust_core::{
-    Aabb, Curve, HomotopyChecker, PlanError, Scene, Vec3, check_non_negative, check_positive,
-};
+use trust_core::{Aabb, Curve, HomotopyChecker, PlanError, Scene, Vec3, check_positive};
 
 use crate::gjk::{Hull, separated_along};
 use crate::visibility::{Obstacles, forecast_cones};
@@ -695,14 +693,17 @@ pub fn chords_visible(
 pub struct UvdParams {
     /// Arc-length step of the matched points (m). Default 0.1 m: Fast-Planner's map resolution, which
     /// its UVD uses as the step.
+    /// Accepted: `[1e-9, 1e6]` m; the matched points (`curve length / resolution`) are capped at [`MAX_POINTS`].
     pub resolution: f64,
     /// A chord is blocked if it comes closer than this to an obstacle (m). Default 0: Fast-Planner's
     /// UVD visibility threshold.
+    /// Accepted: `[0, 1e6]` m.
     pub clearance: f64,
     /// When set, the predictive directional cones of all forecasts over this horizon (s, from
     /// `scene.t0`) are obstacles too (`"uvd+pdc"`), so the checker sees moving obstacles. Cones that
     /// contain the first or last point of either curve are ignored (both curves must cross them, so
     /// they cannot separate the curves). Default `None`: the static map only, as in Fast-Planner.
+    /// Accepted: `[1e-9, 1e7]` s, or `None`.
     pub pdc_horizon_s: Option<f64>,
     /// See the moving obstacles frozen where they are at `scene.t0` (`"uvd+frozen"`; V-PRM's own
     /// view with `VprmParams::freeze_forecasts`). Exclusive with `pdc_horizon_s`. Default `false`.
@@ -723,10 +724,11 @@ impl Default for UvdParams {
 impl UvdParams {
     /// Checks every field.
     pub fn validate(&self) -> Result<(), PlanError> {
-        check_positive("uvd.resolution", self.resolution)?;
-        check_non_negative("uvd.clearance", self.clearance)?;
+        use trust_core::scale::Quantity;
+        crate::ranges::quantity("uvd.resolution", self.resolution, Quantity::PositiveLength)?;
+        crate::ranges::quantity("uvd.clearance", self.clearance, Quantity::Length)?;
         if let Some(h) = self.pdc_horizon_s {
-            check_positive("uvd.pdc_horizon_s", h)?;
+            crate::ranges::quantity("uvd.pdc_horizon_s", h, Quantity::PositiveDuration)?;
             if self.freeze_forecasts {
                 return Err(PlanError::invalid(
                     "uvd.freeze_forecasts",

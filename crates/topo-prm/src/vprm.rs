@@ -19,29 +19,39 @@ use crate::prm::{ConeMode, PrmSetup, run};
 pub struct VprmParams {
     /// Sampling-box inflation (m): along start→goal (added to half the distance), horizontal,
     /// vertical. Fast-Planner: (1.0, 3.5, 1.0).
+    /// Accepted: each component in `[0, 1e6]` m.
     pub inflate: Vec3,
     /// Samples closer than this to an obstacle are rejected (m). Fast-Planner: 0.3.
+    /// Accepted: `[0, 1e6]` m.
     pub clearance: f64,
     /// Map resolution (m): roadmap edges keep this distance from obstacles, and UVD and shortcutting
     /// step by it. Fast-Planner: 0.1.
+    /// Accepted: `[1e-3, 1e6]` m ([`crate::ranges::MIN_RESOLUTION_M`]).
     pub resolution: f64,
     /// Time budget of the roadmap construction (ms, monotonic clock). Fast-Planner: 5 ms
     /// (experiment E1 uses 20 ms).
+    /// Accepted: `(0, 6e5]` ms ([`crate::ranges::MAX_BUDGET_MS`]).
     pub budget_ms: f64,
     /// Sample budget of the roadmap construction. Fast-Planner: 2000. V-PRM samples until this or
     /// `budget_ms` binds, as Fast-Planner does (no stop when the roadmap stalls, unlike
     /// [`crate::DevPrmParams::stall_samples`]).
+    /// Accepted: `[0, 1e6]` (`scale::MAX_SAMPLE_COUNT`).
     pub max_samples: usize,
     /// The depth-first search stops after this many raw paths. Fast-Planner: 300.
+    /// Accepted: `[1, 1e5]` ([`crate::ranges::MAX_PATH_COUNT`]).
     pub max_raw_paths: usize,
     /// Raw paths kept (fewest nodes first) for shortcutting. Fast-Planner: 25.
+    /// Accepted: `[1, 1e5]` ([`crate::ranges::MAX_PATH_COUNT`]).
     pub keep_raw_paths: usize,
     /// At most this many paths are returned. Fast-Planner: 6 (`reserve_num`).
+    /// Accepted: `[1, 1e5]` ([`crate::ranges::MAX_PATH_COUNT`]).
     pub max_paths: usize,
     /// Paths longer than this times the shortest are dropped. Fast-Planner: 5.5.
+    /// Accepted: `[1, 1e6]` ([`crate::ranges::MAX_LENGTH_RATIO`]).
     pub length_ratio: f64,
     /// The search stops after this many node expansions. Ours (the anchor has no bound): 100 000, far
     /// above what the 300-path bound needs on a pruned roadmap.
+    /// Accepted: `[1, 1e6]` ([`crate::ranges::MAX_EXPANSIONS`]).
     pub max_expansions: usize,
     /// See moving obstacles as static obstacles where they are at the query time (their shape with
     /// radius `radius(t)`), as Fast-Planner sees them in its occupancy map. Ours: `true`; `false`

@@ -252,7 +252,7 @@ fn a_tiny_time_budget_stops_the_roadmap() {
     let q = query(Vec3::new(1.0, 10.0, 5.0), Vec3::new(19.0, 10.0, 5.0));
     let f = Vprm::new(VprmParams {
         budget_ms: 1e-6,
-        max_samples: usize::MAX,
+        max_samples: trust_core::scale::MAX_SAMPLE_COUNT,
         ..VprmParams::default()
     })
     .unwrap();
