@@ -932,6 +932,12 @@ pub fn all() -> Vec<Api> {
         api!("params::checkers", 5, params_checkers),
         api!("params::backends", 3, params_backends),
         api!("params::ekf+lbfgs+scenes", 20, params_misc),
+        api!("params::minco_edges", 3, crate::minco_oracles::params_edges),
+        api!(
+            "minco::violations",
+            5,
+            crate::minco_oracles::violations_oracle
+        ),
     ]
     .into_iter()
     .chain(crate::params::apis())

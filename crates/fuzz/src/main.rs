@@ -9,6 +9,7 @@
 
 mod apis;
 mod inputs;
+mod minco_oracles;
 mod params;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
