@@ -14,17 +14,31 @@
 //!   `Solution::violations`, and every listed violation must be real (its amount found again
 //!   at its time).
 //!
-//! Plug in (crates/fuzz/src/main.rs and apis.rs): `mod minco_oracles;` next to `mod apis;`, and in
-//! `apis::all()`: `api!("params::minco_edges", 3, crate::minco_oracles::params_edges)` and
-//! `api!("minco::violations", 5, crate::minco_oracles::violations_oracle)`.
+//! [`apis`] lists both for the harness's registry (`main.rs`).
 
 use trust_core::{
     GuidePath, InitialGuess, Limits, PolyTraj, Scene, State, TrajRequest, TrajectoryBackend, Vec3,
     Violation,
 };
 
-use crate::apis::{Fixtures, Outcome};
+use crate::apis::{Api, Fixtures, Outcome};
 use crate::inputs::Gen;
+
+/// The minco oracles as harness entries (name, weight, call).
+pub fn apis() -> Vec<Api> {
+    vec![
+        Api {
+            name: "params::minco_edges",
+            weight: 3,
+            run: params_edges,
+        },
+        Api {
+            name: "minco::violations",
+            weight: 5,
+            run: violations_oracle,
+        },
+    ]
+}
 
 /// Extreme and edge values tried for a float field.
 const FLOAT_EDGES: [f64; 16] = [
