@@ -8,7 +8,7 @@
 //! with degenerate input; the iteration only makes the bound tight quickly.
 
 use trust_core::Vec3;
-use trust_predict::Pdc;
+use trust_predict::{ObstacleShape, Pdc};
 
 /// Iteration cap of [`separated`]: GJK on a polytope of a few vertices and a smooth convex set
 /// converges in a handful of steps; undecided cases after this many are reported as not separated.
@@ -27,6 +27,47 @@ pub trait SupportMap {
 impl SupportMap for Pdc {
     fn support(&self, d: &Vec3) -> Vec3 {
         Pdc::support(self, d)
+    }
+}
+
+/// The region that [`Pdc::segment_clear`] with `clearance` (≥ 0) treats as blocking: the cone
+/// grown by `clearance` plus [`trust_predict::pdc::CLEAR_TOLERANCE`] — by a ball for a sphere cone,
+/// by a vertical cylinder of that radius and half-height for a cylinder cone (the square rim of the
+/// cylinder's segment test, not the rounded offset surface). A set proven [`separated`] from this
+/// region at margin 0 contains no segment that the cone's own test calls blocked, for both shapes;
+/// testing the bare cone at margin `clearance` instead would be exact Euclidean clearance, which
+/// clears segments that pass a cylinder's rim between `clearance` and `√2·clearance` away although
+/// [`Pdc::segment_clear`] (and therefore testing every chord) blocks them.
+#[derive(Debug, Clone, Copy)]
+pub struct Inflated<'a> {
+    /// The cone.
+    pub cone: &'a Pdc,
+    /// The clearance of the segment test (m; negative values count as 0).
+    pub clearance: f64,
+}
+
+impl SupportMap for Inflated<'_> {
+    fn support(&self, d: &Vec3) -> Vec3 {
+        let base = self.cone.support(d);
+        let grow = self.clearance.max(0.0) + trust_predict::CLEAR_TOLERANCE;
+        // Only the direction matters: rescale so that huge components cannot overflow the norm.
+        let m = d.amax();
+        if !(m.is_finite() && m > 0.0) {
+            return base;
+        }
+        let d = d / m;
+        if matches!(self.cone.forecast().shape, ObstacleShape::Cylinder { .. }) {
+            let n = (d.x * d.x + d.y * d.y).sqrt();
+            let (x, y) = if n > 0.0 {
+                (d.x / n * grow, d.y / n * grow)
+            } else {
+                (0.0, 0.0)
+            };
+            let z = if d.z >= 0.0 { grow } else { -grow };
+            base + Vec3::new(x, y, z)
+        } else {
+            base + d.normalize() * grow
+        }
     }
 }
 
