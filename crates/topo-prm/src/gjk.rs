@@ -514,4 +514,63 @@ mod tests {
             Proximity::Apart
         );
     }
+
+    /// Issue 18: a segment passing a cylinder's rim diagonally, `c` to `√2·c` away, is blocked by
+    /// the cylinder's segment test (square rim) although it is more than `c` away in Euclidean
+    /// distance; only the inflated region gives the test's answer.
+    #[test]
+    fn inflated_cylinder_has_the_square_rim_of_the_segment_test() {
+        use trust_predict::{Forecast, ObstacleShape};
+        let f = Forecast::new(
+            ObstacleShape::Cylinder { half_height: 1.0 },
+            Vec3::zeros(),
+            Vec3::zeros(),
+            0.0,
+            1.0,
+            0.0,
+            0.0,
+        )
+        .unwrap();
+        let cone = Pdc::at_time(&f, 0.0).unwrap();
+        let c = 0.1;
+        for (offset, blocked) in [(0.085, true), (0.12, false)] {
+            // Beyond the rim corner (1, ·, 1) by `offset` both horizontally and vertically: the
+            // Euclidean distance is `√2·offset` > c, the square-rim distance `offset`.
+            let (a, b) = (
+                Vec3::new(1.0 + offset, -2.0, 1.0 + offset),
+                Vec3::new(1.0 + offset, 2.0, 1.0 + offset),
+            );
+            assert_eq!(!cone.segment_clear(&a, &b, c), blocked);
+            assert!(separated(&Hull(&[a, b]), &cone, c), "Euclidean margin");
+            let inflated = Inflated {
+                cone: &cone,
+                clearance: c,
+            };
+            assert_eq!(separated(&Hull(&[a, b]), &inflated, 0.0), !blocked);
+        }
+        // A sphere grows by a ball: the same as a Euclidean margin.
+        let f = Forecast::new(
+            ObstacleShape::Sphere,
+            Vec3::zeros(),
+            Vec3::zeros(),
+            0.0,
+            1.0,
+            0.0,
+            0.0,
+        )
+        .unwrap();
+        let ball = Pdc::at_time(&f, 0.0).unwrap();
+        let inflated = Inflated {
+            cone: &ball,
+            clearance: 0.1,
+        };
+        for gap in [0.09, 0.11] {
+            let seg = [
+                Vec3::new(-2.0, 1.0 + gap, 0.0),
+                Vec3::new(2.0, 1.0 + gap, 0.0),
+            ];
+            assert_eq!(separated(&Hull(&seg), &inflated, 0.0), gap > 0.1);
+            assert_eq!(ball.segment_clear(&seg[0], &seg[1], 0.1), gap > 0.1);
+        }
+    }
 }
