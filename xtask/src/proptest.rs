@@ -424,18 +424,18 @@ fn failure_detail(stdout: &str, test: &str) -> String {
     };
     let section = &stdout[start + header.len()..];
     let section = section.find("\n---- ").map_or(section, |e| &section[..e]);
+    if let Some(i) = section.find("minimal failing input") {
+        // The input may be pretty-printed over several lines, up to proptest's `\tsuccesses:`.
+        let input = &section[i..];
+        let input = input.find("\n\t").map_or(input, |e| &input[..e]);
+        return input.split_whitespace().collect::<Vec<_>>().join(" ");
+    }
     let line = section
         .lines()
-        .find(|l| l.contains("minimal failing input"))
-        .or_else(|| section.lines().find(|l| l.contains("panicked at")))
+        .find(|l| l.contains("panicked at"))
         .or_else(|| section.lines().find(|l| !l.trim().is_empty()))
         .unwrap_or("");
-    let line = line.trim();
-    if let Some(i) = line.find("minimal failing input") {
-        line[i..].to_string()
-    } else {
-        line.to_string()
-    }
+    line.trim().to_string()
 }
 
 /// The command that reruns one failing test under its seed.
@@ -504,12 +504,18 @@ mod tests {
                    ---- m::bad stdout ----\nproptest: Saving this and future failures in x\n\
                    thread 'm::bad' panicked at src/m.rs:10:5:\nTest failed: assertion failed: \
                    `(left == right)`; minimal failing input: x = 3, y = [0.5]\n\tsuccesses: 7\n\n\
+                   ---- m::multi stdout ----\nTest failed: x; minimal failing input: p = [\n    1.5,\n]\n\
+                   \tsuccesses: 2\n\n\
                    ---- m::other stdout ----\nthread 'm::other' panicked at src/m.rs:20:5:\nboom\n\n\
                    failures:\n    m::bad\n\ntest result: FAILED. 1 passed; 1 failed\n";
         assert_eq!(failed_tests(out), vec!["m::bad"]);
         assert_eq!(
             failure_detail(out, "m::bad"),
             "minimal failing input: x = 3, y = [0.5]"
+        );
+        assert_eq!(
+            failure_detail(out, "m::multi"),
+            "minimal failing input: p = [ 1.5, ]"
         );
         assert_eq!(
             failure_detail(out, "m::other"),
