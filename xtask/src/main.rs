@@ -16,6 +16,8 @@
 //! - `fuzz [--cases N] [--seed S] [--only API]`: adversarial inputs against every public entry
 //!   point of the library crates (`trust-fuzz`, release build); fails on any panic, hang,
 //!   non-finite output, wrong answer or call over 1 s.
+//! - `proptest [--seeds K] [--cases N]`: every property test under K random seeds
+//!   (`PROPTEST_RNG_SEED`), reporting each failing seed with its reproducing command.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -26,6 +28,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use serde_json::Value;
 
 mod fuzz;
+mod proptest;
 
 #[derive(Parser)]
 #[command(
@@ -76,6 +79,25 @@ enum Cmd {
         /// Only the APIs whose name contains this.
         #[arg(long)]
         only: Option<String>,
+    },
+    /// Run every property test (`proptest!`) of the workspace under K random seeds
+    /// (`PROPTEST_RNG_SEED`) with `PROPTEST_CASES=N`; lists the seeds that fail which tests.
+    Proptest {
+        /// Number of random seeds.
+        #[arg(long, default_value_t = 8)]
+        seeds: u32,
+        /// `PROPTEST_CASES` of every run (blocks that set their own case count keep it).
+        #[arg(long, default_value_t = 256)]
+        cases: u32,
+        /// Base of the seed sequence (default: from the clock; printed so a run can be repeated).
+        #[arg(long)]
+        base: Option<u64>,
+        /// Run exactly this one seed (e.g. CI's seed derived from the commit).
+        #[arg(long, conflicts_with_all = ["seeds", "base"])]
+        seed: Option<u64>,
+        /// Build and run the tests in the release profile instead of the test profile.
+        #[arg(long)]
+        release: bool,
     },
 }
 
@@ -152,6 +174,22 @@ fn main() -> Result<()> {
             trust_sim(&root, &full)
         }
         Cmd::Fuzz { cases, seed, only } => fuzz::run(&root, cases, seed, only.as_deref()),
+        Cmd::Proptest {
+            seeds,
+            cases,
+            base,
+            seed,
+            release,
+        } => proptest::run(
+            &root,
+            &proptest::Options {
+                seeds,
+                cases,
+                base,
+                seed,
+                release,
+            },
+        ),
     }
 }
 

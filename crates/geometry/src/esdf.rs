@@ -779,6 +779,10 @@ mod tests {
             let c = cbox.clamp(&p);
             let dc = esdf.signed_distance(&c);
             prop_assert!(d >= dc.min(0.0) && d.is_finite());
+            // The extension switches from `sqrt(o² + d_c²)` to `d_c + o` where `d_c` crosses 0: a
+            // kink like the box faces, where central differences straddle two branches
+            // (PROPTEST_RNG_SEED=3174492301114349736 drew a point 6e-7 from it).
+            prop_assume!(dc.abs() > 1e-3);
             let h = 1e-6;
             for i in 0..3 {
                 let mut a = p;

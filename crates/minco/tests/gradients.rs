@@ -341,7 +341,10 @@ proptest! {
             &mut || Box::new(FeasibilityTerm::new(limits, 1e-2)),
             kappa, 0.0, &flat, &durations,
         )?;
-        prop_assert!(value > 0.0, "the limits must be violated");
+        // Random pieces may stay within the limits at every quadrature node (one piece with
+        // kappa = 2 under PROPTEST_RNG_SEED=489215147674969543): the zero gradient was checked
+        // above, but such a case says nothing about the penalty's gradient, so it is discarded.
+        prop_assume!(value > 0.0, "the limits must be violated");
     }
 }
 

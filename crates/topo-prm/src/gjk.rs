@@ -8,7 +8,7 @@
 //! with degenerate input; the iteration only makes the bound tight quickly.
 
 use trust_core::Vec3;
-use trust_predict::Pdc;
+use trust_predict::{ObstacleShape, Pdc};
 
 /// Iteration cap of [`separated`]: GJK on a polytope of a few vertices and a smooth convex set
 /// converges in a handful of steps; undecided cases after this many are reported as not separated.
@@ -27,6 +27,47 @@ pub trait SupportMap {
 impl SupportMap for Pdc {
     fn support(&self, d: &Vec3) -> Vec3 {
         Pdc::support(self, d)
+    }
+}
+
+/// The region that [`Pdc::segment_clear`] with `clearance` (≥ 0) treats as blocking: the cone
+/// grown by `clearance` plus [`trust_predict::pdc::CLEAR_TOLERANCE`] — by a ball for a sphere cone,
+/// by a vertical cylinder of that radius and half-height for a cylinder cone (the square rim of the
+/// cylinder's segment test, not the rounded offset surface). A set proven [`separated`] from this
+/// region at margin 0 contains no segment that the cone's own test calls blocked, for both shapes;
+/// testing the bare cone at margin `clearance` instead would be exact Euclidean clearance, which
+/// clears segments that pass a cylinder's rim between `clearance` and `√2·clearance` away although
+/// [`Pdc::segment_clear`] (and therefore testing every chord) blocks them.
+#[derive(Debug, Clone, Copy)]
+pub struct Inflated<'a> {
+    /// The cone.
+    pub cone: &'a Pdc,
+    /// The clearance of the segment test (m; negative values count as 0).
+    pub clearance: f64,
+}
+
+impl SupportMap for Inflated<'_> {
+    fn support(&self, d: &Vec3) -> Vec3 {
+        let base = self.cone.support(d);
+        let grow = self.clearance.max(0.0) + trust_predict::CLEAR_TOLERANCE;
+        // Only the direction matters: rescale so that huge components cannot overflow the norm.
+        let m = d.amax();
+        if !(m.is_finite() && m > 0.0) {
+            return base;
+        }
+        let d = d / m;
+        if matches!(self.cone.forecast().shape, ObstacleShape::Cylinder { .. }) {
+            let n = (d.x * d.x + d.y * d.y).sqrt();
+            let (x, y) = if n > 0.0 {
+                (d.x / n * grow, d.y / n * grow)
+            } else {
+                (0.0, 0.0)
+            };
+            let z = if d.z >= 0.0 { grow } else { -grow };
+            base + Vec3::new(x, y, z)
+        } else {
+            base + d.normalize() * grow
+        }
     }
 }
 
@@ -472,5 +513,64 @@ mod tests {
             proximity(&Hull(&seg), &ball, 0.4, &Vec3::new(f64::NAN, 0.0, 0.0)),
             Proximity::Apart
         );
+    }
+
+    /// Issue 18: a segment passing a cylinder's rim diagonally, `c` to `√2·c` away, is blocked by
+    /// the cylinder's segment test (square rim) although it is more than `c` away in Euclidean
+    /// distance; only the inflated region gives the test's answer.
+    #[test]
+    fn inflated_cylinder_has_the_square_rim_of_the_segment_test() {
+        use trust_predict::{Forecast, ObstacleShape};
+        let f = Forecast::new(
+            ObstacleShape::Cylinder { half_height: 1.0 },
+            Vec3::zeros(),
+            Vec3::zeros(),
+            0.0,
+            1.0,
+            0.0,
+            0.0,
+        )
+        .unwrap();
+        let cone = Pdc::at_time(&f, 0.0).unwrap();
+        let c = 0.1;
+        for (offset, blocked) in [(0.085, true), (0.12, false)] {
+            // Beyond the rim corner (1, ·, 1) by `offset` both horizontally and vertically: the
+            // Euclidean distance is `√2·offset` > c, the square-rim distance `offset`.
+            let (a, b) = (
+                Vec3::new(1.0 + offset, -2.0, 1.0 + offset),
+                Vec3::new(1.0 + offset, 2.0, 1.0 + offset),
+            );
+            assert_eq!(!cone.segment_clear(&a, &b, c), blocked);
+            assert!(separated(&Hull(&[a, b]), &cone, c), "Euclidean margin");
+            let inflated = Inflated {
+                cone: &cone,
+                clearance: c,
+            };
+            assert_eq!(separated(&Hull(&[a, b]), &inflated, 0.0), !blocked);
+        }
+        // A sphere grows by a ball: the same as a Euclidean margin.
+        let f = Forecast::new(
+            ObstacleShape::Sphere,
+            Vec3::zeros(),
+            Vec3::zeros(),
+            0.0,
+            1.0,
+            0.0,
+            0.0,
+        )
+        .unwrap();
+        let ball = Pdc::at_time(&f, 0.0).unwrap();
+        let inflated = Inflated {
+            cone: &ball,
+            clearance: 0.1,
+        };
+        for gap in [0.09, 0.11] {
+            let seg = [
+                Vec3::new(-2.0, 1.0 + gap, 0.0),
+                Vec3::new(2.0, 1.0 + gap, 0.0),
+            ];
+            assert_eq!(separated(&Hull(&seg), &inflated, 0.0), gap > 0.1);
+            assert_eq!(ball.segment_clear(&seg[0], &seg[1], 0.1), gap > 0.1);
+        }
     }
 }

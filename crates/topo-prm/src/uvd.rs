@@ -18,8 +18,9 @@ use serde::{Deserialize, Serialize};
 
 use trust_core::{Aabb, Curve, HomotopyChecker, PlanError, Scene, Vec3, check_positive};
 
-use crate::gjk::{Hull, separated_along};
+use crate::gjk::{Hull, Inflated, separated_along};
 use crate::visibility::{Obstacles, forecast_cones};
+use trust_predict::CLEAR_TOLERANCE;
 
 /// Upper bound on the resampled point count (guards against a tiny resolution on a huge curve).
 /// The validating entry points ([`equivalent`], [`Uvd`]'s [`HomotopyChecker::equivalent`]) reject
@@ -254,8 +255,10 @@ pub fn equivalent_among(
 
 /// [`equivalent_among`] for polylines given by their vertices (same answer), by subdivision of the
 /// matched index range. The chords of a range lie in the convex hull of the two sub-polylines it
-/// covers, so a cone whose box misses that hull's box, or which [`crate::gjk::separated`] proves to be
-/// at least `threshold` away from the hull, blocks none of them and is dropped for the whole range.
+/// covers, so a cone whose box misses that hull's box, or whose blocking region
+/// ([`crate::gjk::Inflated`]: the cone grown by `threshold` as the chord test grows it, with a square
+/// rim for a cylinder) [`crate::gjk::separated`] proves to miss the hull, blocks none of them and is
+/// dropped for the whole range.
 /// The range is first cut at the vertices of both polylines, so that each piece's hull is the
 /// tetrahedron of its four end points (a triangle where the polylines share an end): for two paths of
 /// the same class that hull is usually clear, and the test costs a few GJK steps instead of a
@@ -536,10 +539,18 @@ fn range_clear(
         min: Vec3::zeros(),
         max: Vec3::zeros(),
     });
-    let bx = tight.inflated(c);
-    // Every chord of the range lies in the ball around the box centre through its corners: a cone at
-    // least `c` outside that ball cannot block any of them. Cones that pass that cheap test are
-    // tested against the convex hull of the two sub-polylines, which contains every chord.
+    // The chord test blocks a chord coming within `c + CLEAR_TOLERANCE` of a cone (for a cylinder
+    // in its square-rim distance, which is 1-Lipschitz, never more than the Euclidean distance and
+    // never less than the gap to the cone's box), so every filter below keeps a cone unless it is
+    // more than that away from every chord of the range.
+    let reach = c + CLEAR_TOLERANCE;
+    let bx = tight.inflated(reach);
+    // Every chord of the range lies in the ball around the box centre through its corners: a cone
+    // more than `reach` outside that ball cannot block any of them. Cones that pass that cheap test
+    // are tested against the convex hull of the two sub-polylines, which contains every chord: the
+    // hull must be separated from the region the chord test blocks ([`Inflated`]: the cone grown by
+    // `reach`, with a square rim for a cylinder), not merely `c` away from the cone in Euclidean
+    // distance — a chord passing a cylinder's rim at `c` to `√2·c` is blocked (issue 18).
     let center = tight.center();
     let ball = 0.5 * tight.extent().norm();
     let cones = obstacles.cones();
@@ -551,11 +562,14 @@ fn range_clear(
     local.clear();
     local.extend(parent.iter().copied().filter(|&i| {
         cones[i].aabb().intersects(&bx)
-            && cones[i].signed_distance(&center) < ball + c
+            && cones[i].signed_distance(&center) <= ball + reach
             && !separated_along(
                 &Hull(&hull),
-                &cones[i],
-                c,
+                &Inflated {
+                    cone: &cones[i],
+                    clearance: c,
+                },
+                0.0,
                 &(center - cones[i].aabb().center()),
             )
     }));
@@ -596,7 +610,9 @@ fn gather_near(
     threshold: f64,
     scratch: &mut UvdScratch,
 ) -> bool {
-    let region = region.inflated(threshold.max(0.0));
+    // The chord test blocks within `threshold + CLEAR_TOLERANCE` of a cone (never less than the gap
+    // to its box).
+    let region = region.inflated(threshold.max(0.0) + CLEAR_TOLERANCE);
     scratch.near.clear();
     scratch.near.extend(
         obstacles
@@ -647,7 +663,7 @@ fn block_clear(
     let (Some(ba), Some(bb)) = (Aabb::from_points(pa), Aabb::from_points(pb)) else {
         return true;
     };
-    let block = ba.union(&bb).inflated(c);
+    let block = ba.union(&bb).inflated(c + CLEAR_TOLERANCE);
     let cones = obstacles.cones();
     scratch.local.clear();
     scratch.local.extend(
@@ -930,7 +946,7 @@ mod tests {
                 (v3(-3.0, 3.0), v3(-1.5, 1.5), 0.2..1.2f64, 0.0..0.6f64, proptest::bool::ANY),
                 1..4,
             ),
-            threshold in proptest::sample::select(vec![0.0, 0.1]),
+            threshold in proptest::sample::select(vec![0.0, 0.1, 0.3]),
         ) {
             let map = pillar_map();
             let map = StaticMap::new(*map.bounds()).unwrap();
@@ -959,6 +975,51 @@ mod tests {
             let slow = chords_visible(&ra, &rb, |p, q| obs.segment_clear(p, q, threshold));
             proptest::prop_assert_eq!(fast, slow);
         }
+    }
+
+    /// Issue 18: the shrunk counterexample of `accelerated_uvd_agrees_with_testing_every_chord`
+    /// (a cylinder cone moving vertically; the accelerated test said "equivalent" where a chord is
+    /// blocked).
+    #[test]
+    fn accelerated_uvd_regression_vertical_cylinder_cone() {
+        let map = StaticMap::new(*pillar_map().bounds()).unwrap();
+        let (start, goal) = (Vec3::new(-6.0, 0.0, 0.0), Vec3::new(6.0, 0.0, 0.0));
+        let a = vec![start, Vec3::zeros(), goal];
+        let b = vec![
+            start,
+            Vec3::new(3.788733526087845, 0.0, 2.1959919954404175),
+            goal,
+        ];
+        let forecast = Forecast::new(
+            ObstacleShape::Cylinder { half_height: 1.0 },
+            Vec3::new(0.07457004516634778, 0.3452869392712231, 2.622563865225167),
+            Vec3::new(0.0, 0.0, 0.6137439797585048),
+            0.0,
+            0.7167979029051007,
+            0.0,
+            0.0,
+        )
+        .unwrap();
+        let obs = Obstacles::with_forecast_cones(&map, &[forecast], 0.0, 1.0).unwrap();
+        let threshold = 0.1;
+        let n = point_count(polyline_length(&a), polyline_length(&b), 0.1);
+        let (mut ra, mut rb) = (Vec::new(), Vec::new());
+        resample_polyline(&a, n, &mut ra);
+        resample_polyline(&b, n, &mut rb);
+        let slow = chords_visible(&ra, &rb, |p, q| obs.segment_clear(p, q, threshold));
+        assert!(!slow, "a matched chord is blocked by the cone");
+        let fast =
+            polylines_equivalent_among(&obs, &a, &b, 0.1, threshold, &mut UvdScratch::default());
+        assert_eq!(fast, slow);
+        let mid = equivalent_among(
+            &obs,
+            &Polyline(&a),
+            &Polyline(&b),
+            0.1,
+            threshold,
+            &mut UvdScratch::default(),
+        );
+        assert_eq!(mid, slow);
     }
 
     #[test]
