@@ -128,7 +128,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
         ("trust-world", with(&["trust-vehicle"])),
         (
             "trust-flight",
-            with(&["trust-vehicle", "trust-world", "trust-runlog"]),
+            with(&["trust-vehicle", "trust-world", "trust-runlog", "trust-plot"]),
         ),
         (
             "trust-experiments",

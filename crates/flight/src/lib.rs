@@ -28,6 +28,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use trust_core::{PolyTraj, Scene, Vec3};
 use trust_manager::{Event, Hit, StepReport};
+use trust_plot::quantile_sorted;
 
 use trust_world::World;
 use trust_world::planner::{self, ResolvedPlanner};
@@ -124,15 +125,6 @@ pub struct Flight {
 
 fn v3(v: &Vec3) -> [f64; 3] {
     [v.x, v.y, v.z]
-}
-
-fn quantile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return 0.0;
-    }
-    let pos = q * (sorted.len() - 1) as f64;
-    let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
-    sorted[lo] + (sorted[hi] - sorted[lo]) * (pos - lo as f64)
 }
 
 /// The run-log header for a flight of `planner_label` through `world`; `points_file` is the
@@ -470,8 +462,8 @@ pub fn fly(
         planner: planner.label.clone(),
         seed: scenario.seed,
         cycle_count: record.cycles.len(),
-        cycle_ms_median: quantile(&walls, 0.5),
-        cycle_ms_p99: quantile(&walls, 0.99),
+        cycle_ms_median: quantile_sorted(&walls, 0.5).unwrap_or(0.0),
+        cycle_ms_p99: quantile_sorted(&walls, 0.99).unwrap_or(0.0),
         solve_ms_per_trajectory: solve_ms / trajectories.max(1) as f64,
         cpu_ms_per_trajectory: cpu_ms / trajectories.max(1) as f64,
         trajectory_count: trajectories,
