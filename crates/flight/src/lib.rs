@@ -31,9 +31,10 @@ use trust_manager::{Event, Hit, StepReport};
 use trust_plot::quantile_sorted;
 
 use trust_world::World;
-use trust_world::planner::{self, ResolvedPlanner};
+use trust_world::planner::{self, AnyManager, ResolvedPlanner};
 use trust_world::scenario::{Latency, ShapeSpec, VehicleModel};
-use trust_world::traffic::MovingShape;
+use trust_world::sensing::Sensing;
+use trust_world::traffic::{MovingShape, Traffic};
 
 mod error;
 pub use error::FlightError;
@@ -247,6 +248,34 @@ fn finite_or_stand_in(x: f64) -> f64 {
     }
 }
 
+/// The parts of a flight at `t = 0`, before the first planning cycle: the traffic, the sensing
+/// (already updated with the traffic's positions at `t = 0`) and the planner built for `world`.
+/// [`fly`] starts from it, and so does E3's single cold cycle.
+pub struct Setup {
+    /// The moving obstacles at `t = 0`.
+    pub traffic: Traffic,
+    /// The sensing, updated at `t = 0`.
+    pub sensing: Sensing,
+    /// The planner, built for `world`.
+    pub manager: AnyManager,
+}
+
+/// Sets up a flight of `planner` through `world` (see [`Setup`]).
+///
+/// # Errors
+/// [`FlightError`] for traffic, sensing or a planner that cannot be set up for `world`.
+pub fn set_up(world: &World, planner: &ResolvedPlanner) -> Result<Setup, FlightError> {
+    let traffic = world.traffic()?;
+    let mut sensing = world.sensing()?;
+    let manager = planner::build(planner, &world.planner_context())?;
+    sensing.update(0.0, traffic.positions())?;
+    Ok(Setup {
+        traffic,
+        sensing,
+        manager,
+    })
+}
+
 /// Flies `planner` through `world` once (see the module docs).
 ///
 /// # Errors
@@ -271,9 +300,11 @@ pub fn fly(
     let (start, goal) = (world.start(), world.goal());
     let tolerance = scenario.mission.goal_tolerance_m;
 
-    let mut traffic = world.traffic()?;
-    let mut sensing = world.sensing()?;
-    let mut manager = planner::build(planner, &world.planner_context())?;
+    let Setup {
+        mut traffic,
+        mut sensing,
+        mut manager,
+    } = set_up(world, planner)?;
     let hover = Reference::hover(start);
     let mut vehicle: Box<dyn Vehicle> = match scenario.vehicle.model {
         VehicleModel::Quadrotor => Box::new(ControlledQuadrotor::starting_on(
@@ -329,7 +360,6 @@ pub fn fly(
     };
 
     // t = 0.
-    sensing.update(0.0, traffic.positions())?;
     {
         let (sc, dc, _) = clearances(&vehicle.state().p, &traffic);
         log.state(0.0, vehicle.as_ref(), traffic.positions(), sc, dc)?;
