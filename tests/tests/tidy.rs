@@ -125,7 +125,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
         ("trust-plot", &[][..]),
         ("trust-runlog", &[][..]),
         ("trust-vehicle", &["trust-core"][..]),
-        ("trust-world", with(&["trust-vehicle"])),
+        ("trust-world", with(&["trust-vehicle", "trust-runlog"])),
         (
             "trust-flight",
             with(&["trust-vehicle", "trust-world", "trust-runlog", "trust-plot"]),

@@ -32,7 +32,7 @@ use trust_plot::quantile_sorted;
 
 use trust_world::World;
 use trust_world::planner::{self, AnyManager, ResolvedPlanner};
-use trust_world::scenario::{Latency, ShapeSpec, VehicleModel};
+use trust_world::scenario::{Latency, VehicleModel};
 use trust_world::sensing::Sensing;
 use trust_world::traffic::{MovingShape, Traffic};
 
@@ -40,7 +40,7 @@ mod error;
 pub use error::FlightError;
 use trust_runlog::{
     Bounds, CycleRecord, Dropped, Header, LimitsInfo, LogWriter, ObstacleInfo, ObstacleKind,
-    Outcome, Record, SCHEMA, StateRecord, StaticShape, Status, VehicleInfo,
+    Outcome, Record, SCHEMA, StateRecord, Status, VehicleInfo,
 };
 use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle};
 
@@ -159,25 +159,7 @@ pub fn header(world: &World, planner_label: &str, points_file: Option<String>) -
         start: v3(&world.start()),
         goal: v3(&world.goal()),
         goal_tolerance: s.mission.goal_tolerance_m,
-        static_shapes: world
-            .static_shape_specs()
-            .iter()
-            .map(|spec| match *spec {
-                ShapeSpec::Sphere { center, radius } => StaticShape::Sphere { center, radius },
-                ShapeSpec::Cylinder {
-                    center,
-                    radius,
-                    z_min,
-                    z_max,
-                } => StaticShape::Cylinder {
-                    center,
-                    radius,
-                    z_min,
-                    z_max,
-                },
-                ShapeSpec::Box { min, max } => StaticShape::Box { min, max },
-            })
-            .collect(),
+        static_shapes: world.static_shape_specs(),
         static_points_file: points_file,
         obstacles: world
             .obstacles()

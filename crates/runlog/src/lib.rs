@@ -52,7 +52,8 @@ pub struct LimitsInfo {
 }
 
 /// A true static obstacle, externally tagged as in the contract:
-/// `{"sphere": {...}}`, `{"cylinder": {...}}`, `{"box": {...}}`.
+/// `{"sphere": {...}}`, `{"cylinder": {...}}`, `{"box": {...}}`. Also the scenario file's
+/// `[[static.shapes]]` entry (`trust-world` reads it tagged by `kind` through a serde adapter).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StaticShape {

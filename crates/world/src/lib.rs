@@ -106,7 +106,7 @@ pub use seeds::{Seeds, mix_seed};
 
 pub use crate::error::WorldError;
 use crate::planner::PlannerContext;
-use crate::scenario::{PointCloudSpec, Scenario, ShapeSpec};
+use crate::scenario::{PointCloudSpec, Scenario, StaticShape};
 use crate::sensing::Sensing;
 use crate::traffic::{MovingObstacle, Traffic};
 
@@ -314,8 +314,11 @@ impl World {
 
     /// The true static shapes in the scenario's and the run-log contract's form (vertical
     /// cylinders as `center = [x, y]`, `z_min`, `z_max`).
-    pub fn static_shape_specs(&self) -> Vec<ShapeSpec> {
-        self.shapes.iter().map(ShapeSpec::from_shape).collect()
+    pub fn static_shape_specs(&self) -> Vec<StaticShape> {
+        self.shapes
+            .iter()
+            .map(scenario::sections::static_shape)
+            .collect()
     }
 
     /// The true static points of an inline or file cloud (tree order, not file order).
