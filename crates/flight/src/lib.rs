@@ -20,6 +20,17 @@
 //! (so a collision or arrival between two log ticks is in the log), a `cycle` record per planning
 //! cycle, and the `outcome`, whose figures are computed from the logged states exactly as the
 //! contract defines them.
+//!
+//! # Changelog
+//!
+//! - Moved out of `trust-sim` (issue 17): `trust_sim::run::{fly, header, RunOptions, RunSummary,
+//!   Flight, FlightRecord}` are at this crate's root.
+//! - `trust_sim::error::SimError` is split by stage; this crate's errors are [`FlightError`]s
+//!   (wrapping `trust_world::WorldError` for setup, vehicle, planner and run-log errors).
+//! - Added [`set_up`] / [`Setup`]: the traffic, sensing and planner at `t = 0`, shared by [`fly`]
+//!   and E3.
+//! - [`RunSummary::cycle_ms_median`] and `cycle_ms_p99` use `trust_plot::quantile_sorted` (the same
+//!   type-7 quantile as before; still 0 without cycles).
 #![warn(missing_docs)]
 
 use std::path::{Path, PathBuf};
