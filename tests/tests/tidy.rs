@@ -61,11 +61,13 @@ fn members() -> Vec<Member> {
 /// The allowed internal dependencies of each crate (design.md §2, ARCHITECTURE.md "Dependency
 /// order"): the planning libraries
 /// `geometry ← predict ← core ← {lbfgs, minco, topo-prm} ← manager`, then the simulator along its
-/// data path `{plot, vehicle} ; world ← flight (+ runlog) ← experiments ← sim (the binary)`.
-/// `lbfgs` depends on nothing of ours; `minco` and `topo-prm` never depend on each other; `plot`
-/// knows no simulator or planner type; `runlog` knows none of the simulator's types either (a log is
-/// read without building a world); `vehicle` knows nothing of the planner; `route`
-/// (the global route, issue 19) sits beside `minco`/`topo-prm` on `geometry` (and may use `core`).
+/// data path `{plot, vehicle, runlog} ; world (+ runlog) ← flight (+ plot) ← experiments ← sim (the
+/// binary)`. `lbfgs` depends on nothing of ours; `minco` and `topo-prm` never depend on each other;
+/// `plot` knows no simulator or planner type (the flight summary uses its `quantile_sorted`);
+/// `runlog` knows none of the simulator's types either (a log is read without building a world;
+/// the scenario's static shapes are its `StaticShape`); `vehicle` knows nothing of the planner;
+/// `route` (the global route, issue 19) sits beside `minco`/`topo-prm` on `geometry` (and may use
+/// `core`).
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
     const PLANNING: &[&str] = &[
         "trust-geometry",
@@ -125,10 +127,10 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
         ("trust-plot", &[][..]),
         ("trust-runlog", &[][..]),
         ("trust-vehicle", &["trust-core"][..]),
-        ("trust-world", with(&["trust-vehicle"])),
+        ("trust-world", with(&["trust-vehicle", "trust-runlog"])),
         (
             "trust-flight",
-            with(&["trust-vehicle", "trust-world", "trust-runlog"]),
+            with(&["trust-vehicle", "trust-world", "trust-runlog", "trust-plot"]),
         ),
         (
             "trust-experiments",

@@ -18,7 +18,6 @@ use crate::ExperimentError;
 use crate::study::{create_dir, write_json, write_text};
 use trust_plot::{Color, Figure, ForecastRings, Marker, Plane, Polyline};
 use trust_world::World;
-use trust_world::planner;
 use trust_world::scenario::Scenario;
 
 /// The paper's Table Sim-B-1: `(H_t s, H_s, I_e, J, CPU ms)` of τ0…τ4.
@@ -99,10 +98,11 @@ pub struct E3Summary {
 pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, ExperimentError> {
     let world = World::build(scenario)?;
     let resolved = scenario.resolve_planner();
-    let mut manager = planner::build(&resolved, &world.planner_context())?;
-    let traffic = world.traffic()?;
-    let mut sensing = world.sensing()?;
-    sensing.update(0.0, traffic.positions())?;
+    let trust_flight::Setup {
+        sensing,
+        mut manager,
+        ..
+    } = trust_flight::set_up(&world, &resolved)?;
     let forecasts = sensing.forecasts(0.0)?;
     let scene = Scene::new(world.planner_map(), &forecasts, 0.0)?;
     let start = State::at_rest(0.0, world.start());

@@ -6,6 +6,18 @@
 //! their `runs.csv`, and writes `summary.json` and `report.md`; [`e3`] reproduces Table Sim-B-1
 //! (the branches of one planning cycle); [`flight_plots`] draws the figures of one flight from its
 //! run log. Errors are [`ExperimentError`]s naming the file, field and value.
+//!
+//! # Changelog
+//!
+//! - Moved out of `trust-sim` (issue 17): `trust_sim::{study, e3, flight_plots}` are
+//!   `trust_experiments::{study, e3, flight_plots}`.
+//! - `trust_sim::error::SimError` is split by stage; this crate's errors are [`ExperimentError`]s
+//!   (wrapping `trust_world::WorldError`, `trust_flight::FlightError`, plotting and run-log errors).
+//! - `study::RunRow::TIMING_COLUMNS` is removed: [`study::RunRow::timing_columns`] is a slice of
+//!   [`study::RunRow::COLUMNS`], so the list is written once.
+//! - [`study::stats::median`] is the 0.5-quantile of `trust_plot::quantile_sorted`: for an even
+//!   count `a + 0.5 (b − a)` instead of `0.5 (a + b)` (the same value up to the last bits; it only
+//!   summarizes timings).
 #![warn(missing_docs)]
 
 pub mod e3;

@@ -20,6 +20,17 @@
 //! (so a collision or arrival between two log ticks is in the log), a `cycle` record per planning
 //! cycle, and the `outcome`, whose figures are computed from the logged states exactly as the
 //! contract defines them.
+//!
+//! # Changelog
+//!
+//! - Moved out of `trust-sim` (issue 17): `trust_sim::run::{fly, header, RunOptions, RunSummary,
+//!   Flight, FlightRecord}` are at this crate's root.
+//! - `trust_sim::error::SimError` is split by stage; this crate's errors are [`FlightError`]s
+//!   (wrapping `trust_world::WorldError` for setup, vehicle, planner and run-log errors).
+//! - Added [`set_up`] / [`Setup`]: the traffic, sensing and planner at `t = 0`, shared by [`fly`]
+//!   and E3.
+//! - [`RunSummary::cycle_ms_median`] and `cycle_ms_p99` use `trust_plot::quantile_sorted` (the same
+//!   type-7 quantile as before; still 0 without cycles).
 #![warn(missing_docs)]
 
 use std::path::{Path, PathBuf};
@@ -28,17 +39,19 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use trust_core::{PolyTraj, Scene, Vec3};
 use trust_manager::{Event, Hit, StepReport};
+use trust_plot::quantile_sorted;
 
 use trust_world::World;
-use trust_world::planner::{self, ResolvedPlanner};
-use trust_world::scenario::{Latency, ShapeSpec, VehicleModel};
-use trust_world::traffic::MovingShape;
+use trust_world::planner::{self, AnyManager, ResolvedPlanner};
+use trust_world::scenario::{Latency, VehicleModel};
+use trust_world::sensing::Sensing;
+use trust_world::traffic::{MovingShape, Traffic};
 
 mod error;
 pub use error::FlightError;
 use trust_runlog::{
     Bounds, CycleRecord, Dropped, Header, LimitsInfo, LogWriter, ObstacleInfo, ObstacleKind,
-    Outcome, Record, SCHEMA, StateRecord, StaticShape, Status, VehicleInfo,
+    Outcome, Record, SCHEMA, StateRecord, Status, VehicleInfo,
 };
 use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle};
 
@@ -126,15 +139,6 @@ fn v3(v: &Vec3) -> [f64; 3] {
     [v.x, v.y, v.z]
 }
 
-fn quantile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return 0.0;
-    }
-    let pos = q * (sorted.len() - 1) as f64;
-    let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
-    sorted[lo] + (sorted[hi] - sorted[lo]) * (pos - lo as f64)
-}
-
 /// The run-log header for a flight of `planner_label` through `world`; `points_file` is the
 /// header's `static_points_file` (relative to the log's folder).
 pub fn header(world: &World, planner_label: &str, points_file: Option<String>) -> Header {
@@ -166,25 +170,7 @@ pub fn header(world: &World, planner_label: &str, points_file: Option<String>) -
         start: v3(&world.start()),
         goal: v3(&world.goal()),
         goal_tolerance: s.mission.goal_tolerance_m,
-        static_shapes: world
-            .static_shape_specs()
-            .iter()
-            .map(|spec| match *spec {
-                ShapeSpec::Sphere { center, radius } => StaticShape::Sphere { center, radius },
-                ShapeSpec::Cylinder {
-                    center,
-                    radius,
-                    z_min,
-                    z_max,
-                } => StaticShape::Cylinder {
-                    center,
-                    radius,
-                    z_min,
-                    z_max,
-                },
-                ShapeSpec::Box { min, max } => StaticShape::Box { min, max },
-            })
-            .collect(),
+        static_shapes: world.static_shape_specs(),
         static_points_file: points_file,
         obstacles: world
             .obstacles()
@@ -255,6 +241,34 @@ fn finite_or_stand_in(x: f64) -> f64 {
     }
 }
 
+/// The parts of a flight at `t = 0`, before the first planning cycle: the traffic, the sensing
+/// (already updated with the traffic's positions at `t = 0`) and the planner built for `world`.
+/// [`fly`] starts from it, and so does E3's single cold cycle.
+pub struct Setup {
+    /// The moving obstacles at `t = 0`.
+    pub traffic: Traffic,
+    /// The sensing, updated at `t = 0`.
+    pub sensing: Sensing,
+    /// The planner, built for `world`.
+    pub manager: AnyManager,
+}
+
+/// Sets up a flight of `planner` through `world` (see [`Setup`]).
+///
+/// # Errors
+/// [`FlightError`] for traffic, sensing or a planner that cannot be set up for `world`.
+pub fn set_up(world: &World, planner: &ResolvedPlanner) -> Result<Setup, FlightError> {
+    let traffic = world.traffic()?;
+    let mut sensing = world.sensing()?;
+    let manager = planner::build(planner, &world.planner_context())?;
+    sensing.update(0.0, traffic.positions())?;
+    Ok(Setup {
+        traffic,
+        sensing,
+        manager,
+    })
+}
+
 /// Flies `planner` through `world` once (see the module docs).
 ///
 /// # Errors
@@ -279,9 +293,11 @@ pub fn fly(
     let (start, goal) = (world.start(), world.goal());
     let tolerance = scenario.mission.goal_tolerance_m;
 
-    let mut traffic = world.traffic()?;
-    let mut sensing = world.sensing()?;
-    let mut manager = planner::build(planner, &world.planner_context())?;
+    let Setup {
+        mut traffic,
+        mut sensing,
+        mut manager,
+    } = set_up(world, planner)?;
     let hover = Reference::hover(start);
     let mut vehicle: Box<dyn Vehicle> = match scenario.vehicle.model {
         VehicleModel::Quadrotor => Box::new(ControlledQuadrotor::starting_on(
@@ -337,7 +353,6 @@ pub fn fly(
     };
 
     // t = 0.
-    sensing.update(0.0, traffic.positions())?;
     {
         let (sc, dc, _) = clearances(&vehicle.state().p, &traffic);
         log.state(0.0, vehicle.as_ref(), traffic.positions(), sc, dc)?;
@@ -470,8 +485,8 @@ pub fn fly(
         planner: planner.label.clone(),
         seed: scenario.seed,
         cycle_count: record.cycles.len(),
-        cycle_ms_median: quantile(&walls, 0.5),
-        cycle_ms_p99: quantile(&walls, 0.99),
+        cycle_ms_median: quantile_sorted(&walls, 0.5).unwrap_or(0.0),
+        cycle_ms_p99: quantile_sorted(&walls, 0.99).unwrap_or(0.0),
         solve_ms_per_trajectory: solve_ms / trajectories.max(1) as f64,
         cpu_ms_per_trajectory: cpu_ms / trajectories.max(1) as f64,
         trajectory_count: trajectories,

@@ -76,9 +76,9 @@ impl BoxStats {
         }
         x.sort_by(f64::total_cmp);
         let (q1, median, q3) = (
-            quantile_sorted(&x, 0.25),
-            quantile_sorted(&x, 0.5),
-            quantile_sorted(&x, 0.75),
+            quantile_sorted(&x, 0.25)?,
+            quantile_sorted(&x, 0.5)?,
+            quantile_sorted(&x, 0.75)?,
         );
         let (min, max) = (x[0], x[x.len() - 1]);
         let (whisker_low, whisker_high, outliers) = match whiskers {
@@ -116,17 +116,21 @@ impl BoxStats {
     }
 }
 
-/// The `q`-quantile (`q` clamped to `[0, 1]`) of ascending, finite, non-empty `sorted`, by linear
-/// interpolation between order statistics (Hyndman–Fan type 7). Returns NaN for an empty slice.
-pub fn quantile_sorted(sorted: &[f64], q: f64) -> f64 {
+/// The `q`-quantile (`q` clamped to `[0, 1]`) of ascending, finite `sorted`, by linear
+/// interpolation between order statistics (Hyndman–Fan type 7, R's default): with
+/// `h = q (n − 1)`, `x[⌊h⌋] + (h − ⌊h⌋) (x[⌊h⌋ + 1] − x[⌊h⌋])`. `None` for an empty slice.
+///
+/// The one quantile of the workspace: box plots, the flight summary's cycle-time median and p99, and
+/// the study medians all use it.
+pub fn quantile_sorted(sorted: &[f64], q: f64) -> Option<f64> {
     let n = sorted.len();
     if n == 0 {
-        return f64::NAN;
+        return None;
     }
     let h = q.clamp(0.0, 1.0) * (n - 1) as f64;
     let lo = h.floor() as usize;
     let hi = (lo + 1).min(n - 1);
-    sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
+    Some(sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo]))
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -456,10 +460,13 @@ mod tests {
     #[test]
     fn quantiles_interpolate_like_r_type_7() {
         let x = [1.0, 2.0, 3.0, 4.0];
-        assert!((quantile_sorted(&x, 0.25) - 1.75).abs() < 1e-12);
-        assert!((quantile_sorted(&x, 0.5) - 2.5).abs() < 1e-12);
-        assert!((quantile_sorted(&x, 1.0) - 4.0).abs() < 1e-12);
-        assert!(quantile_sorted(&[], 0.5).is_nan());
+        let q = |p: f64| quantile_sorted(&x, p).expect("non-empty");
+        assert!((q(0.25) - 1.75).abs() < 1e-12);
+        assert!((q(0.5) - 2.5).abs() < 1e-12);
+        assert!((q(1.0) - 4.0).abs() < 1e-12);
+        // An even count's median is the midpoint, an odd count's the middle value.
+        assert!((quantile_sorted(&[1.0, 2.0, 3.0], 0.5).expect("non-empty") - 2.0).abs() < 1e-12);
+        assert_eq!(quantile_sorted(&[], 0.5), None);
     }
 
     #[test]

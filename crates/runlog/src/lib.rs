@@ -9,6 +9,14 @@
 //! [`LogWriter`] writes a log line by line (buffered); [`RunLog::read`] reads one back and checks its
 //! structure. Numbers are written in the shortest form that reads back to the same `f64`, and the
 //! writer refuses non-finite numbers (a non-finite value is a bug, not data).
+//!
+//! # Changelog
+//!
+//! - Moved out of `trust-sim` (issue 17): `trust_sim::runlog` is this crate's root and
+//!   `trust_sim::audit` is [`audit`]; the run-log errors are [`LogError`]s, no longer wrapped in
+//!   `SimError`.
+//! - [`StaticShape`] is also the scenario file's static shape (`trust_world::scenario::StaticShape`,
+//!   which replaced `ShapeSpec`); its serialized form in the log is unchanged.
 #![warn(missing_docs)]
 
 pub mod audit;
@@ -52,7 +60,8 @@ pub struct LimitsInfo {
 }
 
 /// A true static obstacle, externally tagged as in the contract:
-/// `{"sphere": {...}}`, `{"cylinder": {...}}`, `{"box": {...}}`.
+/// `{"sphere": {...}}`, `{"cylinder": {...}}`, `{"box": {...}}`. Also the scenario file's
+/// `[[static.shapes]]` entry (`trust-world` reads it tagged by `kind` through a serde adapter).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StaticShape {

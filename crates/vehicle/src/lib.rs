@@ -63,6 +63,11 @@
 //! assert!(error < 0.05);
 //! # Ok::<(), trust_vehicle::VehicleError>(())
 //! ```
+//!
+//! # Changelog
+//!
+//! - Moved out of `trust-sim` (issue 17): `trust_sim::vehicle` is this crate's root, with the same
+//!   items; its errors stay [`VehicleError`]s.
 #![warn(missing_docs)]
 
 mod controlled;

@@ -62,7 +62,12 @@ pub(crate) fn generate(s: &Scenario, bounds: &Aabb, seed: u64) -> Result<Layout,
     };
     let mut layout = Layout::default();
     let mut problems = Problems::default();
-    let explicit: Vec<Shape> = s.static_map.shapes.iter().map(|x| x.shape()).collect();
+    let explicit: Vec<Shape> = s
+        .static_map
+        .shapes
+        .iter()
+        .map(crate::scenario::sections::geometry_shape)
+        .collect();
     if let Some(g) = &s.world.generator {
         run_generator(
             g,

@@ -78,6 +78,31 @@
 //! transforms of `trust_geometry::Esdf`), 5.0–5.2 s in all; peak resident memory 870–890 MB
 //! (occupancy, the outside and inside transforms and the points, at once). Build it once per
 //! trial and share it.
+//!
+//! # Changelog
+//!
+//! Issue 17 split `trust-sim` along the data path; this crate holds its first stage.
+//!
+//! - Moves: `trust_sim::{scenario, planner, sensing, traffic}` are `trust_world::{scenario,
+//!   planner, sensing, traffic}`; `trust_sim::world::{World, Seeds, mix_seed, PointTree,
+//!   sample_shapes, esdf_error_bound}` are at this crate's root; `trust_sim::scenario::Problem`
+//!   lives in [`problem`] (still re-exported by [`scenario`]).
+//! - `trust_sim::error::SimError` is split by stage: [`WorldError`] here (reading, parsing,
+//!   validating, building; its plotting, run-log and file-writing variants are gone),
+//!   `trust_flight::FlightError` for the loop, `trust_experiments::ExperimentError` for studies and
+//!   E3.
+//! - [`planner::PlannerSpec::resolve`] and [`scenario::Scenario::resolve_planner`] are infallible:
+//!   they return a `ResolvedPlanner`, not a `Result` (presets and overrides merge on Rust types;
+//!   invalid values are reported by validation and by [`planner::build`]).
+//! - [`scenario::Scenario::validate`] and [`scenario::Scenario::load`] check what the file alone
+//!   shows, without the layout checks (start and goal against the generated layout); those run
+//!   once, where the layout is generated: [`World::build`], [`check`] and [`load_checked`]
+//!   (`trust-sim validate`).
+//! - `World::planner_map_arc` is removed (unused; [`World::planner_map`] gives the map).
+//! - `scenario::ShapeSpec` is replaced by the run log's `trust_runlog::StaticShape`, re-exported as
+//!   [`scenario::StaticShape`] (the TOML form, tagged by `kind`, is unchanged);
+//!   [`World::static_shape_specs`] returns it. `ShapeSpec::{shape, from_shape, is_valid}` are gone:
+//!   validation names the bad field of a shape ([`scenario::Scenario::validate`]).
 
 #![warn(missing_docs)]
 
@@ -106,7 +131,7 @@ pub use seeds::{Seeds, mix_seed};
 
 pub use crate::error::WorldError;
 use crate::planner::PlannerContext;
-use crate::scenario::{PointCloudSpec, Scenario, ShapeSpec};
+use crate::scenario::{PointCloudSpec, Scenario, StaticShape};
 use crate::sensing::Sensing;
 use crate::traffic::{MovingObstacle, Traffic};
 
@@ -314,8 +339,11 @@ impl World {
 
     /// The true static shapes in the scenario's and the run-log contract's form (vertical
     /// cylinders as `center = [x, y]`, `z_min`, `z_max`).
-    pub fn static_shape_specs(&self) -> Vec<ShapeSpec> {
-        self.shapes.iter().map(ShapeSpec::from_shape).collect()
+    pub fn static_shape_specs(&self) -> Vec<StaticShape> {
+        self.shapes
+            .iter()
+            .map(scenario::sections::static_shape)
+            .collect()
     }
 
     /// The true static points of an inline or file cloud (tree order, not file order).

@@ -13,7 +13,7 @@ use trust_world::planner::{
     self, AnyBackend, AnyChecker, AnyFrontend, FrontendSpec, PlannerContext, PlannerPreset,
     REPRODUCIBLE_BUDGET_MS,
 };
-use trust_world::scenario::{PointCloudSpec, Scenario};
+use trust_world::scenario::{PointCloudSpec, Scenario, StaticShape};
 
 fn scenarios_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios")
@@ -156,6 +156,34 @@ fn validation_reports_every_problem_not_just_the_first() {
         }
         other => panic!("expected WorldError::Invalid, got {other:?}"),
     }
+}
+
+/// `[[static.shapes]]` holds the run log's `StaticShape`, written tagged by `kind` in the scenario
+/// (the log's external tagging is checked in `trust-runlog`).
+#[test]
+fn static_shapes_are_the_run_log_type_tagged_by_kind_in_the_scenario() {
+    let text = "name = \"shapes\"\n[world]\nbounds = { min = [0, 0, 0], max = [20, 20, 10] }\n\
+                [mission]\nstart = [1, 10, 5]\ngoal = [19, 10, 5]\n\
+                [[static.shapes]]\nkind = \"sphere\"\ncenter = [5, 5, 5]\nradius = 1\n\
+                [[static.shapes]]\nkind = \"cylinder\"\ncenter = [8, 4]\nradius = 0.5\nz_min = 0\nz_max = 6\n\
+                [[static.shapes]]\nkind = \"box\"\nmin = [10, 1, 0]\nmax = [11, 3, 4]\n";
+    let s = Scenario::from_toml_str(text, Path::new("shapes.toml")).unwrap();
+    let shapes = &s.static_map.shapes;
+    assert_eq!(shapes.len(), 3);
+    assert!(matches!(shapes[0], StaticShape::Sphere { radius, .. } if radius == 1.0));
+    let cylinder = StaticShape::Cylinder {
+        center: [8.0, 4.0],
+        radius: 0.5,
+        z_min: 0.0,
+        z_max: 6.0,
+    };
+    assert_eq!(shapes[1], cylinder);
+    assert!(matches!(shapes[2], StaticShape::Box { max, .. } if max == [11.0, 3.0, 4.0]));
+    let written = s.to_toml_string().unwrap();
+    assert!(written.contains("kind = \"cylinder\""), "{written}");
+    let unknown = text.replace("radius = 1\n", "radius = 1\nheight = 2\n");
+    let e = Scenario::from_toml_str(&unknown, Path::new("shapes.toml")).unwrap_err();
+    assert!(e.to_string().contains("unknown field `height`"), "{e}");
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! medians.
 
 use serde::{Deserialize, Serialize};
+use trust_plot::quantile_sorted;
 
 /// `z` of a two-sided 95 % normal interval.
 const Z95: f64 = 1.959_963_984_540_054;
@@ -100,19 +101,12 @@ pub fn mean_ci(xs: &[f64]) -> Mean {
     }
 }
 
-/// Median of the finite values of `xs` (`None` if there are none).
+/// Median of the finite values of `xs` (`None` if there are none), the 0.5-quantile of
+/// [`trust_plot::quantile_sorted`].
 pub fn median(xs: &[f64]) -> Option<f64> {
     let mut v: Vec<f64> = xs.iter().copied().filter(|x| x.is_finite()).collect();
-    if v.is_empty() {
-        return None;
-    }
     v.sort_by(f64::total_cmp);
-    let m = v.len() / 2;
-    Some(if v.len() % 2 == 1 {
-        v[m]
-    } else {
-        0.5 * (v[m - 1] + v[m])
-    })
+    quantile_sorted(&v, 0.5)
 }
 
 #[cfg(test)]

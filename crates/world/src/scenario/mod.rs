@@ -112,7 +112,7 @@
 pub(crate) mod generator;
 pub mod points;
 
-mod sections;
+pub(crate) mod sections;
 mod validate;
 
 use std::path::{Path, PathBuf};
@@ -124,8 +124,11 @@ pub use crate::problem::Problem;
 pub use generator::{E1Params, E2Params, E3Params, E4Params, GeneratorSpec};
 pub use sections::{
     BoundsSpec, Latency, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec, RandomObstacles,
-    ShapeSpec, SimSection, StaticSection, VehicleModel, VehicleSection, WorldSection,
+    SimSection, StaticSection, VehicleModel, VehicleSection, WorldSection,
 };
+
+/// A static obstacle of `[[static.shapes]]`: the run log's type (see [`StaticSection::shapes`]).
+pub use trust_runlog::StaticShape;
 
 use crate::error::WorldError;
 use crate::planner::{PlannerSpec, ResolvedPlanner};

@@ -8,6 +8,7 @@ use trust_geometry::{AaBox, Cylinder, Shape, Sphere};
 
 use crate::scenario::generator::GeneratorSpec;
 use crate::traffic::{Motion, MovingShape};
+use trust_runlog::StaticShape;
 use trust_vehicle::{QuadrotorParams, Se3Gains};
 
 /// An axis-aligned box `{ min = [x, y, z], max = [x, y, z] }`.
@@ -57,104 +58,100 @@ pub struct WorldSection {
     pub generator: Option<GeneratorSpec>,
 }
 
-/// A static obstacle (tagged by `kind`). Cylinders are vertical: axis through `center = [x, y]`
-/// from `z_min` to `z_max`, as in the run-log contract.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-pub enum ShapeSpec {
-    /// `{ kind = "sphere", center = [x, y, z], radius = r }`.
+/// The scenario's form of a static obstacle: the run log's [`StaticShape`] (one type for both),
+/// written tagged by `kind` — `{ kind = "sphere", center = [x, y, z], radius = r }`,
+/// `{ kind = "cylinder", center = [x, y], radius = r, z_min = a, z_max = b }` (vertical, as in the
+/// run-log contract), `{ kind = "box", min = [x, y, z], max = [x, y, z] }` (axis-aligned) — where
+/// the run log tags it externally. A serde adapter for [`StaticShape`] (`serde(remote)`): it
+/// (de)serializes the run-log type itself, so there is nothing to convert.
+#[derive(Serialize, Deserialize)]
+#[serde(
+    remote = "StaticShape",
+    tag = "kind",
+    rename_all = "snake_case",
+    deny_unknown_fields
+)]
+enum KindTagged {
     Sphere {
-        /// Centre (m).
         center: [f64; 3],
-        /// Radius (m), `> 0`.
         radius: f64,
     },
-    /// `{ kind = "cylinder", center = [x, y], radius = r, z_min = a, z_max = b }`.
     Cylinder {
-        /// Axis position (m).
         center: [f64; 2],
-        /// Radius (m), `> 0`.
         radius: f64,
-        /// Bottom (m).
         z_min: f64,
-        /// Top (m), `> z_min`.
         z_max: f64,
     },
-    /// `{ kind = "box", min = [x, y, z], max = [x, y, z] }` (axis-aligned).
     Box {
-        /// Lower corner (m).
         min: [f64; 3],
-        /// Upper corner (m), `> min` on every axis.
         max: [f64; 3],
     },
 }
 
-impl ShapeSpec {
-    /// The geometry shape, without checks (see [`ShapeSpec::is_valid`]).
-    pub fn shape(&self) -> Shape {
-        match *self {
-            ShapeSpec::Sphere { center, radius } => Shape::Sphere(Sphere {
-                center: Vec3::from(center),
-                radius,
-            }),
-            ShapeSpec::Cylinder {
-                center,
-                radius,
-                z_min,
-                z_max,
-            } => Shape::Cylinder(Cylinder {
-                center: Vec3::new(center[0], center[1], 0.5 * (z_min + z_max)),
-                radius,
-                half_height: 0.5 * (z_max - z_min),
-            }),
-            ShapeSpec::Box { min, max } => Shape::AaBox(AaBox {
-                min: Vec3::from(min),
-                max: Vec3::from(max),
-            }),
-        }
+/// `[[static.shapes]]` through [`KindTagged`].
+mod kind_tagged {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+    use trust_runlog::StaticShape;
+
+    #[derive(Serialize, Deserialize)]
+    #[serde(transparent)]
+    struct One(#[serde(with = "super::KindTagged")] StaticShape);
+
+    pub(super) fn serialize<S: Serializer>(v: &[StaticShape], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(v.iter().map(|x| One(*x)))
     }
 
-    /// The scenario (and run-log) form of a geometry shape.
-    pub fn from_shape(s: &Shape) -> Self {
-        match s {
-            Shape::Sphere(s) => ShapeSpec::Sphere {
-                center: s.center.into(),
-                radius: s.radius,
-            },
-            Shape::Cylinder(c) => ShapeSpec::Cylinder {
-                center: [c.center.x, c.center.y],
-                radius: c.radius,
-                z_min: c.center.z - c.half_height,
-                z_max: c.center.z + c.half_height,
-            },
-            Shape::AaBox(b) => ShapeSpec::Box {
-                min: b.min.into(),
-                max: b.max.into(),
-            },
-        }
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<Vec<StaticShape>, D::Error> {
+        Ok(Vec::<One>::deserialize(d)?
+            .into_iter()
+            .map(|One(x)| x)
+            .collect())
     }
+}
 
-    /// Finite numbers, positive sizes.
-    pub fn is_valid(&self) -> bool {
-        match *self {
-            ShapeSpec::Sphere { center, radius } => {
-                center.iter().all(|x| x.is_finite()) && radius.is_finite() && radius > 0.0
-            }
-            ShapeSpec::Cylinder {
-                center,
-                radius,
-                z_min,
-                z_max,
-            } => {
-                center.iter().all(|x| x.is_finite())
-                    && radius.is_finite()
-                    && radius > 0.0
-                    && z_min.is_finite()
-                    && z_max.is_finite()
-                    && z_min < z_max
-            }
-            ShapeSpec::Box { min, max } => BoundsSpec { min, max }.is_valid(),
-        }
+/// The geometry shape of a static obstacle, without checks (the scenario's validation checks it).
+pub(crate) fn geometry_shape(s: &StaticShape) -> Shape {
+    match *s {
+        StaticShape::Sphere { center, radius } => Shape::Sphere(Sphere {
+            center: Vec3::from(center),
+            radius,
+        }),
+        StaticShape::Cylinder {
+            center,
+            radius,
+            z_min,
+            z_max,
+        } => Shape::Cylinder(Cylinder {
+            center: Vec3::new(center[0], center[1], 0.5 * (z_min + z_max)),
+            radius,
+            half_height: 0.5 * (z_max - z_min),
+        }),
+        StaticShape::Box { min, max } => Shape::AaBox(AaBox {
+            min: Vec3::from(min),
+            max: Vec3::from(max),
+        }),
+    }
+}
+
+/// The scenario (and run-log) form of a geometry shape.
+pub(crate) fn static_shape(s: &Shape) -> StaticShape {
+    match s {
+        Shape::Sphere(s) => StaticShape::Sphere {
+            center: s.center.into(),
+            radius: s.radius,
+        },
+        Shape::Cylinder(c) => StaticShape::Cylinder {
+            center: [c.center.x, c.center.y],
+            radius: c.radius,
+            z_min: c.center.z - c.half_height,
+            z_max: c.center.z + c.half_height,
+        },
+        Shape::AaBox(b) => StaticShape::Box {
+            min: b.min.into(),
+            max: b.max.into(),
+        },
     }
 }
 
@@ -164,8 +161,8 @@ impl ShapeSpec {
 #[serde(deny_unknown_fields)]
 pub struct StaticSection {
     /// Analytic shapes (`[[static.shapes]]`), added to a generator's.
-    #[serde(default)]
-    pub shapes: Vec<ShapeSpec>,
+    #[serde(default, with = "kind_tagged")]
+    pub shapes: Vec<StaticShape>,
     /// What the planner sees as a point cloud (`[static.point_cloud]`); absent: the planner sees
     /// the shapes analytically.
     pub point_cloud: Option<PointCloudSpec>,

@@ -341,14 +341,14 @@ pub(crate) fn esdf_dims(bounds: &Aabb, resolution: f64) -> [usize; 3] {
     dims
 }
 
-fn check_shape(p: &mut Problems, field: &str, s: &super::ShapeSpec) {
-    use super::ShapeSpec;
+fn check_shape(p: &mut Problems, field: &str, s: &super::StaticShape) {
+    use super::StaticShape;
     match *s {
-        ShapeSpec::Sphere { center, radius } => {
+        StaticShape::Sphere { center, radius } => {
             p.finite_vec(&format!("{field}.center"), &center);
             p.positive(&format!("{field}.radius"), radius);
         }
-        ShapeSpec::Cylinder {
+        StaticShape::Cylinder {
             center,
             radius,
             z_min,
@@ -366,7 +366,7 @@ fn check_shape(p: &mut Problems, field: &str, s: &super::ShapeSpec) {
                 );
             }
         }
-        ShapeSpec::Box { min, max } => {
+        StaticShape::Box { min, max } => {
             let a = p.finite_vec(&format!("{field}.min"), &min);
             let b = p.finite_vec(&format!("{field}.max"), &max);
             if a && b {
