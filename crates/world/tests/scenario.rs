@@ -325,15 +325,26 @@ fn an_unknown_frontend_kind_lists_the_accepted_names() {
 }
 
 #[test]
-fn a_fixed_latency_reaches_the_manager() {
+fn a_fixed_latency_has_one_owner_and_reaches_the_manager() {
     let text = "name = \"latency\"\n[world]\nbounds = { min = [0, 0, 0], max = [20, 20, 10] }\n\
                 [mission]\nstart = [1, 10, 5]\ngoal = [19, 10, 5]\n\
                 [sim]\nlatency = { kind = \"fixed\", seconds = 0.03 }\n";
     let s = Scenario::from_toml_str(text, Path::new("latency.toml")).unwrap();
     assert_eq!(s.resolve_planner().manager.latency_s, Some(0.03));
-    let text = format!("{text}[planner.manager]\nlatency_s = 0.01\n");
-    let s = Scenario::from_toml_str(&text, Path::new("latency.toml")).unwrap();
-    assert_eq!(s.resolve_planner().manager.latency_s, Some(0.01));
+    // One owner: a different manager latency is a problem of the file, not silently kept.
+    let conflicting = format!("{text}[planner.manager]\nlatency_s = 0.01\n");
+    let s = Scenario::from_toml_str(&conflicting, Path::new("latency.toml")).unwrap();
+    let problems = s.validate();
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.to_string().contains("planner.manager.latency_s")),
+        "{problems:?}"
+    );
+    let agreeing = format!("{text}[planner.manager]\nlatency_s = 0.03\n");
+    let s = Scenario::from_toml_str(&agreeing, Path::new("latency.toml")).unwrap();
+    assert!(s.validate().is_empty(), "{:?}", s.validate());
+    assert_eq!(s.resolve_planner().manager.latency_s, Some(0.03));
 }
 
 #[test]

@@ -277,20 +277,16 @@ impl Scenario {
             .unwrap_or_else(|| PathBuf::from(format!("<scenario {}>", self.name)))
     }
 
-    /// The planner with every part chosen ([`PlannerSpec::resolve`]); a fixed `sim.latency`
-    /// with `seconds` also sets the manager's `latency_s` unless `[planner.manager]` sets it,
-    /// so that the manager plans for the delay the loop applies.
+    /// The planner with every part chosen ([`PlannerSpec::resolve`]). A fixed `sim.latency`
+    /// with `seconds` is the one owner of the delay: it becomes the manager's `latency_s`, so the
+    /// manager plans for the delay the loop applies (validation rejects a different
+    /// `[planner.manager] latency_s`), so the loop's `sim.latency.seconds` and the manager's
+    /// `latency()` are one value wherever both exist.
     pub fn resolve_planner(&self) -> ResolvedPlanner {
         let mut r = self.planner.resolve();
-        let manager_sets_latency = self
-            .planner
-            .manager
-            .as_ref()
-            .is_some_and(|m| m.latency_s.is_some());
         if let Latency::Fixed {
             seconds: Some(seconds),
         } = self.sim.latency
-            && !manager_sets_latency
         {
             r.manager.latency_s = Some(seconds);
         }

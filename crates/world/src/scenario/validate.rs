@@ -325,6 +325,23 @@ impl Scenario {
         } = s.latency
         {
             p.non_negative("sim.latency.seconds", seconds);
+            // One owner: the loop's delay and the delay the manager plans for must agree.
+            if let Some(manager) = self
+                .planner
+                .manager
+                .as_ref()
+                .and_then(|m| m.latency_s)
+                .filter(|m| *m != seconds)
+            {
+                p.push(
+                    "planner.manager.latency_s",
+                    manager,
+                    format!(
+                        "the same value as sim.latency.seconds ({seconds}) or no value: the \
+                         manager plans for the delay the loop applies; set it in one place"
+                    ),
+                );
+            }
         }
     }
 }
