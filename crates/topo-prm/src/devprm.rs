@@ -197,7 +197,7 @@ impl DevPrmParams {
             },
             cones: if self.pdc {
                 ConeMode::Predictive {
-                    max_horizon_s: self.pdc_horizon_s.unwrap_or(f64::INFINITY),
+                    pdc_horizon_s: self.pdc_horizon_s.unwrap_or(f64::INFINITY),
                 }
             } else {
                 ConeMode::Ignore

@@ -83,9 +83,9 @@ pub(crate) enum ConeMode {
     Ignore,
     /// Frozen where they are at the query time (an occupancy-map snapshot).
     Frozen,
-    /// Predictive directional cones over the query horizon, capped at `max_horizon_s` (s;
+    /// Predictive directional cones over the query horizon, capped at `pdc_horizon_s` (s;
     /// `f64::INFINITY` for no cap).
-    Predictive { max_horizon_s: f64 },
+    Predictive { pdc_horizon_s: f64 },
 }
 
 /// Graph search of the pipeline.
@@ -306,8 +306,8 @@ pub(crate) fn run(
     let cones = match setup.cones {
         ConeMode::Ignore => Vec::new(),
         ConeMode::Frozen => forecast_cones(scene.forecasts, t_query, 0.0)?,
-        ConeMode::Predictive { max_horizon_s } => {
-            forecast_cones(scene.forecasts, t_query, query.horizon_s.min(max_horizon_s))?
+        ConeMode::Predictive { pdc_horizon_s } => {
+            forecast_cones(scene.forecasts, t_query, query.horizon_s.min(pdc_horizon_s))?
         }
     };
     let mut obstacles =
