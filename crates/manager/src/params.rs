@@ -86,6 +86,13 @@ pub struct ManagerParams {
     /// speed limit), or if the incumbent became infeasible. 1 switches to any better branch.
     /// Default 0.75: the factor of de Groot et al.'s T-MPC / guidance_planner.
     pub hysteresis: f64,
+    /// A branch whose trajectory ends within this distance (m) of the goal reaches it, and ranks
+    /// before every branch that does not, whatever their `J` ([`crate::Branch::rank_cmp`]).
+    /// Default 0.05 m (beyond the paper; absolute, justified): the backend ends a trajectory
+    /// whose goal is within reach at the goal at rest, to within the smoothing `ε` of its
+    /// terminal norm (a few millimetres), and 0.05 m is a third of the smallest goal tolerance
+    /// we fly (0.15 m, the Crazyflie room), so a branch that "reaches" also arrives.
+    pub goal_reached_m: f64,
     /// The safety check every kept branch passes each cycle.
     pub safety: SafetyParams,
     /// Seed of the manager's random number generator (handed to the frontend every cycle).
@@ -123,6 +130,7 @@ impl ManagerParams {
             latency_s: None,
             reanchor: ReanchorParams::default(),
             hysteresis: 0.75,
+            goal_reached_m: 0.05,
             safety: SafetyParams::default(),
             seed: 0,
         }
@@ -206,6 +214,7 @@ impl ManagerParams {
             check_non_negative("manager.ranking.lambda_e", w.lambda_e)?;
         }
         check_positive("manager.horizon_s", self.horizon_s)?;
+        check_non_negative("manager.goal_reached_m", self.goal_reached_m)?;
         check_positive("manager.cycle_budget_ms", self.cycle_budget_ms)?;
         if let Some(l) = self.latency_s {
             check_non_negative("manager.latency_s", l)?;

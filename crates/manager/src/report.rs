@@ -145,8 +145,8 @@ pub enum Event {
         from: Option<BranchId>,
         /// The new one.
         to: BranchId,
-        /// `"better"` (beat the incumbent by the hysteresis factor), `"incumbent_dropped"`
-        /// or `"first"`.
+        /// `"better"` (beat the incumbent by the hysteresis factor), `"incumbent_dropped"`,
+        /// `"reaches_goal"` (reaches the goal while the incumbent stops short of it) or `"first"`.
         reason: String,
     },
     /// No branch was feasible: the plan is a braking fallback.
