@@ -12,6 +12,7 @@ use trust_core::{
 
 use crate::ManagerParams;
 use crate::brake::{brake_along, brake_straight};
+use crate::progress::ProgressMonitor;
 use crate::report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
     Origin, StepReport,
@@ -33,6 +34,9 @@ pub struct Branch {
     /// before `J`: a branch that reaches the goal always outranks one that stops short
     /// ([`Branch::outranks`]).
     pub reaches_goal: bool,
+    /// Distance (m) from the trajectory's end to the goal: how short of the goal it stops. While
+    /// the flight is stalled ([`crate::progress`]) it ranks before `J`.
+    pub shortfall_m: f64,
     /// How the trajectory was made in the last cycle.
     pub origin: Origin,
     /// Whether that solve was warm-started.
@@ -47,7 +51,8 @@ impl Branch {
         &self.solution.traj
     }
 
-    /// The ranking order: branches that reach the goal first, then ascending `J`, then id.
+    /// The ranking order: branches that reach the goal first, then (`by_progress`, while the
+    /// flight is stalled) those ending nearer the goal, then ascending `J`, then id.
     ///
     /// `J = λ_t·H_t + λ_s·H_s + λ_e·I_e` alone cannot decide between a branch that reaches the
     /// goal and one that stops short: with the paper's `λ_s = 1/v_max` a branch standing still
@@ -55,19 +60,27 @@ impl Branch {
     /// (`H_t ≥ d/v_max` plus the time to speed up and brake). The stopped branch then wins every
     /// cycle and the hysteresis protects it: E4, seed 7301, hovered 12.8 m before the goal for
     /// 30 s. Reaching the goal therefore ranks first.
-    pub fn rank_cmp(&self, other: &Branch) -> std::cmp::Ordering {
+    pub fn rank_cmp(&self, other: &Branch, by_progress: bool) -> std::cmp::Ordering {
+        let progress = match by_progress {
+            true => self.shortfall_m.total_cmp(&other.shortfall_m),
+            false => std::cmp::Ordering::Equal,
+        };
         other
             .reaches_goal
             .cmp(&self.reaches_goal)
+            .then(progress)
             .then(self.j.total_cmp(&other.j))
             .then(self.id.cmp(&other.id))
     }
 
     /// Whether `self` ranks strictly before `other`, ignoring ids ([`Branch::rank_cmp`]).
-    pub fn outranks(&self, other: &Branch) -> bool {
+    pub fn outranks(&self, other: &Branch, by_progress: bool) -> bool {
         match (self.reaches_goal, other.reaches_goal) {
             (true, false) => true,
             (false, true) => false,
+            (false, false) if by_progress && self.shortfall_m != other.shortfall_m => {
+                self.shortfall_m < other.shortfall_m
+            }
             _ => self.j < other.j,
         }
     }
@@ -114,9 +127,15 @@ fn narrowly_unsafe(v: &SafetyVerdict, margin: f64) -> bool {
 /// over the frontend `F`, the backend `B` and the homotopy checker `H`.
 ///
 /// It keeps up to `N` branches of distinct spatio-temporal homotopy sorted by the ranking cost
-/// `J = λ_t·H_t + λ_s·H_s + λ_e·I_e` and commits the main branch as the plan the vehicle flies.
-/// Each [`Manager::step`] is one cycle:
+/// `J = λ_t·H_t + λ_s·H_s + λ_e·I_e` — after whether they reach the goal, which ranks first
+/// ([`Branch::rank_cmp`], beyond the paper) — and commits the main branch as the plan the vehicle
+/// flies. Each [`Manager::step`] is one cycle:
 ///
+/// 0. **Progress.** The progress monitor ([`crate::progress`]) reports `Stalled` when the
+///    vehicle's progress toward the goal stays below its threshold away from the goal, and
+///    `Escaped` when it moves on; while stalled, FwdExplore runs every cycle with twice
+///    [`ManagerParams::max_explored_paths`], branches ending nearer the goal rank first, and the
+///    best-ranked branch leads without hysteresis (beyond the paper).
 /// 1. **Replan start.** The new trajectories start from the state the vehicle will be in when they
 ///    take effect: the committed plan at `now + latency` (so consecutive plans join with continuous
 ///    position, velocity and acceleration). If the measured state has drifted from the committed
@@ -132,11 +151,12 @@ fn narrowly_unsafe(v: &SafetyVerdict, margin: f64) -> bool {
 ///    is dropped (`DroppedCollision`).
 /// 4. **Distinct classes.** Re-solved branches that slid into the same class as a better one are
 ///    merged (`MergedEquivalent`); then **AddNewBranch** for each explored trajectory, in the frontend's order: if the checker finds
-///    it equivalent to a kept branch with a `J` at least as low it is discarded; if it is equivalent
+///    it equivalent to a kept branch ranked at least as well it is discarded; if it is equivalent
 ///    only to worse branches it replaces the best-ranked of them (which keeps its id); otherwise it
 ///    is added. Beyond `N` branches the worst is dropped (`PopBack`), never the main branch.
 /// 5. **Main branch.** The incumbent stays main unless a challenger's excess cost is below the
-///    hysteresis factor times the incumbent's, or the incumbent was dropped.
+///    hysteresis factor times the incumbent's, or the incumbent was dropped, or it stops short of
+///    the goal while a branch reaches it (the hysteresis compares branches of one tier only).
 /// 6. **Fallback.** With no feasible branch the plan is a braking trajectory ([`crate::brake`]):
 ///    along the committed plan (or along a rejected trajectory of this cycle, or straight), the first
 ///    that passes the safety check against the current forecasts, else the one with the largest
@@ -160,6 +180,7 @@ pub struct Manager<F, B, H> {
     committed: Option<PolyTraj>,
     next_id: BranchId,
     cycle_count: u64,
+    progress: ProgressMonitor,
 }
 
 impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
@@ -198,6 +219,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             main: None,
             committed: None,
             next_id: 0,
+            progress: ProgressMonitor::default(),
             cycle_count: 0,
         })
     }
@@ -212,7 +234,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         &self.limits
     }
 
-    /// The kept branches, sorted by `J`.
+    /// The kept branches, in ranking order ([`Branch::rank_cmp`]).
     pub fn branches(&self) -> &[Branch] {
         &self.branches
     }
@@ -230,6 +252,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     /// Forgets every branch and the plan (a new flight); the random stream continues.
     pub fn reset(&mut self) {
         self.cycle_count = 0;
+        self.progress.reset();
         self.branches.clear();
         self.main = None;
         self.committed = None;
@@ -275,7 +298,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         }
 
         // The main branch (hysteresis), PopBack protecting it, and the fallback without one.
-        let main = self.select_main(&kept, &cycle.start, goal, &cycle.weights, &mut cycle.events);
+        let main = self.select_main(&kept, &cycle.start, goal, cycle.stalled, &mut cycle.events);
         pop_back(&mut kept, self.params.max_branches, main, &mut cycle.events);
         let fallback = self.commit(main, &kept, &mut cycle, scene, &mut spans);
         self.branches = kept;
@@ -301,7 +324,15 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     fn begin_cycle(&mut self, now: f64, measured: &State, goal: &Vec3, started: Instant) -> Cycle {
         let mut events = Vec::new();
         let (start, reanchored) = self.replan_start(now, measured, &mut events);
-        let explore = !self.params.history
+        let rule = self
+            .params
+            .progress
+            .rule(&self.limits, self.params.horizon_s);
+        let distance = (measured.p - goal).norm();
+        events.extend(self.progress.update(now, -distance, distance, &rule));
+        let stalled = self.progress.stalled();
+        let explore = stalled
+            || !self.params.history
             || self
                 .cycle_count
                 .is_multiple_of(self.params.explore_period_cycles as u64)
@@ -311,6 +342,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         Cycle {
             start,
             goal: *goal,
+            stalled,
             reanchored,
             weights: self.params.ranking_weights(&self.limits),
             deadline: self
@@ -368,6 +400,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             horizon_s: self.params.horizon_s,
             deadline: cycle.deadline,
             params: &self.params,
+            explored_paths: self.params.max_explored_paths * if cycle.stalled { 2 } else { 1 },
         };
         let (frontend, rng) = (&self.frontend, &mut self.rng);
         rayon::join(
@@ -421,7 +454,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         }
     }
 
-    /// The re-solved branches that pass the safety pass, sorted by `J`; a main branch whose
+    /// The re-solved branches that pass the safety pass, in ranking order; a main branch whose
     /// re-solve failed keeps its committed trajectory if that still passes
     /// ([`Manager::keep_committed`]), unless the replan was re-anchored.
     fn keep_resolved(
@@ -439,6 +472,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                     id,
                     j: solution.costs.ranking_cost(&cycle.weights),
                     reaches_goal: self.reaches(&solution.traj, &cycle.goal),
+                    shortfall_m: shortfall(&solution.traj, &cycle.goal),
                     solution,
                     origin,
                     warm_started: true,
@@ -457,7 +491,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 None => {}
             }
         }
-        sort_by_rank(&mut kept);
+        sort_by_rank(&mut kept, cycle.stalled);
         kept
     }
 
@@ -478,14 +512,16 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             id: 0,
             j: solution.costs.ranking_cost(&cycle.weights),
             reaches_goal: self.reaches(&solution.traj, &cycle.goal),
+            shortfall_m: shortfall(&solution.traj, &cycle.goal),
             solution,
             origin: Origin::Explored,
             warm_started: false,
             verdict,
         };
         let incumbent = self.main.filter(|_| self.params.history);
+        let by_progress = cycle.stalled;
         spans.time(Span::Checks, || {
-            self.add_new_branch(kept, new, scene, incumbent, &mut cycle.events);
+            self.add_new_branch(kept, new, scene, incumbent, by_progress, &mut cycle.events);
         });
     }
 
@@ -573,6 +609,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             id,
             j: previous.solution.costs.ranking_cost(weights),
             reaches_goal: self.reaches(plan, goal),
+            shortfall_m: shortfall(plan, goal),
             solution: previous.solution.clone(),
             origin: Origin::Kept,
             warm_started: false,
@@ -619,12 +656,13 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         mut new: Branch,
         scene: &Scene<'_>,
         incumbent: Option<BranchId>,
+        by_progress: bool,
         events: &mut Vec<Event>,
     ) {
         let mut worse_equivalent = None;
         for (i, b) in kept.iter().enumerate() {
             match self.equivalent(&new.solution.traj, &b.solution.traj, scene) {
-                Ok(true) if !new.outranks(b) => {
+                Ok(true) if !new.outranks(b, by_progress) => {
                     events.push(Event::DiscardedEquivalent {
                         equivalent_to: b.id,
                     });
@@ -656,13 +694,13 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 kept.push(new);
             }
         }
-        sort_by_rank(kept);
+        sort_by_rank(kept, by_progress);
         pop_back(kept, self.params.max_branches, incumbent, events);
     }
 
     /// Whether `traj` ends within [`ManagerParams::goal_reached_m`] of `goal`.
     fn reaches(&self, traj: &PolyTraj, goal: &Vec3) -> bool {
-        (traj.state(traj.t_end()).p - goal).norm() <= self.params.goal_reached_m
+        shortfall(traj, goal) <= self.params.goal_reached_m
     }
 
     /// The checker on a scene restricted to the forecasts that can reach the two trajectories.
@@ -688,17 +726,20 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         kept: &[Branch],
         start: &State,
         goal: &Vec3,
-        weights: &RankingWeights,
+        stalled: bool,
         events: &mut Vec<Event>,
     ) -> Option<BranchId> {
+        let weights = self.params.ranking_weights(&self.limits);
         let ideal =
             weights.lambda_s.min(weights.lambda_t / self.limits.v_max) * (start.p - goal).norm();
         // The hysteresis compares `J` only among branches of the best one's tier: a branch that
         // reaches the goal replaces an incumbent that stops short, however their `J` compare.
+        // While stalled the best-ranked branch (by progress) leads at once, without hysteresis.
         let tier = kept.first()?.reaches_goal;
         let ranked: Vec<(BranchId, f64)> = kept
             .iter()
             .filter(|b| b.reaches_goal == tier)
+            .take(if stalled { 1 } else { kept.len() })
             .map(|b| (b.id, b.j))
             .collect();
         let incumbent = self.main.filter(|_| self.params.history);
@@ -710,6 +751,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 (None, _) => "first",
                 (Some(_), true) => "better",
                 (Some(_), false) if incumbent_short => "reaches_goal",
+                (Some(id), false) if stalled && kept.iter().any(|b| b.id == id) => "progress",
                 (Some(_), false) => "incumbent_dropped",
             };
             events.push(Event::SwitchedMain {
@@ -808,6 +850,8 @@ struct Cycle {
     start: State,
     /// The goal the branches are ranked against ([`Branch::reaches_goal`]).
     goal: Vec3,
+    /// The flight is stalled ([`crate::progress`]): explore with more paths and rank by progress.
+    stalled: bool,
     /// Whether the replan start was re-anchored on the measured state.
     reanchored: bool,
     /// The ranking weights of `J`.
@@ -852,7 +896,7 @@ fn fwd_explore<F: PathFrontend, B: TrajectoryBackend>(
     let mut paths = match search {
         Ok(mut result) => {
             let path_count = result.paths.len();
-            result.paths.truncate(params.max_explored_paths);
+            result.paths.truncate(solver.explored_paths);
             explored.frontend = Some(FrontendReport {
                 name: frontend.name().to_string(),
                 path_count,
@@ -986,6 +1030,9 @@ struct Solver<'s, 'a, B> {
     horizon_s: f64,
     deadline: Option<Instant>,
     params: &'s ManagerParams,
+    /// Most frontend paths to optimize this cycle: [`ManagerParams::max_explored_paths`], twice
+    /// that while the flight is stalled.
+    explored_paths: usize,
 }
 
 impl<B: TrajectoryBackend> Solver<'_, '_, B> {
@@ -1117,8 +1164,13 @@ pub fn choose_main(
 }
 
 /// Sorts `branches` in ranking order ([`Branch::rank_cmp`]).
-fn sort_by_rank(branches: &mut [Branch]) {
-    branches.sort_by(Branch::rank_cmp);
+fn sort_by_rank(branches: &mut [Branch], by_progress: bool) {
+    branches.sort_by(|a, b| a.rank_cmp(b, by_progress));
+}
+
+/// Distance (m) from the end of `traj` to `goal` ([`Branch::shortfall_m`]).
+fn shortfall(traj: &PolyTraj, goal: &Vec3) -> f64 {
+    (traj.position(traj.t_end()) - goal).norm()
 }
 
 /// Drops the worst branches beyond `n`, never `protect`.

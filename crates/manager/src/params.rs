@@ -1,5 +1,6 @@
 //! Parameters of the [`crate::Manager`] and of its safety check.
 
+use crate::ProgressParams;
 use serde::{Deserialize, Serialize};
 use trust_core::{Limits, PlanError, RankingWeights, check_non_negative, check_positive};
 
@@ -93,6 +94,8 @@ pub struct ManagerParams {
     /// terminal norm (a few millimetres), and 0.05 m is a third of the smallest goal tolerance
     /// we fly (0.15 m, the Crazyflie room), so a branch that "reaches" also arrives.
     pub goal_reached_m: f64,
+    /// The progress monitor's thresholds ([`crate::progress`]).
+    pub progress: ProgressParams,
     /// The safety check every kept branch passes each cycle.
     pub safety: SafetyParams,
     /// Seed of the manager's random number generator (handed to the frontend every cycle).
@@ -131,6 +134,7 @@ impl ManagerParams {
             reanchor: ReanchorParams::default(),
             hysteresis: 0.75,
             goal_reached_m: 0.05,
+            progress: ProgressParams::default(),
             safety: SafetyParams::default(),
             seed: 0,
         }
@@ -215,6 +219,7 @@ impl ManagerParams {
         }
         check_positive("manager.horizon_s", self.horizon_s)?;
         check_non_negative("manager.goal_reached_m", self.goal_reached_m)?;
+        self.progress.validate()?;
         check_positive("manager.cycle_budget_ms", self.cycle_budget_ms)?;
         if let Some(l) = self.latency_s {
             check_non_negative("manager.latency_s", l)?;

@@ -859,3 +859,103 @@ fn a_branch_that_reaches_the_goal_outranks_one_that_stops_short() {
     assert!((end.p - goal).norm() < 0.05, "ends at {:?}", end.p);
     assert!(reports.iter().all(|r| r.fallback.is_none()));
 }
+
+/// A frontend with two guide paths to the goal: straight, and through a point beside the line.
+struct TwoWays;
+
+impl PathFrontend for TwoWays {
+    fn name(&self) -> &str {
+        "two-ways"
+    }
+
+    fn search(
+        &self,
+        q: &PathQuery,
+        _scene: &Scene<'_>,
+        _rng: &mut Rng,
+    ) -> Result<SearchResult, PlanError> {
+        let beside = (q.start.p + q.goal) * 0.5 + Vec3::new(0.0, 1.0, 0.0);
+        Ok(SearchResult {
+            paths: vec![
+                GuidePath::new(vec![q.start.p, q.goal])?,
+                GuidePath::new(vec![q.start.p, beside, q.goal])?,
+            ],
+            ..SearchResult::default()
+        })
+    }
+}
+
+/// A backend for which standing still is cheapest: the straight guide gives a branch standing
+/// still (`J = 0.1 s + d/v_max`), the other guide a branch that flies 8 m toward the goal and
+/// stops (`J` about 1 s more); a warm re-solve keeps the branch's end.
+struct Hesitant;
+
+impl TrajectoryBackend for Hesitant {
+    fn name(&self) -> &str {
+        "hesitant"
+    }
+
+    fn optimize(&self, req: &TrajRequest<'_>, _scene: &Scene<'_>) -> Result<Solution, PlanError> {
+        let s = &req.start;
+        Ok(match req.initial {
+            trust_core::InitialGuess::WarmStart(traj) => {
+                let duration = (traj.t_end() - s.t).max(0.1);
+                StopsFirst::to_rest(s, traj.position(traj.t_end()), duration, &req.goal)
+            }
+            trust_core::InitialGuess::Guide(path) if path.points.len() == 2 => {
+                StopsFirst::to_rest(s, s.p, 0.1, &req.goal)
+            }
+            trust_core::InitialGuess::Guide(_) => {
+                let d = 8.0;
+                let end = s.p + (req.goal - s.p).normalize() * d;
+                let (v, a) = (req.limits.v_max, req.limits.a_max);
+                let duration = 1.1 * (1.875 * d / v).max((5.774 * d / a).sqrt());
+                StopsFirst::to_rest(s, end, duration, &req.goal)
+            }
+        })
+    }
+}
+
+/// Issue 19, "progress, not hovering": a branch that stands still is the cheapest by `J`, so the
+/// vehicle hovers 30 m from the goal; after one window (`T_h/2 = 2 s`) the monitor reports
+/// `stalled`, the ranking by progress takes the branch that flies on, and once the vehicle has
+/// progressed `5 % · v_max · 2 s = 1 m` the monitor reports `escaped`.
+#[test]
+fn a_stalled_flight_says_so_and_progresses_again() {
+    let map = open_air();
+    let mut m = Manager::new(
+        TwoWays,
+        Hesitant,
+        OneClass,
+        Limits::default(),
+        reproducible(ManagerParams::trust()),
+    )
+    .unwrap();
+    let start = State::at_rest(0.0, Vec3::new(60.0, 0.0, 5.0));
+    let goal = Vec3::new(90.0, 0.0, 5.0);
+    let reports = fly(&mut m, &map, goal, start, 50, |_| Vec::new());
+    let first = |tag: &str| reports.iter().position(|r| r.event_tags().contains(&tag));
+    let stalled = first("stalled").expect("a stall is reported");
+    // Standing still until the stall: one window of 2 s (20 cycles).
+    assert_eq!(stalled, 20);
+    let x_at = |k: usize| reports[k].replan_start.p.x;
+    assert!((x_at(stalled) - 60.0).abs() < 1e-6, "{}", x_at(stalled));
+    let escaped = first("escaped").expect("the escape is reported");
+    assert!(escaped > stalled);
+    assert!(x_at(escaped) - 60.0 >= 1.0, "{}", x_at(escaped));
+    let Some(Event::Stalled {
+        progress_mps,
+        distance_to_goal_m,
+        ..
+    }) = reports[stalled]
+        .events
+        .iter()
+        .find(|e| matches!(e, Event::Stalled { .. }))
+    else {
+        unreachable!()
+    };
+    assert!(progress_mps.abs() < 1e-9 && (distance_to_goal_m - 30.0).abs() < 1e-6);
+    // The vehicle ends nearer the goal than it stalled.
+    let last = reports.last().unwrap();
+    assert!(m.plan().unwrap().position(last.t).x > 65.0);
+}
