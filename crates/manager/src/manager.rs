@@ -20,6 +20,7 @@ use crate::report::{
 use crate::safety::{
     SafetyVerdict, assess_trajectory, check_trajectory, forecasts_near, window_bounds,
 };
+use trust_route::GlobalRoute;
 
 /// One kept trajectory branch.
 #[derive(Debug, Clone, PartialEq)]
@@ -181,6 +182,7 @@ pub struct Manager<F, B, H> {
     next_id: BranchId,
     cycle_count: u64,
     progress: ProgressMonitor,
+    route: Option<GlobalRoute>,
 }
 
 impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
@@ -220,6 +222,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             committed: None,
             next_id: 0,
             progress: ProgressMonitor::default(),
+            route: None,
             cycle_count: 0,
         })
     }
@@ -247,6 +250,66 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     /// The committed plan: the main branch's trajectory or the braking fallback.
     pub fn plan(&self) -> Option<&PolyTraj> {
         self.committed.as_ref()
+    }
+
+    /// Sets (or with `None` clears) the global route the branches follow (issue 19, beyond the
+    /// paper). With a route, the frontend's query, the straight guide and the backend's terminal
+    /// cost aim at the route's local goal — where the route leaves the ball of radius
+    /// `T_h·v_max` around the replan start's projection on it — instead of the final goal, and
+    /// progress is measured along the route; near the route's end the aim is the final goal.
+    /// Without a route every cycle is exactly as before (the paper's setting).
+    pub fn set_route(&mut self, route: Option<GlobalRoute>) {
+        self.route = route;
+    }
+
+    /// The global route, if any ([`Manager::set_route`]).
+    pub fn route(&self) -> Option<&GlobalRoute> {
+        self.route.as_ref()
+    }
+
+    /// Where this cycle's branches aim from `from`: the route's local goal
+    /// ([`Manager::set_route`]), or `goal` without a route, near the route's end, or when the
+    /// route cannot be queried.
+    fn aim(&self, from: &Vec3, goal: &Vec3) -> Vec3 {
+        let Some(route) = &self.route else {
+            return *goal;
+        };
+        let horizon_m = self.params.horizon_s * self.limits.v_max;
+        match route.local_goal(from, horizon_m) {
+            Ok(local) if route.length() - local.s > 1e-9 => local.point,
+            _ => *goal,
+        }
+    }
+
+    /// The route from `from`'s projection on it to the aim ([`Manager::aim`]) as a guide path
+    /// starting at `from`; `None` without a route.
+    fn route_guide(&self, from: &Vec3, aim: &Vec3) -> Option<GuidePath> {
+        let route = self.route.as_ref()?;
+        let s0 = route.progress(from).ok()?;
+        let mut points = vec![*from];
+        let mut s = 0.0;
+        for w in route.points().windows(2) {
+            s += (w[1] - w[0]).norm();
+            if s <= s0 {
+                continue;
+            }
+            if (w[1] - from).norm() >= (aim - from).norm() || (w[1] - aim).norm() < 1e-9 {
+                break;
+            }
+            points.push(w[1]);
+        }
+        points.push(*aim);
+        points.dedup_by(|a, b| (*a - *b).norm() < 1e-9);
+        GuidePath::new(points).ok()
+    }
+
+    /// Progress toward `goal` at `p` (m; larger is nearer): the arc length along the route, or
+    /// minus the distance to the goal without a route.
+    fn progress_at(&self, p: &Vec3, goal: &Vec3) -> f64 {
+        match self.route.as_ref().map(|r| r.progress(p)) {
+            Some(Ok(s)) => s,
+            _ => -(p - goal).norm(),
+        }
     }
 
     /// Forgets every branch and the plan (a new flight); the random stream continues.
@@ -282,7 +345,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         // Algorithm 1, lines 5–8: FwdMarch of the main branch and BwdReplan of the sub-branches,
         // in parallel with FwdExplore.
         let warm = self.warm_branches();
-        let (explored, resolved) = self.solve_in_parallel(&cycle, goal, scene, &warm, &mut spans);
+        let aim = self.aim(&cycle.start.p, goal);
+        let (explored, resolved) = self.solve_in_parallel(&cycle, &aim, scene, &warm, &mut spans);
         if let Some(error) = explored.frontend_error {
             cycle.events.push(Event::FrontendFailed { error });
         }
@@ -329,7 +393,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             .progress
             .rule(&self.limits, self.params.horizon_s);
         let distance = (measured.p - goal).norm();
-        events.extend(self.progress.update(now, -distance, distance, &rule));
+        let progress = self.progress_at(&measured.p, goal);
+        events.extend(self.progress.update(now, progress, distance, &rule));
         let stalled = self.progress.stalled();
         let explore = stalled
             || !self.params.history
@@ -401,6 +466,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             deadline: cycle.deadline,
             params: &self.params,
             explored_paths: self.params.max_explored_paths * if cycle.stalled { 2 } else { 1 },
+            route_guide: self.route_guide(&cycle.start.p, goal),
         };
         let (frontend, rng) = (&self.frontend, &mut self.rng);
         rayon::join(
@@ -910,6 +976,11 @@ fn fwd_explore<F: PathFrontend, B: TrajectoryBackend>(
             Vec::new()
         }
     };
+    if let Some(guide) = &solver.route_guide {
+        // With a route, always explore along it: the frontend's sampling box and the straight
+        // guide cannot see around an obstacle wider than the box (a wide wall, a U-trap).
+        paths.push(guide.clone());
+    }
     if paths.is_empty() && params.straight_guide_when_empty {
         // Beyond the paper: never explore empty-handed. The frontend's cones are conservative (an
         // obstacle's whole sweep over the horizon), so in crowded moments it may find no path
@@ -1033,6 +1104,9 @@ struct Solver<'s, 'a, B> {
     /// Most frontend paths to optimize this cycle: [`ManagerParams::max_explored_paths`], twice
     /// that while the flight is stalled.
     explored_paths: usize,
+    /// The route from the replan start to the local goal ([`Manager::set_route`]), explored as a
+    /// guide path every exploring cycle.
+    route_guide: Option<GuidePath>,
 }
 
 impl<B: TrajectoryBackend> Solver<'_, '_, B> {
