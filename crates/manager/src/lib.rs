@@ -17,6 +17,11 @@
 //! - every kept branch passes a safety check each cycle, continuous in time with a proven step
 //!   ([`check_trajectory`]), against the static map and the current forecasts;
 //! - the main branch switches with hysteresis ([`ManagerParams::hysteresis`]);
+//! - a branch that reaches the goal outranks every branch that stops short of it, whatever their
+//!   `J` ([`Branch::rank_cmp`]: with `λ_s = 1/v_max` standing still `d` short costs about `d/v_max`,
+//!   less than flying there);
+//! - a progress monitor reports `stalled` / `escaped` and escalates while stalled
+//!   ([`progress`]);
 //! - with no feasible branch the plan is a braking fallback along the last safe trajectory
 //!   ([`brake_along`]), and the report says whether it is collision-free under the forecasts;
 //! - each cycle returns a serializable [`StepReport`] (branches, events, timing split).
@@ -74,12 +79,14 @@
 pub mod brake;
 mod manager;
 mod params;
+pub mod progress;
 mod report;
 pub mod safety;
 
 pub use brake::{brake_along, brake_straight, hermite_quintic};
 pub use manager::{Branch, MainDecision, Manager, choose_main};
 pub use params::{ManagerParams, ReanchorParams, SafetyParams};
+pub use progress::{ProgressMonitor, ProgressParams, StallRule};
 pub use report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
     Origin, StepReport,

@@ -12,6 +12,7 @@ use trust_core::{
 
 use crate::ManagerParams;
 use crate::brake::{brake_along, brake_straight};
+use crate::progress::ProgressMonitor;
 use crate::report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
     Origin, StepReport,
@@ -19,6 +20,7 @@ use crate::report::{
 use crate::safety::{
     SafetyVerdict, assess_trajectory, check_trajectory, forecasts_near, window_bounds,
 };
+use trust_route::GlobalRoute;
 
 /// One kept trajectory branch.
 #[derive(Debug, Clone, PartialEq)]
@@ -29,6 +31,13 @@ pub struct Branch {
     pub solution: Solution,
     /// Ranking cost `J`.
     pub j: f64,
+    /// Whether the trajectory ends at the goal (within [`ManagerParams::goal_reached_m`]). Ranks
+    /// before `J`: a branch that reaches the goal always outranks one that stops short
+    /// ([`Branch::outranks`]).
+    pub reaches_goal: bool,
+    /// Distance (m) from the trajectory's end to the goal: how short of the goal it stops. While
+    /// the flight is stalled ([`crate::progress`]) it ranks before `J`.
+    pub shortfall_m: f64,
     /// How the trajectory was made in the last cycle.
     pub origin: Origin,
     /// Whether that solve was warm-started.
@@ -41,6 +50,40 @@ impl Branch {
     /// The branch's trajectory.
     pub fn traj(&self) -> &PolyTraj {
         &self.solution.traj
+    }
+
+    /// The ranking order: branches that reach the goal first, then (`by_progress`, while the
+    /// flight is stalled) those ending nearer the goal, then ascending `J`, then id.
+    ///
+    /// `J = λ_t·H_t + λ_s·H_s + λ_e·I_e` alone cannot decide between a branch that reaches the
+    /// goal and one that stops short: with the paper's `λ_s = 1/v_max` a branch standing still
+    /// `d` metres short costs `J ≈ d/v_max`, while any branch flying there costs at least as much
+    /// (`H_t ≥ d/v_max` plus the time to speed up and brake). The stopped branch then wins every
+    /// cycle and the hysteresis protects it: E4, seed 7301, hovered 12.8 m before the goal for
+    /// 30 s. Reaching the goal therefore ranks first.
+    pub fn rank_cmp(&self, other: &Branch, by_progress: bool) -> std::cmp::Ordering {
+        let progress = match by_progress {
+            true => self.shortfall_m.total_cmp(&other.shortfall_m),
+            false => std::cmp::Ordering::Equal,
+        };
+        other
+            .reaches_goal
+            .cmp(&self.reaches_goal)
+            .then(progress)
+            .then(self.j.total_cmp(&other.j))
+            .then(self.id.cmp(&other.id))
+    }
+
+    /// Whether `self` ranks strictly before `other`, ignoring ids ([`Branch::rank_cmp`]).
+    pub fn outranks(&self, other: &Branch, by_progress: bool) -> bool {
+        match (self.reaches_goal, other.reaches_goal) {
+            (true, false) => true,
+            (false, true) => false,
+            (false, false) if by_progress && self.shortfall_m != other.shortfall_m => {
+                self.shortfall_m < other.shortfall_m
+            }
+            _ => self.j < other.j,
+        }
     }
 
     fn report(&self, main: bool) -> BranchReport {
@@ -85,9 +128,15 @@ fn narrowly_unsafe(v: &SafetyVerdict, margin: f64) -> bool {
 /// over the frontend `F`, the backend `B` and the homotopy checker `H`.
 ///
 /// It keeps up to `N` branches of distinct spatio-temporal homotopy sorted by the ranking cost
-/// `J = λ_t·H_t + λ_s·H_s + λ_e·I_e` and commits the main branch as the plan the vehicle flies.
-/// Each [`Manager::step`] is one cycle:
+/// `J = λ_t·H_t + λ_s·H_s + λ_e·I_e` — after whether they reach the goal, which ranks first
+/// ([`Branch::rank_cmp`], beyond the paper) — and commits the main branch as the plan the vehicle
+/// flies. Each [`Manager::step`] is one cycle:
 ///
+/// 0. **Progress.** The progress monitor ([`crate::progress`]) reports `Stalled` when the
+///    vehicle's progress toward the goal stays below its threshold away from the goal, and
+///    `Escaped` when it moves on; while stalled, FwdExplore runs every cycle with twice
+///    [`ManagerParams::max_explored_paths`], branches ending nearer the goal rank first, and the
+///    best-ranked branch leads without hysteresis (beyond the paper).
 /// 1. **Replan start.** The new trajectories start from the state the vehicle will be in when they
 ///    take effect: the committed plan at `now + latency` (so consecutive plans join with continuous
 ///    position, velocity and acceleration). If the measured state has drifted from the committed
@@ -103,11 +152,12 @@ fn narrowly_unsafe(v: &SafetyVerdict, margin: f64) -> bool {
 ///    is dropped (`DroppedCollision`).
 /// 4. **Distinct classes.** Re-solved branches that slid into the same class as a better one are
 ///    merged (`MergedEquivalent`); then **AddNewBranch** for each explored trajectory, in the frontend's order: if the checker finds
-///    it equivalent to a kept branch with a `J` at least as low it is discarded; if it is equivalent
+///    it equivalent to a kept branch ranked at least as well it is discarded; if it is equivalent
 ///    only to worse branches it replaces the best-ranked of them (which keeps its id); otherwise it
 ///    is added. Beyond `N` branches the worst is dropped (`PopBack`), never the main branch.
 /// 5. **Main branch.** The incumbent stays main unless a challenger's excess cost is below the
-///    hysteresis factor times the incumbent's, or the incumbent was dropped.
+///    hysteresis factor times the incumbent's, or the incumbent was dropped, or it stops short of
+///    the goal while a branch reaches it (the hysteresis compares branches of one tier only).
 /// 6. **Fallback.** With no feasible branch the plan is a braking trajectory ([`crate::brake`]):
 ///    along the committed plan (or along a rejected trajectory of this cycle, or straight), the first
 ///    that passes the safety check against the current forecasts, else the one with the largest
@@ -131,6 +181,8 @@ pub struct Manager<F, B, H> {
     committed: Option<PolyTraj>,
     next_id: BranchId,
     cycle_count: u64,
+    progress: ProgressMonitor,
+    route: Option<GlobalRoute>,
 }
 
 impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
@@ -169,6 +221,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             main: None,
             committed: None,
             next_id: 0,
+            progress: ProgressMonitor::default(),
+            route: None,
             cycle_count: 0,
         })
     }
@@ -183,7 +237,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         &self.limits
     }
 
-    /// The kept branches, sorted by `J`.
+    /// The kept branches, in ranking order ([`Branch::rank_cmp`]).
     pub fn branches(&self) -> &[Branch] {
         &self.branches
     }
@@ -198,9 +252,70 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         self.committed.as_ref()
     }
 
+    /// Sets (or with `None` clears) the global route the branches follow (issue 19, beyond the
+    /// paper). With a route, the frontend's query, the straight guide and the backend's terminal
+    /// cost aim at the route's local goal — where the route leaves the ball of radius
+    /// `T_h·v_max` around the replan start's projection on it — instead of the final goal, and
+    /// progress is measured along the route; near the route's end the aim is the final goal.
+    /// Without a route every cycle is exactly as before (the paper's setting).
+    pub fn set_route(&mut self, route: Option<GlobalRoute>) {
+        self.route = route;
+    }
+
+    /// The global route, if any ([`Manager::set_route`]).
+    pub fn route(&self) -> Option<&GlobalRoute> {
+        self.route.as_ref()
+    }
+
+    /// Where this cycle's branches aim from `from`: the route's local goal
+    /// ([`Manager::set_route`]), or `goal` without a route, near the route's end, or when the
+    /// route cannot be queried.
+    fn aim(&self, from: &Vec3, goal: &Vec3) -> Vec3 {
+        let Some(route) = &self.route else {
+            return *goal;
+        };
+        let horizon_m = self.params.horizon_s * self.limits.v_max;
+        match route.local_goal(from, horizon_m) {
+            Ok(local) if route.length() - local.s > 1e-9 => local.point,
+            _ => *goal,
+        }
+    }
+
+    /// The route from `from`'s projection on it to the aim ([`Manager::aim`]) as a guide path
+    /// starting at `from`; `None` without a route.
+    fn route_guide(&self, from: &Vec3, aim: &Vec3) -> Option<GuidePath> {
+        let route = self.route.as_ref()?;
+        let s0 = route.progress(from).ok()?;
+        let mut points = vec![*from];
+        let mut s = 0.0;
+        for w in route.points().windows(2) {
+            s += (w[1] - w[0]).norm();
+            if s <= s0 {
+                continue;
+            }
+            if (w[1] - from).norm() >= (aim - from).norm() || (w[1] - aim).norm() < 1e-9 {
+                break;
+            }
+            points.push(w[1]);
+        }
+        points.push(*aim);
+        points.dedup_by(|a, b| (*a - *b).norm() < 1e-9);
+        GuidePath::new(points).ok()
+    }
+
+    /// Progress toward `goal` at `p` (m; larger is nearer): the arc length along the route, or
+    /// minus the distance to the goal without a route.
+    fn progress_at(&self, p: &Vec3, goal: &Vec3) -> f64 {
+        match self.route.as_ref().map(|r| r.progress(p)) {
+            Some(Ok(s)) => s,
+            _ => -(p - goal).norm(),
+        }
+    }
+
     /// Forgets every branch and the plan (a new flight); the random stream continues.
     pub fn reset(&mut self) {
         self.cycle_count = 0;
+        self.progress.reset();
         self.branches.clear();
         self.main = None;
         self.committed = None;
@@ -225,12 +340,13 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     ) -> Result<StepReport, PlanError> {
         let mut spans = Spans::start();
         check_step_input(now, measured, goal, scene)?;
-        let mut cycle = self.begin_cycle(now, measured, spans.started);
+        let mut cycle = self.begin_cycle(now, measured, goal, spans.started);
 
         // Algorithm 1, lines 5–8: FwdMarch of the main branch and BwdReplan of the sub-branches,
         // in parallel with FwdExplore.
         let warm = self.warm_branches();
-        let (explored, resolved) = self.solve_in_parallel(&cycle, goal, scene, &warm, &mut spans);
+        let aim = self.aim(&cycle.start.p, goal);
+        let (explored, resolved) = self.solve_in_parallel(&cycle, &aim, scene, &warm, &mut spans);
         if let Some(error) = explored.frontend_error {
             cycle.events.push(Event::FrontendFailed { error });
         }
@@ -246,7 +362,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         }
 
         // The main branch (hysteresis), PopBack protecting it, and the fallback without one.
-        let main = self.select_main(&kept, &cycle.start, goal, &cycle.weights, &mut cycle.events);
+        let main = self.select_main(&kept, &cycle.start, goal, cycle.stalled, &mut cycle.events);
         pop_back(&mut kept, self.params.max_branches, main, &mut cycle.events);
         let fallback = self.commit(main, &kept, &mut cycle, scene, &mut spans);
         self.branches = kept;
@@ -269,10 +385,19 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
 
     /// The cycle's starting point: the replan start, the ranking weights, the deadline and
     /// whether FwdExplore runs this cycle.
-    fn begin_cycle(&mut self, now: f64, measured: &State, started: Instant) -> Cycle {
+    fn begin_cycle(&mut self, now: f64, measured: &State, goal: &Vec3, started: Instant) -> Cycle {
         let mut events = Vec::new();
         let (start, reanchored) = self.replan_start(now, measured, &mut events);
-        let explore = !self.params.history
+        let rule = self
+            .params
+            .progress
+            .rule(&self.limits, self.params.horizon_s);
+        let distance = (measured.p - goal).norm();
+        let progress = self.progress_at(&measured.p, goal);
+        events.extend(self.progress.update(now, progress, distance, &rule));
+        let stalled = self.progress.stalled();
+        let explore = stalled
+            || !self.params.history
             || self
                 .cycle_count
                 .is_multiple_of(self.params.explore_period_cycles as u64)
@@ -281,6 +406,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         self.cycle_count += 1;
         Cycle {
             start,
+            goal: *goal,
+            stalled,
             reanchored,
             weights: self.params.ranking_weights(&self.limits),
             deadline: self
@@ -338,6 +465,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             horizon_s: self.params.horizon_s,
             deadline: cycle.deadline,
             params: &self.params,
+            explored_paths: self.params.max_explored_paths * if cycle.stalled { 2 } else { 1 },
+            route_guide: self.route_guide(&cycle.start.p, goal),
         };
         let (frontend, rng) = (&self.frontend, &mut self.rng);
         rayon::join(
@@ -391,7 +520,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         }
     }
 
-    /// The re-solved branches that pass the safety pass, sorted by `J`; a main branch whose
+    /// The re-solved branches that pass the safety pass, in ranking order; a main branch whose
     /// re-solve failed keeps its committed trajectory if that still passes
     /// ([`Manager::keep_committed`]), unless the replan was re-anchored.
     fn keep_resolved(
@@ -408,15 +537,17 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 Some((solution, verdict)) => kept.push(Branch {
                     id,
                     j: solution.costs.ranking_cost(&cycle.weights),
+                    reaches_goal: self.reaches(&solution.traj, &cycle.goal),
+                    shortfall_m: shortfall(&solution.traj, &cycle.goal),
                     solution,
                     origin,
                     warm_started: true,
                     verdict,
                 }),
                 None if origin == Origin::Marched && !cycle.reanchored => {
-                    let (start, weights) = (cycle.start, cycle.weights);
+                    let (start, weights, goal) = (cycle.start, cycle.weights, cycle.goal);
                     let previous = spans.time(Span::Checks, || {
-                        self.keep_committed(id, &start, scene, &weights)
+                        self.keep_committed(id, &start, &goal, scene, &weights)
                     });
                     if let Some(b) = previous {
                         cycle.events.push(Event::KeptCommitted { id });
@@ -426,7 +557,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 None => {}
             }
         }
-        sort_by_j(&mut kept);
+        sort_by_rank(&mut kept, cycle.stalled);
         kept
     }
 
@@ -446,14 +577,17 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let new = Branch {
             id: 0,
             j: solution.costs.ranking_cost(&cycle.weights),
+            reaches_goal: self.reaches(&solution.traj, &cycle.goal),
+            shortfall_m: shortfall(&solution.traj, &cycle.goal),
             solution,
             origin: Origin::Explored,
             warm_started: false,
             verdict,
         };
         let incumbent = self.main.filter(|_| self.params.history);
+        let by_progress = cycle.stalled;
         spans.time(Span::Checks, || {
-            self.add_new_branch(kept, new, scene, incumbent, &mut cycle.events);
+            self.add_new_branch(kept, new, scene, incumbent, by_progress, &mut cycle.events);
         });
     }
 
@@ -520,6 +654,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         &self,
         id: BranchId,
         start: &State,
+        goal: &Vec3,
         scene: &Scene<'_>,
         weights: &RankingWeights,
     ) -> Option<Branch> {
@@ -539,6 +674,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         verdict.safe.then(|| Branch {
             id,
             j: previous.solution.costs.ranking_cost(weights),
+            reaches_goal: self.reaches(plan, goal),
+            shortfall_m: shortfall(plan, goal),
             solution: previous.solution.clone(),
             origin: Origin::Kept,
             warm_started: false,
@@ -585,12 +722,13 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         mut new: Branch,
         scene: &Scene<'_>,
         incumbent: Option<BranchId>,
+        by_progress: bool,
         events: &mut Vec<Event>,
     ) {
         let mut worse_equivalent = None;
         for (i, b) in kept.iter().enumerate() {
             match self.equivalent(&new.solution.traj, &b.solution.traj, scene) {
-                Ok(true) if b.j <= new.j => {
+                Ok(true) if !new.outranks(b, by_progress) => {
                     events.push(Event::DiscardedEquivalent {
                         equivalent_to: b.id,
                     });
@@ -622,8 +760,13 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 kept.push(new);
             }
         }
-        sort_by_j(kept);
+        sort_by_rank(kept, by_progress);
         pop_back(kept, self.params.max_branches, incumbent, events);
+    }
+
+    /// Whether `traj` ends within [`ManagerParams::goal_reached_m`] of `goal`.
+    fn reaches(&self, traj: &PolyTraj, goal: &Vec3) -> bool {
+        shortfall(traj, goal) <= self.params.goal_reached_m
     }
 
     /// The checker on a scene restricted to the forecasts that can reach the two trajectories.
@@ -649,18 +792,32 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         kept: &[Branch],
         start: &State,
         goal: &Vec3,
-        weights: &RankingWeights,
+        stalled: bool,
         events: &mut Vec<Event>,
     ) -> Option<BranchId> {
+        let weights = self.params.ranking_weights(&self.limits);
         let ideal =
             weights.lambda_s.min(weights.lambda_t / self.limits.v_max) * (start.p - goal).norm();
-        let ranked: Vec<(BranchId, f64)> = kept.iter().map(|b| (b.id, b.j)).collect();
+        // The hysteresis compares `J` only among branches of the best one's tier: a branch that
+        // reaches the goal replaces an incumbent that stops short, however their `J` compare.
+        // While stalled the best-ranked branch (by progress) leads at once, without hysteresis.
+        let tier = kept.first()?.reaches_goal;
+        let ranked: Vec<(BranchId, f64)> = kept
+            .iter()
+            .filter(|b| b.reaches_goal == tier)
+            .take(if stalled { 1 } else { kept.len() })
+            .map(|b| (b.id, b.j))
+            .collect();
         let incumbent = self.main.filter(|_| self.params.history);
+        let incumbent_short =
+            tier && incumbent.is_some_and(|id| kept.iter().any(|b| b.id == id && !b.reaches_goal));
         let decision = choose_main(&ranked, incumbent, ideal, self.params.hysteresis)?;
         if decision.switched && self.params.history {
             let reason = match (incumbent, decision.incumbent_kept) {
                 (None, _) => "first",
                 (Some(_), true) => "better",
+                (Some(_), false) if incumbent_short => "reaches_goal",
+                (Some(id), false) if stalled && kept.iter().any(|b| b.id == id) => "progress",
                 (Some(_), false) => "incumbent_dropped",
             };
             events.push(Event::SwitchedMain {
@@ -757,6 +914,10 @@ fn check_step_input(
 struct Cycle {
     /// The replan start ([`Manager::replan_start`]).
     start: State,
+    /// The goal the branches are ranked against ([`Branch::reaches_goal`]).
+    goal: Vec3,
+    /// The flight is stalled ([`crate::progress`]): explore with more paths and rank by progress.
+    stalled: bool,
     /// Whether the replan start was re-anchored on the measured state.
     reanchored: bool,
     /// The ranking weights of `J`.
@@ -801,7 +962,7 @@ fn fwd_explore<F: PathFrontend, B: TrajectoryBackend>(
     let mut paths = match search {
         Ok(mut result) => {
             let path_count = result.paths.len();
-            result.paths.truncate(params.max_explored_paths);
+            result.paths.truncate(solver.explored_paths);
             explored.frontend = Some(FrontendReport {
                 name: frontend.name().to_string(),
                 path_count,
@@ -815,6 +976,11 @@ fn fwd_explore<F: PathFrontend, B: TrajectoryBackend>(
             Vec::new()
         }
     };
+    if let Some(guide) = &solver.route_guide {
+        // With a route, always explore along it: the frontend's sampling box and the straight
+        // guide cannot see around an obstacle wider than the box (a wide wall, a U-trap).
+        paths.push(guide.clone());
+    }
     if paths.is_empty() && params.straight_guide_when_empty {
         // Beyond the paper: never explore empty-handed. The frontend's cones are conservative (an
         // obstacle's whole sweep over the horizon), so in crowded moments it may find no path
@@ -935,6 +1101,12 @@ struct Solver<'s, 'a, B> {
     horizon_s: f64,
     deadline: Option<Instant>,
     params: &'s ManagerParams,
+    /// Most frontend paths to optimize this cycle: [`ManagerParams::max_explored_paths`], twice
+    /// that while the flight is stalled.
+    explored_paths: usize,
+    /// The route from the replan start to the local goal ([`Manager::set_route`]), explored as a
+    /// guide path every exploring cycle.
+    route_guide: Option<GuidePath>,
 }
 
 impl<B: TrajectoryBackend> Solver<'_, '_, B> {
@@ -1065,8 +1237,14 @@ pub fn choose_main(
     })
 }
 
-fn sort_by_j(branches: &mut [Branch]) {
-    branches.sort_by(|a, b| a.j.total_cmp(&b.j).then(a.id.cmp(&b.id)));
+/// Sorts `branches` in ranking order ([`Branch::rank_cmp`]).
+fn sort_by_rank(branches: &mut [Branch], by_progress: bool) {
+    branches.sort_by(|a, b| a.rank_cmp(b, by_progress));
+}
+
+/// Distance (m) from the end of `traj` to `goal` ([`Branch::shortfall_m`]).
+fn shortfall(traj: &PolyTraj, goal: &Vec3) -> f64 {
+    (traj.position(traj.t_end()) - goal).norm()
 }
 
 /// Drops the worst branches beyond `n`, never `protect`.

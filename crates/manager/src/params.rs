@@ -1,5 +1,6 @@
 //! Parameters of the [`crate::Manager`] and of its safety check.
 
+use crate::ProgressParams;
 use serde::{Deserialize, Serialize};
 use trust_core::{Limits, PlanError, RankingWeights, check_non_negative, check_positive};
 
@@ -86,6 +87,15 @@ pub struct ManagerParams {
     /// speed limit), or if the incumbent became infeasible. 1 switches to any better branch.
     /// Default 0.75: the factor of de Groot et al.'s T-MPC / guidance_planner.
     pub hysteresis: f64,
+    /// A branch whose trajectory ends within this distance (m) of the goal reaches it, and ranks
+    /// before every branch that does not, whatever their `J` ([`crate::Branch::rank_cmp`]).
+    /// Default 0.05 m (beyond the paper; absolute, justified): the backend ends a trajectory
+    /// whose goal is within reach at the goal at rest, to within the smoothing `ε` of its
+    /// terminal norm (a few millimetres), and 0.05 m is a third of the smallest goal tolerance
+    /// we fly (0.15 m, the Crazyflie room), so a branch that "reaches" also arrives.
+    pub goal_reached_m: f64,
+    /// The progress monitor's thresholds ([`crate::progress`]).
+    pub progress: ProgressParams,
     /// The safety check every kept branch passes each cycle.
     pub safety: SafetyParams,
     /// Seed of the manager's random number generator (handed to the frontend every cycle).
@@ -123,6 +133,8 @@ impl ManagerParams {
             latency_s: None,
             reanchor: ReanchorParams::default(),
             hysteresis: 0.75,
+            goal_reached_m: 0.05,
+            progress: ProgressParams::default(),
             safety: SafetyParams::default(),
             seed: 0,
         }
@@ -206,6 +218,8 @@ impl ManagerParams {
             check_non_negative("manager.ranking.lambda_e", w.lambda_e)?;
         }
         check_positive("manager.horizon_s", self.horizon_s)?;
+        check_non_negative("manager.goal_reached_m", self.goal_reached_m)?;
+        self.progress.validate()?;
         check_positive("manager.cycle_budget_ms", self.cycle_budget_ms)?;
         if let Some(l) = self.latency_s {
             check_non_negative("manager.latency_s", l)?;

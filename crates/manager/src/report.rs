@@ -145,9 +145,26 @@ pub enum Event {
         from: Option<BranchId>,
         /// The new one.
         to: BranchId,
-        /// `"better"` (beat the incumbent by the hysteresis factor), `"incumbent_dropped"`
-        /// or `"first"`.
+        /// `"better"` (beat the incumbent by the hysteresis factor), `"incumbent_dropped"`,
+        /// `"reaches_goal"` (reaches the goal while the incumbent stops short of it) or `"first"`.
         reason: String,
+    },
+    /// The vehicle's progress toward the goal stayed below the threshold over the window away
+    /// from the goal ([`crate::progress`]): the manager escalates until [`Event::Escaped`].
+    Stalled {
+        /// Progress rate over the window (m/s).
+        progress_mps: f64,
+        /// The window (s).
+        window_s: f64,
+        /// Distance from the vehicle to the goal (m).
+        distance_to_goal_m: f64,
+    },
+    /// The vehicle progressed again after [`Event::Stalled`] (or came near the goal).
+    Escaped {
+        /// How long the stall lasted (s).
+        stalled_s: f64,
+        /// Distance from the vehicle to the goal (m).
+        distance_to_goal_m: f64,
     },
     /// No branch was feasible: the plan is a braking fallback.
     Fallback {
@@ -178,6 +195,8 @@ impl Event {
             Event::CheckerFailed { .. } => "checker_failed",
             Event::SwitchedMain { .. } => "switched",
             Event::Fallback { .. } => "fallback",
+            Event::Stalled { .. } => "stalled",
+            Event::Escaped { .. } => "escaped",
         }
     }
 }
@@ -279,7 +298,8 @@ pub struct StepReport {
     pub replan_start: State,
     /// The main branch, or `None` when the plan is a fallback.
     pub main: Option<BranchId>,
-    /// The kept branches, sorted by `J`.
+    /// The kept branches, in ranking order ([`crate::Branch::rank_cmp`]): those reaching the goal
+    /// first, then by `J`.
     pub branches: Vec<BranchReport>,
     /// What happened, in order.
     pub events: Vec<Event>,

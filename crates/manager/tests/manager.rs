@@ -720,3 +720,277 @@ fn a_start_inside_a_static_obstacle_is_survived_not_fatal() {
     assert!(m.plan().is_some());
     let _ = GuidePath::new(vec![START]).unwrap();
 }
+
+/// A frontend with one guide path: the straight line from the start to the goal.
+struct Toward;
+
+impl PathFrontend for Toward {
+    fn name(&self) -> &str {
+        "toward"
+    }
+
+    fn search(
+        &self,
+        q: &PathQuery,
+        _scene: &Scene<'_>,
+        _rng: &mut Rng,
+    ) -> Result<SearchResult, PlanError> {
+        Ok(SearchResult {
+            paths: vec![GuidePath::new(vec![q.start.p, q.goal])?],
+            ..SearchResult::default()
+        })
+    }
+}
+
+/// A checker for which every two curves are equivalent (one homotopy class, as in open air).
+struct OneClass;
+
+impl trust_core::HomotopyChecker for OneClass {
+    fn name(&self) -> &str {
+        "one-class"
+    }
+
+    fn equivalent(
+        &self,
+        _a: &dyn trust_core::Curve,
+        _b: &dyn trust_core::Curve,
+        _scene: &Scene<'_>,
+    ) -> Result<bool, PlanError> {
+        Ok(true)
+    }
+}
+
+/// A backend reproducing E4 seed 7301's stall: its first cold solve (the cycle at `t = 0`, replanning from `t = 0.05`) stands still
+/// (the branch stopped short), every later cold solve flies rest-to-rest to the goal within the
+/// limits, and a warm re-solve keeps the branch's end (a stopped branch stays stopped). Every
+/// trajectory is the quintic from the start state to rest at its end, so a re-solve of a flying
+/// branch is the same curve.
+struct StopsFirst;
+
+impl StopsFirst {
+    /// The quintic from `start` to rest at `end` over `duration`, with its `H_t` and `H_s`.
+    fn to_rest(start: &State, end: Vec3, duration: f64, goal: &Vec3) -> Solution {
+        let piece = trust_manager::hermite_quintic(
+            [start.p, start.v, start.a],
+            [end, Vec3::zeros(), Vec3::zeros()],
+            duration,
+        );
+        Solution {
+            traj: PolyTraj::new(start.t, vec![duration], vec![piece]).expect("valid"),
+            costs: CostBreakdown {
+                ht: duration,
+                hs: (end - goal).norm(),
+                ..CostBreakdown::default()
+            },
+            stats: SolveStats {
+                iteration_count: 0,
+                evaluation_count: 1,
+                elapsed: std::time::Duration::ZERO,
+                status: SolveStatus::Converged,
+            },
+            violations: Vec::new(),
+        }
+    }
+}
+
+impl TrajectoryBackend for StopsFirst {
+    fn name(&self) -> &str {
+        "stops-first"
+    }
+
+    fn optimize(&self, req: &TrajRequest<'_>, _scene: &Scene<'_>) -> Result<Solution, PlanError> {
+        let s = &req.start;
+        // The standing branch's duration: J = 0.1 s + d/v_max, as the kept branch's in the stall.
+        const HOLD_S: f64 = 0.1;
+        Ok(match req.initial {
+            trust_core::InitialGuess::WarmStart(traj) => {
+                let end = traj.position(traj.t_end());
+                let duration = (traj.t_end() - s.t).max(HOLD_S);
+                Self::to_rest(s, end, duration, &req.goal)
+            }
+            trust_core::InitialGuess::Guide(_) if s.t < 0.1 => {
+                Self::to_rest(s, s.p, HOLD_S, &req.goal)
+            }
+            trust_core::InitialGuess::Guide(_) => {
+                // Rest to rest over d: peak speed 1.875·d/T, peak acceleration 5.774·d/T².
+                let d = (req.goal - s.p).norm();
+                let (v, a) = (req.limits.v_max, req.limits.a_max);
+                let duration = (1.1 * (1.875 * d / v).max((5.774 * d / a).sqrt())).max(HOLD_S);
+                Self::to_rest(s, req.goal, duration, &req.goal)
+            }
+        })
+    }
+}
+
+/// Regression (E4 seed 7301, issue 19): a branch standing still 10 m short of the goal has
+/// `J ≈ d/v_max`, less than any branch that flies there (`H_t ≥ d/v_max` plus speeding up and
+/// braking); ranked by `J` alone it kept the main branch and every explored branch reaching the
+/// goal was `discarded_equivalent`, for ever. A branch that reaches the goal must win.
+#[test]
+fn a_branch_that_reaches_the_goal_outranks_one_that_stops_short() {
+    let map = open_air();
+    let mut m = Manager::new(
+        Toward,
+        StopsFirst,
+        OneClass,
+        Limits::default(),
+        reproducible(ManagerParams::trust()),
+    )
+    .unwrap();
+    let start = State::at_rest(0.0, Vec3::new(80.0, 0.0, 5.0));
+    let goal = Vec3::new(90.0, 0.0, 5.0);
+    let reports = fly(&mut m, &map, goal, start, 40, |_| Vec::new());
+    // The first cycle has only the standing branch.
+    assert_eq!(reports[0].branches.len(), 1);
+    assert!(reports[0].branches[0].j < 1.2, "{:?}", reports[0].branches);
+    // The reaching branch replaces it in its class although its J is larger, and leads.
+    let r = &reports[1];
+    let replaced = r.events.iter().find_map(|e| match e {
+        Event::Replaced { j_old, j_new, .. } => Some((*j_old, *j_new)),
+        _ => None,
+    });
+    let (j_old, j_new) = replaced.expect("the stopped branch is replaced");
+    assert!(j_new > j_old, "J {j_old} → {j_new}");
+    let plan = m.plan().unwrap();
+    assert!((plan.position(plan.t_end()) - goal).norm() < 1e-9);
+    // Flown perfectly, the vehicle arrives and stays.
+    let last = reports.last().unwrap();
+    let end = m.plan().unwrap().state(last.t + 0.1);
+    assert!((end.p - goal).norm() < 0.05, "ends at {:?}", end.p);
+    assert!(reports.iter().all(|r| r.fallback.is_none()));
+}
+
+/// A frontend with two guide paths to the goal: straight, and through a point beside the line.
+struct TwoWays;
+
+impl PathFrontend for TwoWays {
+    fn name(&self) -> &str {
+        "two-ways"
+    }
+
+    fn search(
+        &self,
+        q: &PathQuery,
+        _scene: &Scene<'_>,
+        _rng: &mut Rng,
+    ) -> Result<SearchResult, PlanError> {
+        let beside = (q.start.p + q.goal) * 0.5 + Vec3::new(0.0, 1.0, 0.0);
+        Ok(SearchResult {
+            paths: vec![
+                GuidePath::new(vec![q.start.p, q.goal])?,
+                GuidePath::new(vec![q.start.p, beside, q.goal])?,
+            ],
+            ..SearchResult::default()
+        })
+    }
+}
+
+/// A backend for which standing still is cheapest: the straight guide gives a branch standing
+/// still (`J = 0.1 s + d/v_max`), the other guide a branch that flies 8 m toward the goal and
+/// stops (`J` about 1 s more); a warm re-solve keeps the branch's end.
+struct Hesitant;
+
+impl TrajectoryBackend for Hesitant {
+    fn name(&self) -> &str {
+        "hesitant"
+    }
+
+    fn optimize(&self, req: &TrajRequest<'_>, _scene: &Scene<'_>) -> Result<Solution, PlanError> {
+        let s = &req.start;
+        Ok(match req.initial {
+            trust_core::InitialGuess::WarmStart(traj) => {
+                let duration = (traj.t_end() - s.t).max(0.1);
+                StopsFirst::to_rest(s, traj.position(traj.t_end()), duration, &req.goal)
+            }
+            trust_core::InitialGuess::Guide(path) if path.points.len() == 2 => {
+                StopsFirst::to_rest(s, s.p, 0.1, &req.goal)
+            }
+            trust_core::InitialGuess::Guide(_) => {
+                let d = 8.0;
+                let end = s.p + (req.goal - s.p).normalize() * d;
+                let (v, a) = (req.limits.v_max, req.limits.a_max);
+                let duration = 1.1 * (1.875 * d / v).max((5.774 * d / a).sqrt());
+                StopsFirst::to_rest(s, end, duration, &req.goal)
+            }
+        })
+    }
+}
+
+/// Issue 19, "progress, not hovering": a branch that stands still is the cheapest by `J`, so the
+/// vehicle hovers 30 m from the goal; after one window (`T_h/2 = 2 s`) the monitor reports
+/// `stalled`, the ranking by progress takes the branch that flies on, and once the vehicle has
+/// progressed `5 % · v_max · 2 s = 1 m` the monitor reports `escaped`.
+#[test]
+fn a_stalled_flight_says_so_and_progresses_again() {
+    let map = open_air();
+    let mut m = Manager::new(
+        TwoWays,
+        Hesitant,
+        OneClass,
+        Limits::default(),
+        reproducible(ManagerParams::trust()),
+    )
+    .unwrap();
+    let start = State::at_rest(0.0, Vec3::new(60.0, 0.0, 5.0));
+    let goal = Vec3::new(90.0, 0.0, 5.0);
+    let reports = fly(&mut m, &map, goal, start, 50, |_| Vec::new());
+    let first = |tag: &str| reports.iter().position(|r| r.event_tags().contains(&tag));
+    let stalled = first("stalled").expect("a stall is reported");
+    // Standing still until the stall: one window of 2 s (20 cycles).
+    assert_eq!(stalled, 20);
+    let x_at = |k: usize| reports[k].replan_start.p.x;
+    assert!((x_at(stalled) - 60.0).abs() < 1e-6, "{}", x_at(stalled));
+    let escaped = first("escaped").expect("the escape is reported");
+    assert!(escaped > stalled);
+    assert!(x_at(escaped) - 60.0 >= 1.0, "{}", x_at(escaped));
+    let Some(Event::Stalled {
+        progress_mps,
+        distance_to_goal_m,
+        ..
+    }) = reports[stalled]
+        .events
+        .iter()
+        .find(|e| matches!(e, Event::Stalled { .. }))
+    else {
+        unreachable!()
+    };
+    assert!(progress_mps.abs() < 1e-9 && (distance_to_goal_m - 30.0).abs() < 1e-6);
+    // The vehicle ends nearer the goal than it stalled.
+    let last = reports.last().unwrap();
+    assert!(m.plan().unwrap().position(last.t).x > 65.0);
+}
+
+/// Issue 19, "a wide wall ahead": a full-height wall 30 m wide, 15 m from the start, across the
+/// straight line to the goal. With the global route the branches aim at the route's local goal,
+/// around the wall's end, and the vehicle (tracking perfectly) leaves the start and arrives.
+#[test]
+fn with_a_route_a_wide_wall_ahead_is_flown_around_to_the_goal() {
+    let bounds = Aabb::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(60.0, 40.0, 10.0)).unwrap();
+    let wall =
+        Shape::AaBox(AaBox::new(Vec3::new(20.0, 5.0, 0.0), Vec3::new(21.0, 35.0, 10.0)).unwrap());
+    let map = StaticMap::from_shapes(bounds, vec![wall]).unwrap();
+    let (start, goal) = (Vec3::new(5.0, 20.0, 5.0), Vec3::new(50.0, 20.0, 5.0));
+    let route = trust_route::RoutePlanner::new(trust_route::RouteParams::default())
+        .unwrap()
+        .plan(&map, &start, &goal, 0.3)
+        .expect("a route around the wall");
+    // Without the route (the paper's setting) it never leaves the start: every branch collides.
+    let mut m = planner(ManagerParams::trust());
+    let reports = fly(&mut m, &map, goal, State::at_rest(0.0, start), 30, |_| {
+        Vec::new()
+    });
+    assert!(reports.iter().all(|r| r.main.is_none()));
+    assert!((reports.last().unwrap().replan_start.p - start).norm() < 1e-6);
+    let mut m = planner(ManagerParams::trust());
+    m.set_route(Some(route));
+    let reports = fly(&mut m, &map, goal, State::at_rest(0.0, start), 150, |_| {
+        Vec::new()
+    });
+    let arrived = reports
+        .iter()
+        .position(|r| (r.replan_start.p - goal).norm() < 0.5)
+        .expect("arrives");
+    assert!(arrived < 150, "{arrived}");
+    // It never touched the wall (the safety check passed every committed plan).
+    assert!(reports.iter().all(|r| r.fallback.is_none()));
+}
