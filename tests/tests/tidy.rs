@@ -76,6 +76,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
         "trust-lbfgs",
         "trust-minco",
         "trust-topo-prm",
+        "trust-route",
         "trust-manager",
     ];
     fn with(extra: &[&'static str]) -> &'static [&'static str] {
@@ -111,6 +112,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-lbfgs",
                 "trust-minco",
                 "trust-topo-prm",
+                "trust-route",
             ][..],
         ),
         (
