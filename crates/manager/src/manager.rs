@@ -838,7 +838,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         scene: &Scene<'_>,
         events: &mut Vec<Event>,
     ) -> Option<FallbackReport> {
-        let hold_s = self.params.horizon_s;
+        let hold_s = self.params.brake_hold();
         let a_max = self.limits.a_max;
         let mut options: Vec<(&'static str, PolyTraj)> = Vec::new();
         if let Some(plan) = self.committed.as_ref().filter(|_| !reanchored)

@@ -67,6 +67,10 @@ pub struct ManagerParams {
     /// backend's terminal surface (`r_des = ‖p_s − p_g‖ − T_h·v_max`). Default 4 s: the paper's
     /// Fig. Sim-A-1-1(a) has `r_des = 25 m` for a goal 65 m away at `v_max = 10 m/s`.
     pub horizon_s: f64,
+    /// How long the braking fallback holds still after it has stopped (s): the plan the vehicle
+    /// flies while every branch is unsafe ends this long after the stop. `None`: the planning
+    /// horizon [`ManagerParams::horizon_s`] (the stop is then planned as far ahead as any branch).
+    pub brake_hold_s: Option<f64>,
     /// Time budget of one cycle (ms). With [`ManagerParams::enforce_budget`] every trajectory
     /// solve of the cycle gets the deadline `cycle start + budget` ([`trust_core::TrajRequest`]).
     /// Default 50 ms: half of the 10 Hz replanning period.
@@ -128,6 +132,7 @@ impl ManagerParams {
             repair_margin_m: 0.05,
             ranking: None,
             horizon_s: 4.0,
+            brake_hold_s: None,
             cycle_budget_ms: 50.0,
             enforce_budget: true,
             latency_s: None,
@@ -156,6 +161,12 @@ impl ManagerParams {
             max_explored_paths: 1,
             ..Self::trust()
         }
+    }
+
+    /// The braking fallback's hold in use (s): [`ManagerParams::brake_hold_s`], else the
+    /// planning horizon.
+    pub fn brake_hold(&self) -> f64 {
+        self.brake_hold_s.unwrap_or(self.horizon_s)
     }
 
     /// The latency in use (s).
@@ -218,6 +229,9 @@ impl ManagerParams {
             check_non_negative("manager.ranking.lambda_e", w.lambda_e)?;
         }
         check_positive("manager.horizon_s", self.horizon_s)?;
+        if let Some(hold) = self.brake_hold_s {
+            check_positive("manager.brake_hold_s", hold)?;
+        }
         check_non_negative("manager.goal_reached_m", self.goal_reached_m)?;
         self.progress.validate()?;
         check_positive("manager.cycle_budget_ms", self.cycle_budget_ms)?;
@@ -391,5 +405,17 @@ mod tests {
         assert_eq!(p.max_branches, 3);
         assert_eq!(p.horizon_s, 4.0);
         assert!(toml::from_str::<ManagerParams>("branches = 3\n").is_err());
+    }
+
+    #[test]
+    fn the_brake_hold_defaults_to_the_horizon_and_is_validated() {
+        let mut p = ManagerParams::default();
+        assert_eq!(p.brake_hold(), p.horizon_s);
+        p.brake_hold_s = Some(1.5);
+        assert_eq!(p.brake_hold(), 1.5);
+        p.validate().unwrap();
+        p.brake_hold_s = Some(0.0);
+        let e = p.validate().unwrap_err().to_string();
+        assert!(e.contains("manager.brake_hold_s"), "{e}");
     }
 }

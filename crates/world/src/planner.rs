@@ -58,7 +58,7 @@ use trust_core::{
     Curve, HomotopyChecker, Limits, PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult,
     Solution, TrajRequest, TrajectoryBackend,
 };
-use trust_manager::{Manager, ManagerParams, ReanchorParams, SafetyParams};
+use trust_manager::{Manager, ManagerParams, ProgressParams, ReanchorParams, SafetyParams};
 use trust_minco::{Minco, MincoParams, UtfMinco, UtfMincoParams};
 use trust_topo_prm::{
     DevPrm, DevPrmParams, SparseAStar, SparseAStarParams, StraightLine, Tvd, TvdParams, Uvd,
@@ -455,6 +455,9 @@ pub struct ManagerOverrides {
     /// Replaces `ManagerParams::horizon_s`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub horizon_s: Option<f64>,
+    /// Replaces `ManagerParams::brake_hold_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub brake_hold_s: Option<f64>,
     /// Replaces `ManagerParams::cycle_budget_ms`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cycle_budget_ms: Option<f64>,
@@ -473,6 +476,12 @@ pub struct ManagerOverrides {
     /// Replaces `ManagerParams::safety`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub safety: Option<SafetyOverrides>,
+    /// Replaces `ManagerParams::goal_reached_m`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub goal_reached_m: Option<f64>,
+    /// Replaces `ManagerParams::progress` (fields not given take their defaults).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub progress: Option<ProgressParams>,
 }
 
 impl ManagerOverrides {
@@ -515,6 +524,15 @@ impl ManagerOverrides {
         }
         if let Some(v) = self.horizon_s {
             p.horizon_s = v;
+        }
+        if let Some(v) = self.brake_hold_s {
+            p.brake_hold_s = Some(v);
+        }
+        if let Some(v) = self.goal_reached_m {
+            p.goal_reached_m = v;
+        }
+        if let Some(v) = self.progress {
+            p.progress = v;
         }
         if let Some(v) = self.cycle_budget_ms {
             p.cycle_budget_ms = v;
