@@ -19,13 +19,13 @@
 //! - `proptest [--seeds K] [--cases N]`: every property test under K random seeds
 //!   (`PROPTEST_RNG_SEED`), reporting each failing seed with its reproducing command.
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use serde_json::Value;
+use trust_experiments::{e1, e2};
 
 mod fuzz;
 mod proptest;
@@ -197,6 +197,7 @@ fn main() -> Result<()> {
 const E1_OBSTACLE_COUNTS: [usize; 5] = [2, 5, 10, 15, 20];
 
 fn experiment_e1(root: &Path, trials: usize, seed: u64, out: &Path) -> Result<()> {
+    let mut raw = Vec::new();
     let mut rows = Vec::new();
     for (i, k) in E1_OBSTACLE_COUNTS.iter().enumerate() {
         eprintln!(
@@ -204,10 +205,10 @@ fn experiment_e1(root: &Path, trials: usize, seed: u64, out: &Path) -> Result<()
             i + 1,
             E1_OBSTACLE_COUNTS.len()
         );
-        let json = cargo_example_json(
+        let stdout = cargo_example_output(
             root,
             "trust-topo-prm",
-            "prm_efficiency",
+            e1::EXAMPLE,
             &[
                 "--obstacles",
                 &k.to_string(),
@@ -217,65 +218,26 @@ fn experiment_e1(root: &Path, trials: usize, seed: u64, out: &Path) -> Result<()
                 &seed.to_string(),
             ],
         )?;
-        rows.push(json);
+        rows.push(e1::parse_row(&stdout)?);
+        raw.push(example_json(e1::EXAMPLE, &stdout)?);
     }
-    let mut md = String::from(
-        "# E1 — DEV-PRM vs V-PRM (paper Fig. Sim-A-1-1(c))\n\n\
-         20×20×10 m scenes with k random dynamic obstacles, 20 ms budget per planner. Headline: \
-         distinct *valid* paths (clear of the static map and of every moving obstacle's predictive \
-         cone) per CPU ms, judged by one common checker for both planners. `raw` counts every \
-         returned path; `st` flies each path at v_max and counts TVD classes of those that stay clear \
-         of the moving obstacles at every instant.\n\n\
-         | k | V-PRM paths | V-PRM ms | V-PRM paths/ms | DEV-PRM paths | DEV-PRM ms | DEV-PRM paths/ms | ratio | raw ratio | st ratio |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n",
-    );
-    for r in &rows {
-        let f = |path: &[&str]| -> String {
-            let mut v = r;
-            for p in path {
-                v = &v[*p];
-            }
-            v.as_f64()
-                .map(|x| format!("{x:.3}"))
-                .unwrap_or_else(|| "—".into())
-        };
-        writeln!(
-            md,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-            r["obstacles"],
-            f(&["vprm", "distinct_paths_mean"]),
-            f(&["vprm", "cpu_ms_mean"]),
-            f(&["vprm", "paths_per_ms"]),
-            f(&["devprm", "distinct_paths_mean"]),
-            f(&["devprm", "cpu_ms_mean"]),
-            f(&["devprm", "paths_per_ms"]),
-            f(&["ratio"]),
-            f(&["raw_ratio"]),
-            f(&["st_ratio"]),
-        )?;
-    }
-    md.push_str("\nPaper, k = 10: V-PRM 0.186, DEV-PRM 0.338 paths/ms (ratio 1.82).\n");
-    if let Some(metric) = rows.first().and_then(|r| r.get("metric")) {
-        writeln!(md, "\nMetric definitions (from the example): {metric}")?;
-    }
-    write_outputs(out, &Value::Array(rows), &md)
+    write_outputs(out, &Value::Array(raw), &e1::report(&rows))
 }
 
 fn experiment_e2(root: &Path, trials: usize, out: &Path) -> Result<()> {
     eprintln!("E2: UTF-MINCO vs MINCO, {trials} repetitions per case");
-    let json = cargo_example_json(
+    let stdout = cargo_example_output(
         root,
         "trust-minco",
-        "e2_compare",
+        e2::EXAMPLE,
         &["--repeats", &trials.to_string()],
     )?;
-    let md = format!(
-        "# E2 — UTF-MINCO vs MINCO (paper Table Sim-A-2)\n\n```json\n{}\n```\n\n\
-         Paper: UTF-MINCO 8.98 ms / 7.08 s (static), 9.71 ms / 6.47 s (dynamic); \
-         MINCO 7.77 ms / 7.09 s, 8.52 ms / 6.72 s (collides in the dynamic case).\n",
-        serde_json::to_string_pretty(&json)?
-    );
-    write_outputs(out, &json, &md)
+    let results = e2::parse(&stdout)?;
+    write_outputs(
+        out,
+        &example_json(e2::EXAMPLE, &stdout)?,
+        &e2::report(&results),
+    )
 }
 
 /// Runs `cargo run --release -p trust-sim -- ARGS` in the workspace root, passing the terminal
@@ -309,8 +271,13 @@ fn write_outputs(out: &Path, json: &Value, md: &str) -> Result<()> {
     Ok(())
 }
 
-/// Runs `cargo run --release -p PACKAGE --example EXAMPLE -- ARGS` and parses its stdout as JSON.
-fn cargo_example_json(root: &Path, package: &str, example: &str, args: &[&str]) -> Result<Value> {
+/// Runs `cargo run --release -p PACKAGE --example EXAMPLE -- ARGS` and returns its stdout.
+fn cargo_example_output(
+    root: &Path,
+    package: &str,
+    example: &str,
+    args: &[&str],
+) -> Result<String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let output = Command::new(cargo)
         .current_dir(root)
@@ -331,7 +298,11 @@ fn cargo_example_json(root: &Path, package: &str, example: &str, args: &[&str]) 
     if !output.status.success() {
         bail!("example {example} failed with {}", output.status);
     }
-    let stdout = String::from_utf8(output.stdout).context("example output is not UTF-8")?;
+    String::from_utf8(output.stdout).context("example output is not UTF-8")
+}
+
+/// The example's output as it printed it, archived in `results.json`.
+fn example_json(example: &str, stdout: &str) -> Result<Value> {
     serde_json::from_str(stdout.trim())
         .with_context(|| format!("example {example} did not print one JSON object: {stdout}"))
 }

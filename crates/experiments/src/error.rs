@@ -26,6 +26,15 @@ pub enum ExperimentError {
     /// A run log could not be read.
     #[error(transparent)]
     Log(#[from] trust_runlog::LogError),
+    /// An experiment's example printed JSON that does not match its type (the message names the
+    /// missing, unknown or mistyped field).
+    #[error("example {example} printed JSON that does not match its type: {source}")]
+    ExampleOutput {
+        /// The example's name.
+        example: &'static str,
+        /// serde_json's reason, naming the field.
+        source: serde_json::Error,
+    },
     /// A file could not be read or written.
     #[error("cannot write {}: {source}", path.display())]
     Write {
