@@ -100,6 +100,7 @@ mod error;
 mod params;
 mod planner;
 mod route;
+pub mod scenes;
 
 /// The public vector type: `nalgebra::Vector3<f64>` (as in `trust-geometry`).
 pub type Vec3 = nalgebra::Vector3<f64>;

@@ -6,6 +6,7 @@ use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use trust_geometry::{AaBox, Aabb, Cylinder, Shape, StaticMap, Vec3};
+use trust_route::scenes::crazyflie_room;
 use trust_route::{Endpoint, GlobalRoute, RouteError, RouteParams, RoutePlanner};
 
 fn planner() -> RoutePlanner {
@@ -105,23 +106,9 @@ fn a_cul_de_sac_opening_toward_the_start_is_left_by_its_mouth() {
     assert!(route.points().iter().any(|p| p.y < 20.0 || p.y > 40.0));
 }
 
-/// An 8 × 6 × 3 m room with four 5 cm pillars and a wall across most of the middle.
-fn crazyflie_room() -> StaticMap {
-    let mut shapes: Vec<Shape> = [(2.5, 2.0), (2.5, 4.0), (5.5, 2.0), (5.5, 4.0)]
-        .iter()
-        .map(|&(x, y)| {
-            Cylinder::new(Vec3::new(x, y, 1.5), 0.05, 1.5)
-                .unwrap()
-                .into()
-        })
-        .collect();
-    shapes.push(aabox([3.9, 0.0, 0.0], [4.1, 4.5, 3.0]));
-    StaticMap::from_shapes(bounds([8.0, 6.0, 3.0]), shapes).unwrap()
-}
-
 #[test]
 fn a_crazyflie_room_with_thin_pillars_is_crossed_with_clearance() {
-    let map = crazyflie_room();
+    let map = crazyflie_room().expect("room map");
     let (s, g) = (Vec3::new(1.0, 1.0, 1.0), Vec3::new(7.0, 1.0, 1.5));
     let route = planner().plan(&map, &s, &g, 0.1).unwrap();
     assert_relative_eq!(route.clearance_m(), 0.15);
