@@ -352,8 +352,10 @@ proptest! {
         let p = planner();
         let route = match p.plan(&map, &s, &g, r) {
             Ok(route) => route,
-            // A random map may wall the goal off; that must be the typed answer, never a panic.
-            Err(RouteError::Unreachable { .. }) => return Ok(()),
+            // A random map may wall the goal off; that must be a typed answer, never a panic:
+            // `Unreachable`, or the expansion cap when the walled-in free space is larger than
+            // the cap (regression_seed_5240_big_map_ends_in_a_typed_answer).
+            Err(RouteError::Unreachable { .. } | RouteError::ExpansionCap { .. }) => return Ok(()),
             Err(e) => return Err(TestCaseError::fail(format!("{e}"))),
         };
         assert_clear(&map, &route);
@@ -388,5 +390,29 @@ proptest! {
             prop_assert!(((lg.point - proj.point).norm() - horizon).abs() < 1e-6);
         }
         prop_assert!((route.remaining_length(&pos).unwrap() - (route.length() - proj.s)).abs() < 1e-9);
+    }
+}
+
+/// CI's commit-derived proptest seed 564830140411337884 drew this map (120 × 40 × 10 m, r = 0.3):
+/// the search ran into its expansion cap. Whatever the map, the answer must be typed and the
+/// search must stop at the cap; with a cap large enough to exhaust the reachable space the
+/// answer is a route or `Unreachable`, never the cap.
+#[test]
+fn regression_seed_5240_big_map_ends_in_a_typed_answer() {
+    let (map, s, g) = random_map(5240, [120.0, 40.0, 10.0], 40, 0.3);
+    match planner().plan(&map, &s, &g, 0.3) {
+        Ok(route) => assert_clear(&map, &route),
+        Err(RouteError::Unreachable { .. } | RouteError::ExpansionCap { .. }) => {}
+        Err(e) => panic!("unexpected error: {e}"),
+    }
+    let exhaustive = RoutePlanner::new(RouteParams {
+        max_expansions: 20_000_000,
+        ..RouteParams::default()
+    })
+    .unwrap();
+    match exhaustive.plan(&map, &s, &g, 0.3) {
+        Ok(route) => assert_clear(&map, &route),
+        Err(RouteError::Unreachable { .. }) => {}
+        Err(e) => panic!("with the cap out of the way: {e}"),
     }
 }
