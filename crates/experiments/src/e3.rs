@@ -97,7 +97,9 @@ pub struct E3Summary {
 /// file-system or plotting failures.
 pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, ExperimentError> {
     let world = World::build(scenario)?;
-    let resolved = scenario.resolve_planner();
+    // The paper's table: the branches of one cycle aimed at the final goal, no global route.
+    let mut resolved = scenario.resolve_planner();
+    resolved.route = None;
     let trust_flight::Setup {
         sensing,
         mut manager,

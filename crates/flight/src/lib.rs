@@ -40,6 +40,7 @@ use serde::{Deserialize, Serialize};
 use trust_core::{PolyTraj, Scene, Vec3};
 use trust_manager::{Event, Hit, StepReport};
 use trust_plot::quantile_sorted;
+use trust_route::GlobalRoute;
 
 use trust_world::World;
 use trust_world::planner::{self, AnyManager, ResolvedPlanner};
@@ -405,7 +406,12 @@ pub fn fly(
                         .iter()
                         .filter(|e| matches!(e, trust_manager::Event::Reanchored { .. }))
                         .count();
-                    log.cycle(cycle_record(&report, effective, options.zero_timing))?;
+                    log.cycle(cycle_record(
+                        &report,
+                        manager.route(),
+                        effective,
+                        options.zero_timing,
+                    ))?;
                 }
                 Err(e) => {
                     ended = Some((Status::Invalid, None, Some(e.to_string())));
@@ -545,8 +551,21 @@ impl Logger {
     }
 }
 
-fn cycle_record(report: &StepReport, effective_t: f64, zero_timing: bool) -> CycleRecord {
+fn cycle_record(
+    report: &StepReport,
+    route: Option<&GlobalRoute>,
+    effective_t: f64,
+    zero_timing: bool,
+) -> CycleRecord {
     let time = |x: f64| if zero_timing { 0.0 } else { x };
+    let rerouted = report
+        .events
+        .iter()
+        .any(|e| matches!(e, Event::Rerouted { .. }));
+    let planned = report
+        .events
+        .iter()
+        .any(|e| matches!(e, Event::Rerouted { .. } | Event::RouteFailed { .. }));
     CycleRecord {
         t: report.t,
         wall_ms: time(report.timing.wall_ms),
@@ -561,6 +580,10 @@ fn cycle_record(report: &StepReport, effective_t: f64, zero_timing: bool) -> Cyc
         branch_j: report.branches.iter().map(|b| b.j).collect(),
         fallback_collision_free: report.fallback.as_ref().map(|f| f.collision_free),
         dropped: dropped(report),
+        route: route
+            .filter(|_| rerouted)
+            .map(|r| r.points().iter().map(v3).collect()),
+        route_ms: planned.then(|| time(report.timing.route_ms)),
     }
 }
 

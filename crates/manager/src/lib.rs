@@ -81,6 +81,7 @@ mod manager;
 mod params;
 pub mod progress;
 mod report;
+pub mod routing;
 pub mod safety;
 
 pub use brake::{brake_along, brake_straight, hermite_quintic};
@@ -91,4 +92,5 @@ pub use report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
     Origin, StepReport,
 };
+pub use routing::Router;
 pub use safety::{Hit, SafetyVerdict, Violation, assess_trajectory, check_trajectory};

@@ -22,6 +22,8 @@ use crate::safety::{
 };
 use trust_route::GlobalRoute;
 
+use crate::routing::{RouteReason, Router, plan_route};
+
 /// One kept trajectory branch.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Branch {
@@ -183,6 +185,10 @@ pub struct Manager<F, B, H> {
     cycle_count: u64,
     progress: ProgressMonitor,
     route: Option<GlobalRoute>,
+    router: Option<Router>,
+    /// The goal the last route was planned toward (planned or failed), so a failing plan is not
+    /// retried every cycle.
+    routed_goal: Option<Vec3>,
 }
 
 impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
@@ -223,6 +229,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             next_id: 0,
             progress: ProgressMonitor::default(),
             route: None,
+            router: None,
+            routed_goal: None,
             cycle_count: 0,
         })
     }
@@ -260,6 +268,19 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     /// Without a route every cycle is exactly as before (the paper's setting).
     pub fn set_route(&mut self, route: Option<GlobalRoute>) {
         self.route = route;
+    }
+
+    /// Gives the manager a route planner (or with `None` takes it away): it then plans its own
+    /// route before the first cycle toward a goal and again on a stall ([`crate::routing`]),
+    /// replacing any route given with [`Manager::set_route`] at those moments.
+    pub fn set_router(&mut self, router: Option<Router>) {
+        self.router = router;
+        self.routed_goal = None;
+    }
+
+    /// The route planner, if any ([`Manager::set_router`]).
+    pub fn router(&self) -> Option<&Router> {
+        self.router.as_ref()
     }
 
     /// The global route, if any ([`Manager::set_route`]).
@@ -316,6 +337,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     pub fn reset(&mut self) {
         self.cycle_count = 0;
         self.progress.reset();
+        self.routed_goal = None;
         self.branches.clear();
         self.main = None;
         self.committed = None;
@@ -341,6 +363,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let mut spans = Spans::start();
         check_step_input(now, measured, goal, scene)?;
         let mut cycle = self.begin_cycle(now, measured, goal, spans.started);
+        self.update_route(&mut cycle, measured, scene, &mut spans);
 
         // Algorithm 1, lines 5–8: FwdMarch of the main branch and BwdReplan of the sub-branches,
         // in parallel with FwdExplore.
@@ -383,6 +406,40 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         })
     }
 
+    /// Plans the global route with the router ([`Manager::set_router`]) when there is none
+    /// toward this goal yet, or when the progress monitor has just declared a stall; the
+    /// progress monitor is carried over to the new route's arc length.
+    fn update_route(
+        &mut self,
+        cycle: &mut Cycle,
+        measured: &State,
+        scene: &Scene<'_>,
+        spans: &mut Spans,
+    ) {
+        let Some(router) = &self.router else {
+            return;
+        };
+        let goal = cycle.goal;
+        let reason = if self.routed_goal.is_none_or(|g| (g - goal).norm() > 1e-9) {
+            RouteReason::First
+        } else if cycle.newly_stalled {
+            RouteReason::Stalled
+        } else {
+            return;
+        };
+        let (route, event) = spans.time(Span::Route, || {
+            plan_route(router, scene.map, &measured.p, &goal, reason)
+        });
+        cycle.events.push(event);
+        self.routed_goal = Some(goal);
+        if let Some(route) = route {
+            let before = self.progress_at(&measured.p, &goal);
+            self.route = Some(route);
+            let after = self.progress_at(&measured.p, &goal);
+            self.progress.rebase(after - before);
+        }
+    }
+
     /// The cycle's starting point: the replan start, the ranking weights, the deadline and
     /// whether FwdExplore runs this cycle.
     fn begin_cycle(&mut self, now: f64, measured: &State, goal: &Vec3, started: Instant) -> Cycle {
@@ -394,7 +451,9 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             .rule(&self.limits, self.params.horizon_s);
         let distance = (measured.p - goal).norm();
         let progress = self.progress_at(&measured.p, goal);
-        events.extend(self.progress.update(now, progress, distance, &rule));
+        let stall_event = self.progress.update(now, progress, distance, &rule);
+        let newly_stalled = matches!(stall_event, Some(Event::Stalled { .. }));
+        events.extend(stall_event);
         let stalled = self.progress.stalled();
         let explore = stalled
             || !self.params.history
@@ -408,6 +467,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             start,
             goal: *goal,
             stalled,
+            newly_stalled,
             reanchored,
             weights: self.params.ranking_weights(&self.limits),
             deadline: self
@@ -918,6 +978,8 @@ struct Cycle {
     goal: Vec3,
     /// The flight is stalled ([`crate::progress`]): explore with more paths and rank by progress.
     stalled: bool,
+    /// The stall began this cycle (the router, if any, re-plans the route).
+    newly_stalled: bool,
     /// Whether the replan start was re-anchored on the measured state.
     reanchored: bool,
     /// The ranking weights of `J`.
@@ -1008,6 +1070,8 @@ fn fwd_explore<F: PathFrontend, B: TrajectoryBackend>(
 enum Span {
     /// The frontend search ([`CycleTiming::frontend_ms`]).
     Frontend,
+    /// Planning the global route ([`CycleTiming::route_ms`]).
+    Route,
     /// Homotopy checks, safety checks outside the parallel solves, and the fallback's
     /// ([`CycleTiming::checker_ms`]).
     Checks,
@@ -1036,6 +1100,7 @@ impl Spans {
         let elapsed = ms(t.elapsed());
         match span {
             Span::Frontend => self.timing.frontend_ms += elapsed,
+            Span::Route => self.timing.route_ms += elapsed,
             Span::Checks => self.timing.checker_ms += elapsed,
         }
         out

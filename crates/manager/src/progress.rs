@@ -103,6 +103,22 @@ impl ProgressMonitor {
         *self = Self::default();
     }
 
+    /// Shifts every recorded progress by `offset_m` (m): the progress coordinate changed (a new
+    /// route, whose arc length at the vehicle differs from the old one's by `offset_m`), the
+    /// vehicle did not move. A stall stays a stall.
+    pub fn rebase(&mut self, offset_m: f64) {
+        if !offset_m.is_finite() {
+            self.reset();
+            return;
+        }
+        for (_, p) in &mut self.samples {
+            *p += offset_m;
+        }
+        if let Some((_, at)) = &mut self.stalled_at {
+            *at += offset_m;
+        }
+    }
+
     /// Records the progress `progress_m` (m; larger is nearer the goal, e.g. minus the distance
     /// to it) at time `t` with the vehicle `distance_to_goal_m` from the goal, and returns
     /// [`Event::Stalled`] or [`Event::Escaped`] when the state changes. Non-finite input is

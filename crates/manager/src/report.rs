@@ -159,6 +159,24 @@ pub enum Event {
         /// Distance from the vehicle to the goal (m).
         distance_to_goal_m: f64,
     },
+    /// The manager planned its global route ([`crate::routing`]): `reason` is `"first"` (no
+    /// route yet toward this goal) or `"stalled"` (after [`Event::Stalled`]).
+    Rerouted {
+        /// Why the route was planned.
+        reason: String,
+        /// Its length (m).
+        length_m: f64,
+        /// Its vertices, start and goal included.
+        vertex_count: usize,
+    },
+    /// The route planner failed (unreachable goal, a cap); the manager keeps its previous route,
+    /// or aims at the final goal without one.
+    RouteFailed {
+        /// Why the route was planned.
+        reason: String,
+        /// The route planner's error message.
+        error: String,
+    },
     /// The vehicle progressed again after [`Event::Stalled`] (or came near the goal).
     Escaped {
         /// How long the stall lasted (s).
@@ -197,6 +215,8 @@ impl Event {
             Event::Fallback { .. } => "fallback",
             Event::Stalled { .. } => "stalled",
             Event::Escaped { .. } => "escaped",
+            Event::Rerouted { .. } => "rerouted",
+            Event::RouteFailed { .. } => "route_failed",
         }
     }
 }
@@ -239,6 +259,9 @@ pub struct CycleTiming {
     pub backend_ms: f64,
     /// Sum of homotopy checks and safety checks (CPU time across threads).
     pub checker_ms: f64,
+    /// Planning the global route ([`crate::routing`]); 0 in the cycles that do not plan one.
+    #[serde(default)]
+    pub route_ms: f64,
     /// Trajectories optimized this cycle.
     pub solve_count: usize,
     /// The part of `backend_ms` spent on cold solves from frontend paths (FwdExplore); the rest

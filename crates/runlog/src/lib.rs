@@ -203,6 +203,13 @@ pub struct CycleRecord {
     /// Added: what the safety check dropped this cycle, by the first violation's cause.
     #[serde(default, skip_serializing_if = "Dropped::is_empty")]
     pub dropped: Dropped,
+    /// Added: the global route the manager planned this cycle (event `rerouted`), start first;
+    /// absent in the cycles that planned none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub route: Option<Vec<[f64; 3]>>,
+    /// Added: time spent planning that route (ms); absent when none was planned.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub route_ms: Option<f64>,
 }
 
 /// Trajectories the safety check dropped in one cycle, by cause of the first violation.

@@ -58,8 +58,9 @@ use trust_core::{
     Curve, HomotopyChecker, Limits, PathFrontend, PathQuery, PlanError, Rng, Scene, SearchResult,
     Solution, TrajRequest, TrajectoryBackend,
 };
-use trust_manager::{Manager, ManagerParams, ProgressParams, ReanchorParams, SafetyParams};
+use trust_manager::{Manager, ManagerParams, ProgressParams, ReanchorParams, Router, SafetyParams};
 use trust_minco::{Minco, MincoParams, UtfMinco, UtfMincoParams};
+use trust_route::{RouteError, RouteParams};
 use trust_topo_prm::{
     DevPrm, DevPrmParams, SparseAStar, SparseAStarParams, StraightLine, Tvd, TvdParams, Uvd,
     UvdParams, Vprm, VprmParams,
@@ -646,6 +647,32 @@ pub struct PlannerSpec {
     pub checker: Option<CheckerSpec>,
     /// Replaces single fields of the preset's manager parameters.
     pub manager: Option<ManagerOverrides>,
+    /// The global route (`[planner.route]`, beyond the paper; [`RouteSpec`]). On by default.
+    pub route: RouteSpec,
+}
+
+/// Scenario section `[planner.route]`: whether the manager plans and follows a global route on
+/// the known static map (`trust_manager::routing`), and the route planner's parameters
+/// (`[planner.route.params]`, `trust_route::RouteParams`; every length there is relative to the
+/// vehicle radius). The paper has no route: every query aims at the final goal, which is what
+/// `enabled = false` flies — and what the E4 study flies unless given `--variant route`, so
+/// that the paper's comparison stays the paper's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RouteSpec {
+    /// Plan and follow a global route. Default `true`.
+    pub enabled: bool,
+    /// The route planner's parameters. Default `RouteParams::default()`.
+    pub params: RouteParams,
+}
+
+impl Default for RouteSpec {
+    fn default() -> Self {
+        RouteSpec {
+            enabled: true,
+            params: RouteParams::default(),
+        }
+    }
 }
 
 impl Default for PlannerSpec {
@@ -658,6 +685,7 @@ impl Default for PlannerSpec {
             backend: None,
             checker: None,
             manager: None,
+            route: RouteSpec::default(),
         }
     }
 }
@@ -680,6 +708,9 @@ pub struct ResolvedPlanner {
     pub reproducible: bool,
     /// See [`PlannerSpec::clearance_margin_m`].
     pub clearance_margin_m: f64,
+    /// The route planner's parameters when the route is on ([`PlannerSpec::route`]); `None`
+    /// flies the paper's setting (every query aims at the final goal).
+    pub route: Option<RouteParams>,
 }
 
 impl PlannerSpec {
@@ -718,6 +749,7 @@ impl PlannerSpec {
             manager,
             reproducible: self.reproducible,
             clearance_margin_m: self.clearance_margin_m,
+            route: self.route.enabled.then(|| self.route.params.clone()),
         }
     }
 
@@ -734,7 +766,29 @@ impl PlannerSpec {
         if let Err(e) = r.manager.validate() {
             p.list.push(plan_problem(e, "manager", "planner.manager"));
         }
+        if let Err(e) = self.route.params.validate() {
+            p.list.push(route_problem(e));
+        }
         p.list
+    }
+}
+
+/// A route-parameter error as a problem under `planner.route.params`.
+fn route_problem(e: RouteError) -> Problem {
+    match e {
+        RouteError::InvalidParam {
+            field,
+            value,
+            expected,
+        } => Problem {
+            field: format!(
+                "planner.route.params.{}",
+                field.strip_prefix("route.").unwrap_or(&field)
+            ),
+            value: format!("{value}"),
+            expected,
+        },
+        other => Problem::new("planner.route.params", other, "valid route parameters"),
     }
 }
 
@@ -847,13 +901,11 @@ pub fn build(resolved: &ResolvedPlanner, ctx: &PlannerContext) -> Result<AnyMana
     let frontend = eff.frontend.build()?;
     let backend = eff.backend.build()?;
     let checker = eff.checker.build()?;
-    Ok(Manager::new(
-        frontend,
-        backend,
-        checker,
-        ctx.limits,
-        eff.manager,
-    )?)
+    let mut manager = Manager::new(frontend, backend, checker, ctx.limits, eff.manager)?;
+    if let Some(params) = eff.route {
+        manager.set_router(Some(Router::new(params, ctx.vehicle_radius_m)?));
+    }
+    Ok(manager)
 }
 
 #[cfg(test)]

@@ -159,6 +159,9 @@ impl StudyConfig {
         s.planner.backend = None;
         s.planner.checker = None;
         s.planner.manager = None;
+        // The paper's setting: no global route (every query aims at the final goal), unless the
+        // variant is `route`.
+        s.planner.route.enabled = false;
         self.variant.apply(&mut s)?;
         Ok(s)
     }

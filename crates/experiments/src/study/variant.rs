@@ -47,13 +47,17 @@ pub enum Variant {
     /// (`manager.explore_period_cycles`); `K = 1` explores every cycle as the paper's Algorithm 1
     /// does (the warm re-solve budgets stay).
     Explore(usize),
+    /// `route`: every planner follows a global route on the known static map
+    /// (`[planner.route]`, beyond the paper). Without it a study flies the paper's setting: every
+    /// query aims at the final goal.
+    Route,
 }
 
 impl Variant {
     /// Every variant name, for help texts.
     pub const NAMES: &'static str = "none, vprm, minco, uvd, no-pdc, no-ggs, no-history, \
                                      no-hysteresis, perfect, quadrotor, mu=X, fault=X, \
-                                     explore=K";
+                                     explore=K, route";
 
     /// Applies the variant to `scenario` (whose planner preset is already chosen): replaces the
     /// preset's part it concerns, or the scenario section it sweeps.
@@ -121,6 +125,7 @@ impl Variant {
             Variant::Mu(x) => scenario.sensing.ekf.sigma_scale *= x,
             Variant::Fault(x) => scenario.traffic.fault_level = x,
             Variant::Explore(k) => manager_overrides(planner).explore_period_cycles = Some(k),
+            Variant::Route => planner.route.enabled = true,
         }
         Ok(())
     }
@@ -149,6 +154,7 @@ impl fmt::Display for Variant {
             Variant::Mu(x) => write!(f, "mu={x}"),
             Variant::Fault(x) => write!(f, "fault={x}"),
             Variant::Explore(k) => write!(f, "explore={k}"),
+            Variant::Route => f.write_str("route"),
         }
     }
 }
@@ -173,6 +179,7 @@ impl FromStr for Variant {
             "minco" => Variant::Minco,
             "uvd" => Variant::Uvd,
             "no-pdc" => Variant::NoPdc,
+            "route" => Variant::Route,
             "no-ggs" => Variant::NoGgs,
             "no-history" => Variant::NoHistory,
             "no-hysteresis" => Variant::NoHysteresis,
@@ -245,6 +252,7 @@ mod tests {
             "mu=2",
             "fault=0.5",
             "explore=3",
+            "route",
         ] {
             let v: Variant = name.parse().unwrap();
             assert_eq!(v.to_string(), name);
