@@ -579,6 +579,11 @@ fn cycle_record(
         effective_t,
         branch_j: report.branches.iter().map(|b| b.j).collect(),
         fallback_collision_free: report.fallback.as_ref().map(|f| f.collision_free),
+        fallback_shortfall_m: report
+            .fallback
+            .as_ref()
+            .filter(|f| !f.collision_free)
+            .map(|f| f.shortfall_m),
         dropped: dropped(report),
         route: route
             .filter(|_| rerouted)

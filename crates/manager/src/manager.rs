@@ -914,6 +914,14 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         if let Ok(b) = brake_straight(start, a_max, hold_s) {
             options.push(("straight", b));
         }
+        // Beyond the paper: the rejected trajectories flown as they are. Braking is the answer
+        // to an obstacle ahead, not to one walking into a vehicle at rest (the suite's rooms with
+        // people: the stopped vehicle was run into); a trajectory that keeps moving stays clear
+        // longer there, and the next cycle replans from it. Only taken when no braking option is
+        // collision-free and it is clear for longer than every one of them.
+        for (_, traj) in rejected {
+            options.push(("evade", traj.clone()));
+        }
         // The first collision-free option; else the one that collides latest, then least deeply.
         let mut best: Option<(usize, SafetyVerdict)> = None;
         let rank =
@@ -951,6 +959,11 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             along: along.into(),
             collision_free,
             min_margin_m: verdict.min_margin_m(),
+            shortfall_m: if collision_free {
+                0.0
+            } else {
+                (-verdict.min_margin_m()).max(0.0)
+            },
             stop_time,
         })
     }

@@ -186,7 +186,9 @@ pub enum Event {
     },
     /// No branch was feasible: the plan is a braking fallback.
     Fallback {
-        /// What it brakes along: `"committed"`, `"branch"`, `"candidate"` or `"straight"`.
+        /// What it brakes along: `"committed"`, `"branch"`, `"candidate"` or `"straight"`; or
+        /// `"evade"`: a trajectory the safety pass rejected, flown as it is because it stays
+        /// clear longer than every braking option (an obstacle coming at a vehicle at rest).
         along: String,
         /// Whether it passed the safety check against the current forecasts.
         collision_free: bool,
@@ -308,6 +310,9 @@ pub struct FallbackReport {
     pub collision_free: bool,
     /// Its smallest clearance margin (m).
     pub min_margin_m: f64,
+    /// How far it fails to keep the required clearance (m): `max(0, −min_margin_m)` when it is
+    /// not collision-free, 0 when it is. A fallback that cannot stop clear says by how much.
+    pub shortfall_m: f64,
     /// Time (s) at which it is at rest.
     pub stop_time: f64,
 }

@@ -40,4 +40,6 @@ pub use params::{
 pub use penalties::{BrakingTail, PenaltyIntegrals, PenaltyIntegrand, TAIL_RAMP_MPS};
 pub use smooth::{SmoothedL1, smoothed_l1};
 pub use static_map::StaticObstacleTerm;
-pub use terminal::{TerminalCost, smoothed_weighted_norm, terminal_velocity_weight, time_cost};
+pub use terminal::{
+    TerminalCost, final_approach_gain, smoothed_weighted_norm, terminal_velocity_weight, time_cost,
+};

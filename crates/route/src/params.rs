@@ -48,6 +48,13 @@ pub struct RouteParams {
     /// A start or goal inside the inflated obstacles snaps to the nearest free cell within
     /// `snap_radius_factor · c`. Range `[0, 100]`; default 4.
     pub snap_radius_factor: f64,
+    /// Coarse to fine: the search first runs on cells `coarse_factor` times larger than `h₀`
+    /// and only falls back to `h₀` when that grid finds no route (a passage narrower than its
+    /// inflated cells). Range `[1, 64]`, `1` searches the fine grid only; default 4: a coarse
+    /// route is as safe (a coarse cell is free only farther from the obstacles) and the search
+    /// touches 4³ = 64 times fewer cells — on the suite's shaft climb (a 40 × 40 m slab with one
+    /// 4 × 4 m shaft, the search fills the whole space below the slab) 3.3 s became TIME_MS.
+    pub coarse_factor: f64,
     /// Replace the grid path by the greedy line-of-sight shortcut (each kept segment checked with
     /// `StaticMap::segment_clear` at the inflated clearance). Default true.
     pub shortcut: bool,
@@ -71,6 +78,7 @@ impl Default for RouteParams {
             max_expansions: 2_000_000,
             heuristic_weight: DEFAULT_HEURISTIC_WEIGHT,
             snap_radius_factor: 4.0,
+            coarse_factor: 4.0,
             shortcut: true,
         }
     }
@@ -98,6 +106,7 @@ impl RouteParams {
         )?;
         check_range("route.max_coarsening", self.max_coarsening, 1.0, 16.0)?;
         check_range("route.heuristic_weight", self.heuristic_weight, 1.0, 10.0)?;
+        check_range("route.coarse_factor", self.coarse_factor, 1.0, 64.0)?;
         check_range(
             "route.snap_radius_factor",
             self.snap_radius_factor,

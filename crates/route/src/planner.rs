@@ -130,6 +130,16 @@ struct Search<'a> {
     parent: Vec<u32>,
 }
 
+/// The two ends of a route query and what [`RoutePlanner::plan_until`] found about them.
+#[derive(Debug, Clone, Copy)]
+struct Ends {
+    start: Vec3,
+    goal: Vec3,
+    start_free: bool,
+    goal_free: bool,
+    clearance: f64,
+}
+
 /// A heap entry: smallest `f` first, then largest `g` (deeper first), then smallest index.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Open {
@@ -425,7 +435,50 @@ impl RoutePlanner {
                     .to_owned(),
             });
         }
-        let grid = Grid::new(map.bounds(), h0, p.max_cells, h0 * p.max_coarsening)?;
+        let ends = Ends {
+            start,
+            goal,
+            start_free,
+            goal_free,
+            clearance,
+        };
+        // Coarse to fine: a coarse grid's free cells are farther from the obstacles (the node
+        // clearance grows with the cell), so a coarse route is as safe as a fine one; only when
+        // the coarse grid finds none (a passage too narrow for it) does the fine grid search.
+        let mut expanded_before = 0;
+        if p.coarse_factor > 1.0 {
+            let coarse = h0 * p.coarse_factor;
+            match self.grid_route(map, &ends, coarse, coarse, deadline) {
+                Ok(route) => return Ok(route),
+                Err(RouteError::Unreachable { expanded, .. }) => expanded_before = expanded,
+                Err(RouteError::NoFreeCell { .. }) => {}
+                Err(e) => return Err(e),
+            }
+        }
+        let mut route = self.grid_route(map, &ends, h0, h0 * p.max_coarsening, deadline)?;
+        route.add_expanded(expanded_before);
+        Ok(route)
+    }
+
+    /// A* on a grid of cells of size `h` (coarsened up to `h_max` to fit `max_cells`) between
+    /// the ends, then the shortcut.
+    fn grid_route(
+        &self,
+        map: &StaticMap,
+        ends: &Ends,
+        h0: f64,
+        h_max: f64,
+        deadline: Option<Instant>,
+    ) -> Result<GlobalRoute, RouteError> {
+        let p = &self.params;
+        let Ends {
+            start,
+            goal,
+            start_free,
+            goal_free,
+            clearance,
+        } = *ends;
+        let grid = Grid::new(map.bounds(), h0, p.max_cells, h_max)?;
         let n = grid.len();
         let mut search = Search {
             map,

@@ -200,6 +200,10 @@ pub struct CycleRecord {
     /// Added: whether the plan is a braking fallback, and whether it was collision-free.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback_collision_free: Option<bool>,
+    /// Added, only on fallback cycles that are not collision-free: by how much (m) the fallback
+    /// fails to keep the required clearance under the forecasts.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback_shortfall_m: Option<f64>,
     /// Added: what the safety check dropped this cycle, by the first violation's cause.
     #[serde(default, skip_serializing_if = "Dropped::is_empty")]
     pub dropped: Dropped,

@@ -8,7 +8,7 @@ use super::params::PieceParams;
 use super::time_map::{positive_time, positive_time_inverse};
 use crate::costs::{
     BrakingTail, CostWeights, PenaltyIntegrand, PenaltyParams, PiecewiseView, TerminalCost,
-    TrapezoidIntegrator,
+    TrapezoidIntegrator, final_approach_gain,
 };
 use crate::error::MincoError;
 use crate::minco::{BoundaryState, MincoGrad, MincoS3};
@@ -249,7 +249,14 @@ impl<'a> UtfMincoObjective<'a> {
                 &params.penalty,
                 pieces,
             )?,
-            terminal: TerminalCost::new(goal, &start.p, &params.penalty),
+            terminal: TerminalCost::new(goal, &start.p, &params.penalty).with_approach_gain(
+                final_approach_gain(
+                    params.weights.time,
+                    params.weights.terminal,
+                    limits.a_max,
+                    params.penalty.goal_settle_m,
+                ),
+            ),
             min_total: min_total(&params.pieces, pieces),
             terminal_grad: (Vec3::zeros(), Vec3::zeros(), 0.0),
             tail_setup: {

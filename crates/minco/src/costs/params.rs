@@ -106,6 +106,15 @@ pub struct PenaltyParams {
     /// `d_ε` (m): within this distance of the goal the terminal-velocity weight `α` of eq.
     /// design-of-Hs rises linearly from 0 (at `d_ε`) to 1 (on the goal).
     pub goal_radius_m: f64,
+    /// Settling distance `d_s` (m) of the final approach: near the goal (weighted by `α`) the
+    /// terminal pull is raised so that the free terminal settles within `d_s` of the goal
+    /// instead of `c/(4 a_max)(λ_t/λ_s)²` short of it
+    /// ([`crate::costs::final_approach_gain`]; UTF-MINCO only). Ours, beyond the paper: 0.02 m,
+    /// under half the manager's 0.05 m "reaches the goal" threshold
+    /// (`trust_manager::ManagerParams::goal_reached_m`) and far below every goal tolerance, at
+    /// any scale — the gain it implies scales with `a_max` (3.1 at E4's 15 m/s², 6.9 at a
+    /// Crazyflie's 3 m/s² with `λ_t = λ_s`). Accepted: `[1e-6, 1e6]` m.
+    pub goal_settle_m: f64,
     /// Diagonal of `K_f^p`, the terminal position weights of eq. design-of-Hs.
     pub terminal_position_gains: Vec3,
     /// Diagonal of `K_f^ṗ`, the terminal velocity weights of eq. design-of-Hs.
@@ -157,6 +166,7 @@ impl Default for PenaltyParams {
             dynamic_clearance_m: 0.1,
             static_clearance_m: 0.1,
             goal_radius_m: 10.0,
+            goal_settle_m: 0.02,
             terminal_position_gains: Vec3::new(1.0, 1.0, 1.0),
             terminal_velocity_gains: Vec3::new(1.0, 1.0, 1.0),
             terminal_norm_epsilon: 1e-2,
@@ -178,6 +188,7 @@ impl PenaltyParams {
     /// | `smoothing` | `[1e-9, 1]` ([`MAX_SMOOTHING`]) |
     /// | `dynamic_clearance_m`, `static_clearance_m` | `[0, 1e6]` m (a length) |
     /// | `goal_radius_m`, `guidance_smoothing_m` | `[1e-9, 1e6]` m (a positive length) |
+    /// | `goal_settle_m` | `[1e-6, 1e6]` m |
     /// | `terminal_position_gains`, `terminal_velocity_gains` | each component `[0, 1e6]` |
     /// | `terminal_norm_epsilon` | `[1e-6, 1e6]` ([`TERMINAL_NORM_EPSILON_RANGE`]) |
     /// | `braking_tail_decel_fraction` | `(0, 1]` |
@@ -212,6 +223,7 @@ impl PenaltyParams {
             self.goal_radius_m,
             Quantity::PositiveLength,
         )?;
+        check_range(&field("goal_settle_m"), self.goal_settle_m, 1e-6, 1e6, "m")?;
         check_gains(
             &field("terminal_position_gains"),
             &self.terminal_position_gains,
