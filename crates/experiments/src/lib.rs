@@ -29,5 +29,6 @@ pub mod e3;
 mod error;
 pub mod flight_plots;
 pub mod study;
+pub mod suite;
 
 pub use error::ExperimentError;

@@ -7,6 +7,8 @@
 //! trust-sim ablate [--scenario FILE] [--trials N] [--seed S] [--planners a,b] [--variant V]
 //!                  [--out DIR] [--jobs J] [--shard K/M] [--time-limit T] [--no-plots]
 //! trust-sim ablate-merge --out DIR SHARD_DIR...
+//! trust-sim suite [SCENARIO.toml|DIR...] [--seeds K] [--seed S] [--planners a,b] [--out DIR]
+//!                 [--jobs J] [--time-limit T] [--no-plots]
 //! trust-sim e3 [--scenario FILE] [--seed S] [--out DIR]
 //! ```
 //!
@@ -22,6 +24,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use trust_experiments::flight_plots::write_flight_plots;
 use trust_experiments::study::{RunStudyOptions, Shard, StudyConfig, merge, run_study};
+use trust_experiments::suite::{SuiteConfig, SuiteOptions, expand_paths, run_suite};
 use trust_flight::{RunOptions, fly, header};
 use trust_runlog::RunLog;
 use trust_runlog::audit::audit;
@@ -98,7 +101,8 @@ enum Cmd {
         planners: Vec<String>,
         /// One-component ablation applied to every planner it concerns: none, vprm, minco, uvd,
         /// no-pdc, no-ggs, no-history, no-hysteresis, perfect, quadrotor, mu=X, fault=X,
-        /// explore=K.
+        /// explore=K, route (a global route on the static map; without it every planner aims at
+        /// the final goal, the paper's setting).
         #[arg(long, default_value = "none")]
         variant: String,
         /// Output directory.
@@ -114,6 +118,36 @@ enum Cmd {
         #[arg(long)]
         time_limit: Option<f64>,
         /// Skip the plots.
+        #[arg(long)]
+        no_plots: bool,
+    },
+    /// Fly the scenario suite: every file (one class each; folders expand to their *.toml) with
+    /// K seeds, as written (global route included); writes runs.csv, summary.json, report.md
+    /// (one table per class), outcomes.svg/png and every run log. Exit status 1 if any flight
+    /// collided or was invalid.
+    Suite {
+        /// Scenario files or folders.
+        #[arg(default_value = "scenarios/suite")]
+        scenarios: Vec<PathBuf>,
+        /// Seeds per file and planner: S, S + 1, ..., S + K - 1.
+        #[arg(long, default_value_t = 5)]
+        seeds: usize,
+        /// The first seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Planner presets, comma-separated (default: each file's own `[planner]` section).
+        #[arg(long, value_delimiter = ',')]
+        planners: Vec<String>,
+        /// Output directory.
+        #[arg(long, default_value = "out/suite")]
+        out: PathBuf,
+        /// Worker threads (default: one per core).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Simulated time limit per flight (s), replacing the files'.
+        #[arg(long)]
+        time_limit: Option<f64>,
+        /// Skip the chart.
         #[arg(long)]
         no_plots: bool,
     },
@@ -251,6 +285,53 @@ fn run_cli() -> Result<ExitCode> {
             };
             let rows = run_study(&config, &out, &options)?;
             print_study(&out, rows.len())
+        }
+        Cmd::Suite {
+            scenarios,
+            seeds,
+            seed,
+            planners,
+            out,
+            jobs,
+            time_limit,
+            no_plots,
+        } => {
+            let planners = planners
+                .iter()
+                .map(|p| parse_preset(p.trim()))
+                .collect::<Result<Vec<_>>>()?;
+            let config = SuiteConfig {
+                files: expand_paths(&scenarios)?,
+                seeds,
+                seed,
+                planners,
+                time_limit_s: time_limit,
+            };
+            eprintln!(
+                "{} file(s) × {} seed(s) × {} planner setting(s)",
+                config.files.len(),
+                config.seeds,
+                config.planners.len().max(1)
+            );
+            let options = SuiteOptions {
+                jobs,
+                no_plots,
+                progress: std::io::stderr().is_terminal(),
+            };
+            let rows = run_suite(&config, &out, &options)?;
+            let report = std::fs::read_to_string(out.join("report.md"))
+                .with_context(|| format!("reading {}", out.join("report.md").display()))?;
+            println!("{report}");
+            println!("wrote {} ({} flights)", out.display(), rows.len());
+            let bad = rows
+                .iter()
+                .filter(|r| r.status == "collided" || r.status == "invalid")
+                .count();
+            Ok(if bad == 0 {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::FAILURE
+            })
         }
         Cmd::E3 {
             scenario,

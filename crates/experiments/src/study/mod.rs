@@ -504,7 +504,7 @@ fn sort_rows(rows: &mut [RunRow], planners: &[PlannerPreset]) {
     rows.sort_by_key(|r| (r.trial, rank(&r.planner)));
 }
 
-fn progress_bar(show: bool, total: u64) -> indicatif::ProgressBar {
+pub(crate) fn progress_bar(show: bool, total: u64) -> indicatif::ProgressBar {
     if !show {
         return indicatif::ProgressBar::hidden();
     }
