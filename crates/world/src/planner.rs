@@ -30,15 +30,19 @@
 //! moving-obstacle clearances of the parts stay as given. The static map holds the obstacles
 //! themselves, so:
 //!
-//! * the manager's `safety.static_clearance_m ≥ r + e`, where `e` is how much the planner's map
-//!   may overestimate a distance (0 for analytic shapes; see
-//!   [`crate::World::static_map_error_m`]) — a branch the safety check passes keeps the
-//!   vehicle's body off the true static obstacles;
-//! * the backend's `penalty.static_clearance_m ≥ r + clearance_margin_m + e`: the optimizer aims
-//!   for a margin beyond what the safety check requires (its penalty is soft and sampled);
-//! * DEV-PRM's and V-PRM's `clearance ≥ r` (samples closer than the vehicle radius to an obstacle
-//!   are useless guides; DEV-PRM's `surface_offset` is raised with it, as it must be `≥
-//!   clearance`), sparse A*'s `clearance ≥ r`.
+//! * the manager's `safety.static_clearance_m ≥ r + e + m`, where `e` is how much the planner's
+//!   map may overestimate a distance (0 for analytic shapes; see
+//!   [`crate::World::static_map_error_m`]) and `m` the tracking margin
+//!   ([`PlannerSpec::tracking_margin_m`]) — a branch the safety check passes keeps the true
+//!   vehicle's body off the true static obstacles although it strays from its plan by up to
+//!   `m`; likewise `safety.dynamic_clearance_m ≥ m` beyond every forecast. The braking
+//!   fallback is checked with the same parameters;
+//! * the backend's `penalty.static_clearance_m ≥ r + max(clearance_margin_m, m) + e` and
+//!   `penalty.dynamic_clearance_m ≥ m`: the optimizer aims for at least what the safety check
+//!   requires (its penalty is soft and sampled);
+//! * DEV-PRM's and V-PRM's `clearance ≥ r + m` (samples closer than that to an obstacle are
+//!   useless guides; DEV-PRM's `surface_offset` is raised with it, as it must be `≥
+//!   clearance`), sparse A*'s `clearance ≥ r + m`.
 //!
 //! Each is a lower bound: a larger value in the scenario is kept.
 //!
@@ -639,6 +643,12 @@ pub struct PlannerSpec {
     /// Margin (m) of the backend's static clearance beyond the vehicle radius (module docs).
     /// Default 0.1 m: the backends' own default static clearance.
     pub clearance_margin_m: f64,
+    /// Tracking margin `m` (m): how far the true vehicle may stray from its plan. The manager's
+    /// safety check (and with it the braking fallback) keeps `r + e + m` from the static map and
+    /// `m` beyond every forecast; the backend's penalties and the frontends' clearances are
+    /// raised to at least that (module docs). Default `None`: [`tracking_margin_for`] the
+    /// vehicle's `a_max`.
+    pub tracking_margin_m: Option<f64>,
     /// Replaces the preset's frontend.
     pub frontend: Option<FrontendSpec>,
     /// Replaces the preset's backend.
@@ -681,6 +691,7 @@ impl Default for PlannerSpec {
             name: PlannerPreset::Trust,
             reproducible: true,
             clearance_margin_m: 0.1,
+            tracking_margin_m: None,
             frontend: None,
             backend: None,
             checker: None,
@@ -708,6 +719,8 @@ pub struct ResolvedPlanner {
     pub reproducible: bool,
     /// See [`PlannerSpec::clearance_margin_m`].
     pub clearance_margin_m: f64,
+    /// See [`PlannerSpec::tracking_margin_m`].
+    pub tracking_margin_m: Option<f64>,
     /// The route planner's parameters when the route is on ([`PlannerSpec::route`]); `None`
     /// flies the paper's setting (every query aims at the final goal).
     pub route: Option<RouteParams>,
@@ -749,6 +762,7 @@ impl PlannerSpec {
             manager,
             reproducible: self.reproducible,
             clearance_margin_m: self.clearance_margin_m,
+            tracking_margin_m: self.tracking_margin_m,
             route: self.route.enabled.then(|| self.route.params.clone()),
         }
     }
@@ -759,6 +773,9 @@ impl PlannerSpec {
     pub fn problems(&self) -> Vec<Problem> {
         let mut p = Problems::default();
         p.non_negative("planner.clearance_margin_m", self.clearance_margin_m);
+        if let Some(m) = self.tracking_margin_m {
+            p.non_negative("planner.tracking_margin_m", m);
+        }
         let r = self.resolve();
         r.frontend.check(&mut p);
         r.backend.check(&mut p);
@@ -771,6 +788,20 @@ impl PlannerSpec {
         }
         p.list
     }
+}
+
+/// The default tracking margin (m) for a vehicle with acceleration limit `a_max` (m/s²):
+/// `0.01 + 0.0015·a_max` — 14.5 mm at a Crazyflie's 3 m/s², 32.5 mm at E4's 15 m/s².
+///
+/// Measured on the default quadrotor model (`trust_vehicle`, SE(3) controller at 500 Hz): the
+/// largest deviation from the plan is 1.1 / 7.3 mm on the gentle / aggressive figure-eight
+/// (4 / 9.5 m/s, 4.1 / 12.8 m/s²; `trust_vehicle` docs) and, worst, during the manager's
+/// braking manoeuvre from `v_max` (`crates/flight/tests/braking.rs`): 6.9 mm at 1 m/s and
+/// 3 m/s², 13.5 mm at 5 m/s and 8 m/s², 21.8 mm at 10 m/s and 15 m/s² — it grows with the
+/// deceleration's ramp (`a_max` over 0.2 s), i.e. with `a_max`. The rule stays 1.5–2.1 times
+/// above every measurement; the braking test asserts it.
+pub fn tracking_margin_for(a_max: f64) -> f64 {
+    0.01 + 0.0015 * a_max
 }
 
 /// A route-parameter error as a problem under `planner.route.params`.
@@ -833,22 +864,25 @@ pub fn effective(
         ));
     }
     let mut out = resolved.clone();
+    let m = out
+        .tracking_margin_m
+        .unwrap_or_else(|| tracking_margin_for(ctx.limits.a_max));
     match &mut out.frontend {
         FrontendSpec::DevPrm(x) => {
-            x.clearance = x.clearance.max(r);
+            x.clearance = x.clearance.max(r + m);
             x.surface_offset = x.surface_offset.max(x.clearance);
             if out.reproducible {
                 x.budget_ms = x.budget_ms.max(REPRODUCIBLE_BUDGET_MS);
             }
         }
         FrontendSpec::VPrm(x) => {
-            x.clearance = x.clearance.max(r);
+            x.clearance = x.clearance.max(r + m);
             if out.reproducible {
                 x.budget_ms = x.budget_ms.max(REPRODUCIBLE_BUDGET_MS);
             }
         }
         FrontendSpec::SparseAStar(x) => {
-            x.clearance = x.clearance.max(r);
+            x.clearance = x.clearance.max(r + m);
             if out.reproducible {
                 x.budget_ms = x.budget_ms.max(REPRODUCIBLE_BUDGET_MS);
             }
@@ -858,9 +892,11 @@ pub fn effective(
     let penalty = out.backend.penalty_mut();
     penalty.static_clearance_m = penalty
         .static_clearance_m
-        .max(r + out.clearance_margin_m + e);
+        .max(r + out.clearance_margin_m.max(m) + e);
+    penalty.dynamic_clearance_m = penalty.dynamic_clearance_m.max(m);
     let safety = &mut out.manager.safety;
-    safety.static_clearance_m = safety.static_clearance_m.max(r + e);
+    safety.static_clearance_m = safety.static_clearance_m.max(r + e + m);
+    safety.dynamic_clearance_m = safety.dynamic_clearance_m.max(m);
     if out.reproducible {
         out.manager.enforce_budget = false;
     }
