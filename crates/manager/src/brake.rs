@@ -114,6 +114,60 @@ pub fn brake_straight(state: &State, a_max: f64, hold_s: f64) -> Result<PolyTraj
     brake(&line, state.t, Some(state.a), a_max, hold_s)
 }
 
+/// Escape manoeuvres from `state` (beyond the paper): in each of `directions` (normalized; zero
+/// vectors skipped), a single quintic from `state` to rest `distance_m` away, then a hold of
+/// `hold_s` seconds. Its duration is the least of a geometric sequence (×1.25) whose speed and
+/// acceleration stay within `limits` (checked on a dense sampling), starting from the
+/// minimum-jerk rest-to-rest time of the distance. For the braking fallback: when a moving
+/// obstacle comes at a vehicle that brakes in place, moving out of its way is the only safe
+/// answer.
+///
+/// # Errors
+/// [`PlanError::InvalidInput`] for a non-finite state, a non-positive distance or hold, or
+/// invalid limits.
+pub fn escape_maneuvers(
+    state: &State,
+    directions: &[Vec3],
+    distance_m: f64,
+    limits: &trust_core::Limits,
+    hold_s: f64,
+) -> Result<Vec<PolyTraj>, PlanError> {
+    state.validate("state")?;
+    limits.validate()?;
+    check_positive("escape.distance_m", distance_m)?;
+    check_positive("escape.hold_s", hold_s)?;
+    let (v_max, a_max) = (limits.v_max, limits.a_max);
+    // Minimum-jerk rest to rest: peak speed 1.875 d/T, peak acceleration 5.77 d/T².
+    let base = (1.875 * distance_m / v_max)
+        .max((5.77 * distance_m / a_max).sqrt())
+        .max(state.v.norm() / a_max);
+    let mut out = Vec::new();
+    for u in directions {
+        let n = u.norm();
+        if !(n.is_finite() && n > 1e-9) {
+            continue;
+        }
+        let end = [state.p + u * (distance_m / n), Vec3::zeros(), Vec3::zeros()];
+        let mut duration = base;
+        for _ in 0..12 {
+            let piece = hermite_quintic([state.p, state.v, state.a], end, duration);
+            let hold = hermite_quintic(end, end, hold_s);
+            let traj = PolyTraj::new(state.t, vec![duration, hold_s], vec![piece, hold])?;
+            let within = (0..=64).all(|k| {
+                let t = state.t + duration * k as f64 / 64.0;
+                traj.velocity(t).norm() <= v_max * 1.001
+                    && traj.acceleration(t).norm() <= a_max * 1.001
+            });
+            if within {
+                out.push(traj);
+                break;
+            }
+            duration *= 1.25;
+        }
+    }
+    Ok(out)
+}
+
 fn brake(
     path: &dyn BrakePath,
     t0: f64,

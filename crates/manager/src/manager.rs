@@ -11,7 +11,7 @@ use trust_core::{
 };
 
 use crate::ManagerParams;
-use crate::brake::{brake_along, brake_straight};
+use crate::brake::{brake_along, brake_straight, escape_maneuvers};
 use crate::progress::ProgressMonitor;
 use crate::report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
@@ -921,6 +921,21 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         // collision-free and it is clear for longer than every one of them.
         for (_, traj) in rejected {
             options.push(("evade", traj.clone()));
+        }
+        // And short escapes to rest in eight horizontal directions and up and down, a quarter of
+        // the horizon's reach at v_max away (scales with the vehicle: 1 m at 1 m/s, 10 m at
+        // 10 m/s): out of the way of an obstacle that the rejected trajectories, all aimed at the
+        // goal, cross.
+        let reach = 0.25 * self.params.horizon_s * self.limits.v_max;
+        let directions: Vec<Vec3> = (0..8)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::FRAC_PI_4;
+                Vec3::new(a.cos(), a.sin(), 0.0)
+            })
+            .chain([Vec3::z(), -Vec3::z()])
+            .collect();
+        if let Ok(escapes) = escape_maneuvers(start, &directions, reach, &self.limits, hold_s) {
+            options.extend(escapes.into_iter().map(|t| ("escape", t)));
         }
         // The first collision-free option; else the one that collides latest, then least deeply.
         let mut best: Option<(usize, SafetyVerdict)> = None;

@@ -188,7 +188,9 @@ pub enum Event {
     Fallback {
         /// What it brakes along: `"committed"`, `"branch"`, `"candidate"` or `"straight"`; or
         /// `"evade"`: a trajectory the safety pass rejected, flown as it is because it stays
-        /// clear longer than every braking option (an obstacle coming at a vehicle at rest).
+        /// clear longer than every braking option (an obstacle coming at a vehicle at rest); or
+        /// `"escape"`: a short manoeuvre to rest out of the way ([`crate::escape_maneuvers`]),
+        /// for the same reason.
         along: String,
         /// Whether it passed the safety check against the current forecasts.
         collision_free: bool,
