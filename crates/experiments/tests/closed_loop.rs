@@ -38,6 +38,7 @@ fn quickstart_arrives_and_its_log_passes_the_independent_audit() {
         log_path: Some(dir.join("run.jsonl")),
         zero_timing: false,
         progress_every_s: None,
+        log_branches: false,
     };
     let flight = fly(&world, &s.resolve_planner(), &options, |_| {}).unwrap();
     let o = &flight.summary.outcome;
@@ -75,6 +76,8 @@ fn the_same_seed_gives_a_byte_identical_log() {
             log_path: Some(path.clone()),
             zero_timing: true,
             progress_every_s: None,
+            // Branches and forecasts are part of what must be reproducible.
+            log_branches: true,
         };
         fly(&world, &planner, &options, |_| {}).unwrap();
         texts.push(std::fs::read(&path).unwrap());
@@ -91,6 +94,7 @@ fn the_same_seed_gives_a_byte_identical_log() {
         log_path: Some(path.clone()),
         zero_timing: true,
         progress_every_s: None,
+        log_branches: false,
     };
     fly(&w8, &other.resolve_planner(), &options, |_| {}).unwrap();
     assert!(std::fs::read(&path).unwrap() != texts[0]);
@@ -131,6 +135,7 @@ fn every_shipped_scenario_validates_and_flies_with_every_planner() {
                 log_path: Some(log.clone()),
                 zero_timing: false,
                 progress_every_s: None,
+                log_branches: false,
             };
             let f = fly(&w, &t.resolve_planner(), &options, |_| {})
                 .unwrap_or_else(|e| panic!("{} with {}: {e}", s.name, p.name()));
