@@ -4,7 +4,7 @@
 //! trust-sim run SCENARIO.toml [--planner NAME] [--seed S] [--out DIR] [--vehicle quadrotor|perfect]
 //! trust-sim validate SCENARIO.toml...
 //! trust-sim audit RUN.jsonl...
-//! trust-sim replay RUN.jsonl [--out DIR]
+//! trust-sim replay RUN.jsonl [--out DIR] [--gif-width PX] [--gif-frames N]
 //! trust-sim ablate [--scenario FILE] [--trials N] [--seed S] [--planners a,b] [--variant V]
 //!                  [--out DIR] [--jobs J] [--shard K/M] [--time-limit T] [--no-plots]
 //! trust-sim ablate-merge --out DIR SHARD_DIR...
@@ -90,6 +90,12 @@ enum Cmd {
         /// Output directory (default: the log's folder).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Width of the GIF (px).
+        #[arg(long, default_value_t = 480)]
+        gif_width: u32,
+        /// At most this many GIF frames (at least 0.5 s of flight apart).
+        #[arg(long, default_value_t = 48)]
+        gif_frames: usize,
     },
     /// Check scenario files and report every problem found (exit status 1 if any).
     Validate {
@@ -243,13 +249,21 @@ fn run_cli() -> Result<ExitCode> {
             };
             run(&s, &out, &options)
         }
-        Cmd::Replay { log, out } => {
+        Cmd::Replay {
+            log,
+            out,
+            gif_width,
+            gif_frames,
+        } => {
             let dir = out.unwrap_or_else(|| {
                 log.parent()
                     .filter(|p| !p.as_os_str().is_empty())
                     .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
             });
-            write_replay_files(&log, &dir)?;
+            let mut params = trust_replay::ReplayParams::default();
+            params.gif.width_px = gif_width;
+            params.gif.max_frames = gif_frames;
+            write_replay_files(&log, &dir, &params)?;
             Ok(ExitCode::SUCCESS)
         }
         Cmd::Ablate {
@@ -394,8 +408,8 @@ struct RunFlags {
     replay: bool,
 }
 
-fn write_replay_files(log: &Path, dir: &Path) -> Result<()> {
-    let files = trust_replay::write_replay(log, dir, &trust_replay::ReplayParams::default())?;
+fn write_replay_files(log: &Path, dir: &Path, params: &trust_replay::ReplayParams) -> Result<()> {
+    let files = trust_replay::write_replay(log, dir, params)?;
     println!(
         "replay: {} ({:.0} kB), {} ({} frames, {}×{} px)",
         files.html.display(),
@@ -467,7 +481,7 @@ fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
     );
     println!("wrote {}", out.display());
     if flags.replay {
-        write_replay_files(&log_path, out)?;
+        write_replay_files(&log_path, out, &trust_replay::ReplayParams::default())?;
     }
     Ok(ExitCode::SUCCESS)
 }
