@@ -86,6 +86,29 @@ fn the_same_seed_gives_a_byte_identical_log() {
         texts[0] == texts[1],
         "two runs with seed 7 wrote different logs"
     );
+    // The branches are logged main first, sampled from their start to their end; the forecasts
+    // name header obstacles.
+    let log = RunLog::read(&dir.join("run0.jsonl")).unwrap();
+    assert!(!log.cycles.is_empty());
+    for c in &log.cycles {
+        let branches = c.branch_samples.as_ref().expect("branch samples logged");
+        assert_eq!(branches.len(), c.branches, "cycle at {}", c.t);
+        if let Some(main) = c.main {
+            assert_eq!(branches[0].id, main, "main branch first at {}", c.t);
+        }
+        for b in branches {
+            assert!(b.samples.len() >= 2, "cycle at {}", c.t);
+            assert!(b.samples.windows(2).all(|w| w[1][0] > w[0][0]));
+            assert!(
+                b.samples
+                    .windows(2)
+                    .all(|w| w[1][0] - w[0][0] <= 0.2 + 1e-9)
+            );
+        }
+        for f in c.forecasts.as_ref().expect("forecasts logged") {
+            assert!(f.id < log.header.obstacles.len() && f.r0 > 0.0 && f.t0 <= c.t + 1e-9);
+        }
+    }
     // Another seed flies another trial.
     let other = quickstart().with_seed(8);
     let w8 = World::build(&other).unwrap();
