@@ -16,6 +16,20 @@ fn xy(p: &[f64; 3]) -> Point2<f64> {
     Point2::new(p[0], p[1])
 }
 
+/// The `route` polyline of a serialized header or cycle record (`[[x, y, z], ...]`), if it has
+/// one: the run log's optional global route, drawn when present.
+pub(crate) fn route_of(record: &serde_json::Value) -> Option<Vec<Point2<f64>>> {
+    record
+        .get("route")?
+        .as_array()?
+        .iter()
+        .map(|p| {
+            let a = p.as_array()?;
+            Some(Point2::new(a.first()?.as_f64()?, a.get(1)?.as_f64()?))
+        })
+        .collect()
+}
+
 /// The latest cycle at or before `t`.
 pub(crate) fn cycle_at(cycles: &[CycleRecord], t: f64) -> Option<&CycleRecord> {
     let n = cycles.partition_point(|c| c.t <= t + 1e-9);
@@ -111,6 +125,13 @@ pub fn write_top_view_gif(
             .collect(),
         None => Vec::new(),
     };
+    let header_route = serde_json::to_value(h).ok().and_then(|v| route_of(&v));
+    let cycle_routes: Vec<Option<Vec<Point2<f64>>>> = log
+        .cycles
+        .iter()
+        .map(|c| serde_json::to_value(c).ok().and_then(|v| route_of(&v)))
+        .collect();
+    let has_route = header_route.is_some() || cycle_routes.iter().any(Option::is_some);
     let states = &log.states;
     let times = frame_times(states[0].t, states[states.len() - 1].t, params);
     let truth_color = Color::rgb(204, 51, 17);
@@ -150,6 +171,22 @@ pub fn write_top_view_gif(
             .shapes(shapes.clone());
         if !cloud.is_empty() {
             view = view.point_cloud(cloud.clone(), Color::DARK_GREY, "static points");
+        }
+        if has_route {
+            let n = log.cycles.partition_point(|c| c.t <= t + 1e-9);
+            let route = cycle_routes[..n]
+                .iter()
+                .rev()
+                .find_map(Clone::clone)
+                .or_else(|| header_route.clone())
+                .unwrap_or_default();
+            view = view.polyline(
+                Polyline::new(route)
+                    .color(Color::START_GREEN)
+                    .width_px(2)
+                    .dashed()
+                    .label("global route"),
+            );
         }
         // The same legend entries in every frame, so that every frame has the same size.
         let truth: Vec<(Point2<f64>, f64)> = h
@@ -240,6 +277,17 @@ pub fn write_top_view_gif(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_route_is_read_when_a_record_has_one() {
+        let with = serde_json::json!({"t": 1.0, "route": [[0.0, 1.0, 2.0], [3.0, 4.0, 5.0]]});
+        assert_eq!(
+            route_of(&with),
+            Some(vec![Point2::new(0.0, 1.0), Point2::new(3.0, 4.0)])
+        );
+        assert_eq!(route_of(&serde_json::json!({"t": 1.0})), None);
+        assert_eq!(route_of(&serde_json::json!({"route": [[0.0]]})), None);
+    }
 
     #[test]
     fn frame_times_span_the_flight_within_the_frame_budget() {

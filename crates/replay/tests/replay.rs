@@ -366,3 +366,40 @@ fn the_page_plays_in_headless_chromium() {
     assert!(check.moved_px > 20.0, "{check:?}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_static_point_cloud_is_drawn_and_a_missing_one_is_named() {
+    let dir = temp_dir("points");
+    let log = dir.join("run.jsonl");
+    write_log(&log, 1.0, true);
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert!(text.contains("\"static_points_file\":null"));
+    std::fs::write(
+        &log,
+        text.replacen(
+            "\"static_points_file\":null",
+            "\"static_points_file\":\"pts.xyz\"",
+            1,
+        ),
+    )
+    .unwrap();
+    let e = write_replay(&log, &dir, &ReplayParams::default()).unwrap_err();
+    assert!(matches!(e, ReplayError::Points { .. }), "{e:?}");
+    assert!(e.to_string().contains("pts.xyz"), "{e}");
+
+    let points: String = (0..50)
+        .map(|i| format!("{} 8.0 {}\n", 0.2 * f64::from(i), 0.05 * f64::from(i)))
+        .collect();
+    std::fs::write(dir.join("pts.xyz"), format!("# a wall\n{points}")).unwrap();
+    let params = ReplayParams {
+        max_points: 20,
+        ..ReplayParams::default()
+    };
+    let files = write_replay(&log, &dir, &params).unwrap();
+    let html = std::fs::read_to_string(&files.html).unwrap();
+    let data: serde_json::Value = serde_json::from_str(embedded_json(&html)).unwrap();
+    // 50 points thinned to every third: 17 ≤ 20.
+    assert_eq!(data["points"].as_array().unwrap().len(), 17);
+    assert_eq!(data["points"][1], serde_json::json!([0.6, 8.0, 0.15]));
+    std::fs::remove_dir_all(&dir).ok();
+}
