@@ -328,3 +328,28 @@ impl Scenario {
             .map_err(|e| WorldError::input("scenario", e, "a TOML-serializable scenario"))
     }
 }
+
+#[cfg(test)]
+mod log_section_tests {
+    use super::*;
+
+    const BASE: &str = "name = \"t\"\n[world]\nbounds = { min = [0, 0, 0], max = [20, 20, 10] }\n\
+                        [mission]\nstart = [1, 10, 5]\ngoal = [19, 10, 5]\n";
+
+    #[test]
+    fn the_log_section_is_optional_typed_and_closed() {
+        let parse =
+            |extra: &str| Scenario::from_toml_str(&format!("{BASE}{extra}"), Path::new("t.toml"));
+        let none = parse("").unwrap();
+        assert_eq!(none.log.branches, None);
+        assert!(none.log.branches_or(true) && !none.log.branches_or(false));
+        let off = parse("[log]\nbranches = false\n").unwrap();
+        assert!(!off.log.branches_or(true));
+        let e = parse("[log]\nbranches = \"yes\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("t.toml") && e.contains("branches"), "{e}");
+        let e = parse("[log]\nbranch = true\n").unwrap_err().to_string();
+        assert!(e.contains("unknown field `branch`"), "{e}");
+    }
+}
