@@ -67,7 +67,7 @@ fn members() -> Vec<Member> {
 /// `runlog` knows none of the simulator's types either (a log is read without building a world;
 /// the scenario's static shapes are its `StaticShape`); `vehicle` knows nothing of the planner;
 /// `route` (the global route, issue 19) sits beside `minco`/`topo-prm` on `geometry` (and may use
-/// `core`).
+/// `core`); `replay` (issue 20) reads run logs and draws with `plot`, and only the binary uses it.
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
     const PLANNING: &[&str] = &[
         "trust-geometry",
@@ -144,6 +144,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-plot",
             ]),
         ),
+        ("trust-replay", &["trust-runlog", "trust-plot"][..]),
         (
             "trust-sim",
             with(&[
@@ -153,6 +154,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-flight",
                 "trust-plot",
                 "trust-experiments",
+                "trust-replay",
             ]),
         ),
     ])

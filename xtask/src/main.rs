@@ -18,6 +18,9 @@
 //!   non-finite output, wrong answer or call over 1 s.
 //! - `proptest [--seeds K] [--cases N]`: every property test under K random seeds
 //!   (`PROPTEST_RNG_SEED`), reporting each failing seed with its reproducing command.
+//! - `replay-check PAGE [--at T]`: opens a replay page (`trust-sim replay`) in headless Chromium
+//!   at `#t=0` and `#t=T`, fails on any script or console error, and checks that the vehicle
+//!   moved (its canvas position and the screenshots' pixels; `trust_replay::browser`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -98,6 +101,18 @@ enum Cmd {
         /// Build and run the tests in the release profile instead of the test profile.
         #[arg(long)]
         release: bool,
+    },
+    /// Open a replay page in headless Chromium (`$TRUST_CHROMIUM` or `chromium` on the PATH):
+    /// no script or console errors, and the vehicle moves when the slider does.
+    ReplayCheck {
+        /// The page (`trust-sim replay RUN.jsonl` writes `RUN.replay.html`).
+        page: PathBuf,
+        /// The later time the slider is moved to (s; the page clamps it to the flight).
+        #[arg(long, default_value_t = 3.0)]
+        at: f64,
+        /// Where the screenshots go.
+        #[arg(long, default_value = "target/replay-check")]
+        out: PathBuf,
     },
 }
 
@@ -190,7 +205,33 @@ fn main() -> Result<()> {
                 release,
             },
         ),
+        Cmd::ReplayCheck { page, at, out } => replay_check(&page, at, &root.join(out)),
     }
+}
+
+fn replay_check(page: &Path, at: f64, out: &Path) -> Result<()> {
+    if !(at.is_finite() && at > 0.0) {
+        bail!("--at must be a positive number of seconds, got {at}");
+    }
+    let chromium = trust_replay::browser::find_chromium().context(
+        "no chromium on the PATH (Debian: apt-get install chromium chromium-driver; or set \
+         TRUST_CHROMIUM)",
+    )?;
+    let check = trust_replay::browser::check_page(&chromium, page, at, out)?;
+    println!(
+        "{}: no errors; vehicle at t = {} s {:?} px, at t = {} s {:?} px ({:.0} px apart); \
+         {} pixels changed; screenshots {} and {}",
+        page.display(),
+        check.start.t,
+        check.start.vehicle_px,
+        check.later.t,
+        check.later.vehicle_px,
+        check.moved_px,
+        check.changed_pixels,
+        check.screenshots[0].display(),
+        check.screenshots[1].display()
+    );
+    Ok(())
 }
 
 /// Obstacle counts of paper Fig. Sim-A-1-1(c).

@@ -350,6 +350,8 @@ fn fly_one(class: &str, s: &Scenario, out: &Path) -> Result<SuiteRow, Experiment
         log_path: Some(log_path),
         zero_timing: false,
         progress_every_s: None,
+        // A study: branches only when the file asks (`[log] branches = true`).
+        log_branches: s.log.branches_or(false),
     };
     let flight = fly(&world, &planner, &options, |_| {})?;
     let sm = &flight.summary;

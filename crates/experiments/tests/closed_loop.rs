@@ -38,6 +38,7 @@ fn quickstart_arrives_and_its_log_passes_the_independent_audit() {
         log_path: Some(dir.join("run.jsonl")),
         zero_timing: false,
         progress_every_s: None,
+        log_branches: false,
     };
     let flight = fly(&world, &s.resolve_planner(), &options, |_| {}).unwrap();
     let o = &flight.summary.outcome;
@@ -75,6 +76,8 @@ fn the_same_seed_gives_a_byte_identical_log() {
             log_path: Some(path.clone()),
             zero_timing: true,
             progress_every_s: None,
+            // Branches and forecasts are part of what must be reproducible.
+            log_branches: true,
         };
         fly(&world, &planner, &options, |_| {}).unwrap();
         texts.push(std::fs::read(&path).unwrap());
@@ -83,6 +86,29 @@ fn the_same_seed_gives_a_byte_identical_log() {
         texts[0] == texts[1],
         "two runs with seed 7 wrote different logs"
     );
+    // The branches are logged main first, sampled from their start to their end; the forecasts
+    // name header obstacles.
+    let log = RunLog::read(&dir.join("run0.jsonl")).unwrap();
+    assert!(!log.cycles.is_empty());
+    for c in &log.cycles {
+        let branches = c.branch_samples.as_ref().expect("branch samples logged");
+        assert_eq!(branches.len(), c.branches, "cycle at {}", c.t);
+        if let Some(main) = c.main {
+            assert_eq!(branches[0].id, main, "main branch first at {}", c.t);
+        }
+        for b in branches {
+            assert!(b.samples.len() >= 2, "cycle at {}", c.t);
+            assert!(b.samples.windows(2).all(|w| w[1][0] > w[0][0]));
+            assert!(
+                b.samples
+                    .windows(2)
+                    .all(|w| w[1][0] - w[0][0] <= 0.2 + 1e-9)
+            );
+        }
+        for f in c.forecasts.as_ref().expect("forecasts logged") {
+            assert!(f.id < log.header.obstacles.len() && f.r0 > 0.0 && f.t0 <= c.t + 1e-9);
+        }
+    }
     // Another seed flies another trial.
     let other = quickstart().with_seed(8);
     let w8 = World::build(&other).unwrap();
@@ -91,6 +117,7 @@ fn the_same_seed_gives_a_byte_identical_log() {
         log_path: Some(path.clone()),
         zero_timing: true,
         progress_every_s: None,
+        log_branches: false,
     };
     fly(&w8, &other.resolve_planner(), &options, |_| {}).unwrap();
     assert!(std::fs::read(&path).unwrap() != texts[0]);
@@ -131,6 +158,7 @@ fn every_shipped_scenario_validates_and_flies_with_every_planner() {
                 log_path: Some(log.clone()),
                 zero_timing: false,
                 progress_every_s: None,
+                log_branches: false,
             };
             let f = fly(&w, &t.resolve_planner(), &options, |_| {})
                 .unwrap_or_else(|e| panic!("{} with {}: {e}", s.name, p.name()));

@@ -41,6 +41,7 @@ fn fly_audited(s: &Scenario, tag: &str) -> (Flight, Vec<String>) {
         log_path: Some(log_path.clone()),
         zero_timing: true,
         progress_every_s: None,
+        log_branches: false,
     };
     let world = World::build(s).unwrap();
     let flight = fly(&world, &s.resolve_planner(), &options, |_| {}).unwrap();

@@ -29,6 +29,8 @@
 //!   (wrapping `trust_world::WorldError` for setup, vehicle, planner and run-log errors).
 //! - Added [`set_up`] / [`Setup`]: the traffic, sensing and planner at `t = 0`, shared by [`fly`]
 //!   and E3.
+//! - Added (issue 20): [`RunOptions::log_branches`] writes the kept branches and the forecasts
+//!   into the `cycle` records ([`BRANCH_SAMPLE_STEP_S`]).
 //! - [`RunSummary::cycle_ms_median`] and `cycle_ms_p99` use `trust_plot::quantile_sorted` (the same
 //!   type-7 quantile as before; still 0 without cycles).
 #![warn(missing_docs)]
@@ -50,9 +52,11 @@ use trust_world::traffic::{MovingShape, Traffic};
 
 mod error;
 pub use error::FlightError;
+use trust_predict::{Forecast, ObstacleShape};
 use trust_runlog::{
-    Bounds, CycleRecord, Dropped, Header, LimitsInfo, LogWriter, ObstacleInfo, ObstacleKind,
-    Outcome, Record, SCHEMA, StateRecord, Status, VehicleInfo,
+    Bounds, BranchSamples, CycleRecord, Dropped, ForecastRecord, ForecastShape, Header, LimitsInfo,
+    LogWriter, ObstacleInfo, ObstacleKind, Outcome, Record, SCHEMA, StateRecord, Status,
+    VehicleInfo,
 };
 use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle};
 
@@ -70,7 +74,16 @@ pub struct RunOptions {
     pub zero_timing: bool,
     /// Report progress (simulated seconds) to this callback every simulated second.
     pub progress_every_s: Option<f64>,
+    /// Write the kept branches (sampled every [`BRANCH_SAMPLE_STEP_S`]) and the cycle's forecasts
+    /// into every `cycle` record (`branch_samples`, `forecasts`). The scenario's `[log] branches`
+    /// and `trust-sim run --log-branches` decide; off by default.
+    pub log_branches: bool,
 }
+
+/// Time between two logged samples of a branch (s): 5 per second, enough to draw a trajectory
+/// that turns at most a few times per second, and about 4 numbers × 5 per second of horizon per
+/// branch in the log.
+pub const BRANCH_SAMPLE_STEP_S: f64 = 0.2;
 
 /// What one flight did: the outcome and statistics of its planning cycles.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -406,12 +419,14 @@ pub fn fly(
                         .iter()
                         .filter(|e| matches!(e, trust_manager::Event::Reanchored { .. }))
                         .count();
-                    log.cycle(cycle_record(
-                        &report,
-                        manager.route(),
-                        effective,
-                        options.zero_timing,
-                    ))?;
+                    let mut record =
+                        cycle_record(&report, manager.route(), effective, options.zero_timing);
+                    if options.log_branches {
+                        record.branch_samples = Some(branch_samples(&manager));
+                        record.forecasts =
+                            Some(forecast_records(&sensing.tracked_ids(), &forecasts));
+                    }
+                    log.cycle(record)?;
                 }
                 Err(e) => {
                     ended = Some((Status::Invalid, None, Some(e.to_string())));
@@ -589,7 +604,61 @@ fn cycle_record(
             .filter(|_| rerouted)
             .map(|r| r.points().iter().map(v3).collect()),
         route_ms: planned.then(|| time(report.timing.route_ms)),
+        branch_samples: None,
+        forecasts: None,
     }
+}
+
+/// The manager's kept branches after a cycle, main branch first, then the others in ranking
+/// order, each sampled every [`BRANCH_SAMPLE_STEP_S`] from its start to its end (both included).
+fn branch_samples(manager: &AnyManager) -> Vec<BranchSamples> {
+    let main = manager.main();
+    let ordered = manager
+        .branches()
+        .iter()
+        .filter(|b| Some(b.id) == main)
+        .chain(manager.branches().iter().filter(|b| Some(b.id) != main));
+    ordered
+        .map(|b| {
+            let traj = b.traj();
+            let (t0, t1) = (traj.t_start(), traj.t_end());
+            let n = ((t1 - t0) / BRANCH_SAMPLE_STEP_S).ceil().max(1.0) as usize;
+            let samples = (0..=n)
+                .map(|k| {
+                    let t = if k == n {
+                        t1
+                    } else {
+                        t0 + k as f64 * BRANCH_SAMPLE_STEP_S
+                    };
+                    let p = traj.position(t);
+                    [t, p.x, p.y, p.z]
+                })
+                .collect();
+            BranchSamples { id: b.id, samples }
+        })
+        .collect()
+}
+
+/// The cycle's forecasts as the log records them; `ids[i]` is the obstacle of `forecasts[i]`
+/// (`trust_world::sensing::Sensing::tracked_ids`).
+fn forecast_records(ids: &[usize], forecasts: &[Forecast]) -> Vec<ForecastRecord> {
+    ids.iter()
+        .zip(forecasts)
+        .map(|(&id, f)| ForecastRecord {
+            id,
+            p0: v3(&f.p0),
+            v0: v3(&f.v0),
+            t0: f.t0,
+            r0: f.radius(f.t0),
+            mu: f.mu,
+            shape: match f.shape {
+                ObstacleShape::Sphere => ForecastShape::Sphere,
+                ObstacleShape::Cylinder { .. } => ForecastShape::Cylinder {
+                    half_height: f.vertical_half_extent(f.t0),
+                },
+            },
+        })
+        .collect()
 }
 
 /// Counts the cycle's safety drops by cause.

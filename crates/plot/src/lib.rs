@@ -1,6 +1,6 @@
 //! Figures for the experiment reports, written as both SVG and PNG.
 //!
-//! Four figure kinds cover the reports of the paper's simulation experiments (Sec. IV-D):
+//! Four figure kinds (and one animation) cover the reports of the paper's simulation experiments (Sec. IV-D):
 //!
 //! - [`MapView`]: a top (x–y) or side (x–z) view of a scene at equal aspect ratio — static shapes,
 //!   a thinned point cloud, the flown path and planned trajectories, obstacle tracks, forecast rings,
@@ -9,6 +9,8 @@
 //!   optional shaded bands — speed, acceleration, clearance and CPU time per cycle.
 //! - [`BarChart`]: one bar per category with an optional interval (a 95 % Wilson interval, mean ± CI),
 //!   an optional reference value per category (the paper's number) and value labels.
+//! - [`write_gif`]: a sequence of [`MapView`] frames as an animated GIF (the flight replay's top
+//!   view; plotters' GIF backend over the pure-Rust `gif` crate).
 //! - [`Distribution`]: box plots (Tukey or min/max whiskers) and/or strip plots per category — flight
 //!   duration and CPU time across trials.
 //!
@@ -44,6 +46,7 @@
 //!   the workspace's one quantile (box plots, the flight summary, the study medians).
 #![warn(missing_docs)]
 
+mod animation;
 mod axis;
 mod bar;
 mod distribution;
@@ -55,6 +58,7 @@ mod output;
 mod series;
 mod style;
 
+pub use animation::{GifWritten, write_gif};
 pub use bar::{Bar, BarChart};
 pub use distribution::{BoxStats, Distribution, DistributionKind, Whiskers, quantile_sorted};
 pub use error::PlotError;

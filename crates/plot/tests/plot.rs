@@ -539,3 +539,44 @@ fn written_paths_live_in_the_given_directory() {
     );
     let _ = fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn an_animated_gif_has_one_frame_per_view_and_rejects_mixed_sizes() {
+    use trust_plot::{MapView, Polyline, write_gif};
+    let dir = std::env::temp_dir().join(format!("trust-plot-gif-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bounds = Bounds::new(Point2::new(0.0, 0.0), Point2::new(10.0, 5.0));
+    let frame = |k: usize| {
+        MapView::new(format!("t = {k}"), bounds)
+            .width_px(300)
+            .polyline(
+                Polyline::new(vec![Point2::new(0.0, 0.0), Point2::new(k as f64, 2.0)])
+                    .label("path"),
+            )
+    };
+    let frames: Vec<MapView> = (1..=4).map(frame).collect();
+    let path = dir.join("anim.gif");
+    let written = write_gif(&frames, &path, 100).unwrap();
+    assert_eq!(written.frame_count, 4);
+    let bytes = std::fs::read(&path).unwrap();
+    assert!(bytes.starts_with(b"GIF89a"));
+    // Width and height as written in the logical screen descriptor.
+    let w = u32::from(u16::from_le_bytes([bytes[6], bytes[7]]));
+    let h = u32::from(u16::from_le_bytes([bytes[8], bytes[9]]));
+    assert_eq!((w, h), (written.width_px, written.height_px));
+
+    // A frame of other bounds (so another height) is named, and nothing is written.
+    let mut mixed = frames.clone();
+    mixed[2] = MapView::new(
+        "taller",
+        Bounds::new(Point2::new(0.0, 0.0), Point2::new(10.0, 10.0)),
+    )
+    .width_px(300)
+    .polyline(Polyline::new(vec![Point2::new(0.0, 0.0), Point2::new(1.0, 2.0)]).label("path"));
+    let bad = dir.join("mixed.gif");
+    let e = write_gif(&mixed, &bad, 100).unwrap_err();
+    assert!(e.to_string().contains("frames[2] size"), "{e}");
+    assert!(!bad.exists());
+    assert!(write_gif(&[], &bad, 100).is_err());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -189,13 +189,71 @@ fn read_points(path: &Path) -> Result<Vec<[f64; 3]>, String> {
     Ok(points)
 }
 
+/// The static and dynamic clearances of the vehicle in state `s` (minus its radius), and the
+/// nearest moving obstacle's id.
+fn clearance_at(h: &Header, grid: Option<&PointGrid>, s: &StateRecord) -> (f64, f64, usize) {
+    let radius = h.vehicle.radius;
+    let mut static_c = h
+        .static_shapes
+        .iter()
+        .map(|shape| static_distance(&s.p, shape) - radius)
+        .fold(f64::INFINITY, f64::min);
+    if let Some(g) = grid {
+        static_c = static_c.min(g.nearest(&s.p, 100.0) - radius);
+    }
+    let (mut dynamic_c, mut nearest) = (f64::INFINITY, 0);
+    for (info, c) in h.obstacles.iter().zip(&s.obstacles) {
+        let d = match info.shape {
+            ObstacleKind::Sphere => dist(&s.p, c) - info.radius,
+            ObstacleKind::Cylinder => {
+                let hh = info.half_height.unwrap_or(0.0);
+                vertical_cylinder(&s.p, c[0], c[1], info.radius, c[2] - hh, c[2] + hh)
+            }
+        } - radius;
+        if d < dynamic_c {
+            dynamic_c = d;
+            nearest = info.id;
+        }
+    }
+    (static_c, dynamic_c, nearest)
+}
+
+/// The clearances at every state of `log`, `[static, dynamic]` (m, vehicle radius subtracted;
+/// `+∞` without geometry of that kind), with the audit's own distance formulas; `log_dir`
+/// resolves `static_points_file`. The flight replay draws them as traces.
+///
+/// # Errors
+/// A message if the points file cannot be read.
+pub fn state_clearances(log: &RunLog, log_dir: &Path) -> Result<Vec<[f64; 2]>, String> {
+    let grid = match &log.header.static_points_file {
+        Some(f) => Some(PointGrid::new(read_points(&log_dir.join(f))?, 1.0)),
+        None => None,
+    };
+    Ok(log
+        .states
+        .iter()
+        .map(|s| {
+            let (st, dy, _) = clearance_at(&log.header, grid.as_ref(), s);
+            [st, dy]
+        })
+        .collect())
+}
+
+/// Reads the `x y z` points of a log's `static_points_file` (blank lines and `#` comments
+/// ignored).
+///
+/// # Errors
+/// A message naming the file and line.
+pub fn read_static_points(path: &Path) -> Result<Vec<[f64; 3]>, String> {
+    read_points(path)
+}
+
 /// Recomputes the outcome of `log`; `log_dir` resolves `static_points_file`.
 ///
 /// # Errors
 /// A message if the points file cannot be read.
 pub fn recompute(log: &RunLog, log_dir: &Path) -> Result<Recomputed, String> {
     let h: &Header = &log.header;
-    let radius = h.vehicle.radius;
     let grid = match &h.static_points_file {
         Some(f) => Some(PointGrid::new(read_points(&log_dir.join(f))?, 1.0)),
         None => None,
@@ -213,28 +271,7 @@ pub fn recompute(log: &RunLog, log_dir: &Path) -> Result<Recomputed, String> {
     };
     let mut previous: Option<&StateRecord> = None;
     for s in &log.states {
-        let mut static_c = h
-            .static_shapes
-            .iter()
-            .map(|shape| static_distance(&s.p, shape) - radius)
-            .fold(f64::INFINITY, f64::min);
-        if let Some(g) = &grid {
-            static_c = static_c.min(g.nearest(&s.p, 100.0) - radius);
-        }
-        let (mut dynamic_c, mut nearest) = (f64::INFINITY, 0);
-        for (info, c) in h.obstacles.iter().zip(&s.obstacles) {
-            let d = match info.shape {
-                ObstacleKind::Sphere => dist(&s.p, c) - info.radius,
-                ObstacleKind::Cylinder => {
-                    let hh = info.half_height.unwrap_or(0.0);
-                    vertical_cylinder(&s.p, c[0], c[1], info.radius, c[2] - hh, c[2] + hh)
-                }
-            } - radius;
-            if d < dynamic_c {
-                dynamic_c = d;
-                nearest = info.id;
-            }
-        }
+        let (static_c, dynamic_c, nearest) = clearance_at(h, grid.as_ref(), s);
         r.min_clearance_static_m = r.min_clearance_static_m.min(static_c);
         r.min_clearance_dynamic_m = r.min_clearance_dynamic_m.min(dynamic_c);
         r.max_speed = r.max_speed.max(norm(&s.v));

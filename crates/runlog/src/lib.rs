@@ -15,6 +15,9 @@
 //! - Moved out of `trust-sim` (issue 17): `trust_sim::runlog` is this crate's root and
 //!   `trust_sim::audit` is [`audit`]; the run-log errors are [`LogError`]s, no longer wrapped in
 //!   `SimError`.
+//! - Added (issue 20): [`CycleRecord::branch_samples`] ([`BranchSamples`]) and
+//!   [`CycleRecord::forecasts`] ([`ForecastRecord`], [`ForecastShape`]), optional and absent
+//!   unless branch logging is on, so older logs read as before.
 //! - [`StaticShape`] is also the scenario file's static shape (`trust_world::scenario::StaticShape`,
 //!   which replaced `ShapeSpec`); its serialized form in the log is unchanged.
 #![warn(missing_docs)]
@@ -214,6 +217,58 @@ pub struct CycleRecord {
     /// Added: time spent planning that route (ms); absent when none was planned.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub route_ms: Option<f64>,
+    /// Added (issue 20), only when branch logging is on: the kept branches' trajectories after the
+    /// cycle, main branch first, then the others in ranking order.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub branch_samples: Option<Vec<BranchSamples>>,
+    /// Added (issue 20), only when branch logging is on: the forecasts the cycle planned against.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub forecasts: Option<Vec<ForecastRecord>>,
+}
+
+/// One kept branch's trajectory, sampled (added, issue 20).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BranchSamples {
+    /// The manager's branch id.
+    pub id: u64,
+    /// `[t, x, y, z]` along the trajectory from its start to its end, both included (absolute
+    /// time, s; position, m).
+    pub samples: Vec<[f64; 4]>,
+}
+
+/// The base shape of a forecast (added, issue 20).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ForecastShape {
+    /// A ball of radius `r(t)`.
+    Sphere,
+    /// A vertical cylinder of radius `r(t)` and half-height `half_height + mu·(t − t0)`.
+    Cylinder {
+        /// Half-height at `t0` (m), margin included.
+        half_height: f64,
+    },
+}
+
+/// A forecast of one moving obstacle as the planner received it (added, issue 20): centre
+/// `p0 + v0·(t − t0)`, radius `r0 + mu·(t − t0)` for `t ≥ t0`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForecastRecord {
+    /// The obstacle (index in the header's `obstacles`).
+    pub id: usize,
+    /// Centre at `t0`.
+    pub p0: [f64; 3],
+    /// Velocity.
+    pub v0: [f64; 3],
+    /// Time of the forecast (s).
+    pub t0: f64,
+    /// Avoidance radius at `t0` (m): the obstacle's radius plus the safety margin.
+    pub r0: f64,
+    /// Growth rate of the radius (m/s).
+    pub mu: f64,
+    /// Base shape.
+    pub shape: ForecastShape,
 }
 
 /// Trajectories the safety check dropped in one cycle, by cause of the first violation.
@@ -447,6 +502,20 @@ fn check_finite(record: &Record) -> Result<(), LogError> {
             if !all(&c.branch_j) {
                 return bad(format!("branch J at t = {}", c.t));
             }
+            for b in c.branch_samples.iter().flatten() {
+                if let Some(k) = b.samples.iter().position(|s| !all(s)) {
+                    return bad(format!("sample {k} of branch {} at t = {}", b.id, c.t));
+                }
+            }
+            for f in c.forecasts.iter().flatten() {
+                let h = match f.shape {
+                    ForecastShape::Sphere => 0.0,
+                    ForecastShape::Cylinder { half_height } => half_height,
+                };
+                if !(all(&f.p0) && all(&f.v0) && all(&[f.t0, f.r0, f.mu, h])) {
+                    return bad(format!("forecast of obstacle {} at t = {}", f.id, c.t));
+                }
+            }
         }
         Record::Outcome(o) => {
             let xs = [
@@ -649,6 +718,109 @@ mod tests {
         assert_eq!(json["with"], "static");
         let timed_out = serde_json::to_value(Status::TimedOut).unwrap();
         assert_eq!(timed_out, "timed_out");
+    }
+
+    fn cycle(t: f64) -> CycleRecord {
+        CycleRecord {
+            t,
+            wall_ms: 1.5,
+            main: Some(3),
+            branches: 2,
+            events: vec!["switched".into()],
+            frontend_ms: 0.5,
+            backend_ms: 0.75,
+            checker_ms: 0.25,
+            solve_count: 2,
+            effective_t: t + 0.1,
+            branch_j: vec![1.0, 2.0],
+            fallback_collision_free: None,
+            fallback_shortfall_m: None,
+            dropped: Dropped::default(),
+            route: None,
+            route_ms: None,
+            branch_samples: None,
+            forecasts: None,
+        }
+    }
+
+    #[test]
+    fn a_planned_route_round_trips_and_is_absent_otherwise() {
+        let mut c = cycle(0.0);
+        assert!(!serde_json::to_string(&c).unwrap().contains("route"));
+        c.route = Some(vec![[0.0, 0.0, 1.0], [5.0, 2.0, 1.0], [9.0, 0.0, 1.5]]);
+        c.route_ms = Some(0.8);
+        let text = serde_json::to_string(&c).unwrap();
+        let back: CycleRecord = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, c);
+    }
+
+    #[test]
+    fn branch_samples_and_forecasts_round_trip_and_stay_absent_when_off() {
+        let mut c = cycle(1.0);
+        let off = serde_json::to_string(&Record::Cycle(c.clone())).unwrap();
+        assert!(
+            !off.contains("branch_samples") && !off.contains("forecasts"),
+            "{off}"
+        );
+        c.branch_samples = Some(vec![
+            BranchSamples {
+                id: 3,
+                samples: vec![[1.0, 0.1, 0.2, 1.0], [1.2, 0.3, 0.2, 1.0]],
+            },
+            BranchSamples {
+                id: 1,
+                samples: vec![[1.0, 0.1, 0.2, 1.0]],
+            },
+        ]);
+        c.forecasts = Some(vec![
+            ForecastRecord {
+                id: 0,
+                p0: [4.0, 4.0, 1.5],
+                v0: [0.5, -0.25, 0.0],
+                t0: 1.0,
+                r0: 0.6,
+                mu: 0.3,
+                shape: ForecastShape::Cylinder { half_height: 1.7 },
+            },
+            ForecastRecord {
+                id: 2,
+                p0: [1.0, 2.0, 3.0],
+                v0: [0.0; 3],
+                t0: 1.0,
+                r0: 0.5,
+                mu: 0.0,
+                shape: ForecastShape::Sphere,
+            },
+        ]);
+        let on = serde_json::to_string(&Record::Cycle(c.clone())).unwrap();
+        let back: Record = serde_json::from_str(&on).unwrap();
+        assert_eq!(back, Record::Cycle(c.clone()));
+        let json: serde_json::Value = serde_json::from_str(&on).unwrap();
+        assert_eq!(json["branch_samples"][0]["samples"][1][0], 1.2);
+        assert_eq!(
+            json["forecasts"][0]["shape"]["cylinder"]["half_height"],
+            1.7
+        );
+        assert_eq!(json["forecasts"][1]["shape"], "sphere");
+        // A non-finite sample is refused.
+        let dir = std::env::temp_dir().join(format!("trust-runlog-nf-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut w = LogWriter::create(&dir.join("run.jsonl")).unwrap();
+        c.branch_samples.as_mut().unwrap()[1].samples[0][2] = f64::INFINITY;
+        let e = w.write(&Record::Cycle(c)).unwrap_err().to_string();
+        assert!(e.contains("sample 0 of branch 1"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_cycle_line_written_before_issue_20_still_reads() {
+        let old = r#"{"type":"cycle","t":0.1,"wall_ms":2.0,"main":1,"branches":1,"events":["added"],"frontend_ms":1.0,"backend_ms":0.5,"checker_ms":0.1,"solve_count":1,"effective_t":0.2,"branch_j":[3.5]}"#;
+        let Record::Cycle(c) = serde_json::from_str::<Record>(old).unwrap() else {
+            panic!("not a cycle");
+        };
+        assert_eq!(c.branch_samples, None);
+        assert_eq!(c.forecasts, None);
+        assert_eq!(c.branch_j, vec![3.5]);
     }
 
     #[test]

@@ -4,6 +4,7 @@
 //! trust-sim run SCENARIO.toml [--planner NAME] [--seed S] [--out DIR] [--vehicle quadrotor|perfect]
 //! trust-sim validate SCENARIO.toml...
 //! trust-sim audit RUN.jsonl...
+//! trust-sim replay RUN.jsonl [--out DIR] [--gif-width PX] [--gif-frames N]
 //! trust-sim ablate [--scenario FILE] [--trials N] [--seed S] [--planners a,b] [--variant V]
 //!                  [--out DIR] [--jobs J] [--shard K/M] [--time-limit T] [--no-plots]
 //! trust-sim ablate-merge --out DIR SHARD_DIR...
@@ -13,8 +14,8 @@
 //! ```
 //!
 //! The binary only parses the command line; the work is in `trust-world` (scenarios, worlds),
-//! `trust-flight` (the closed loop), `trust-runlog` (logs, audit) and `trust-experiments`
-//! (studies, E3, figures).
+//! `trust-flight` (the closed loop), `trust-runlog` (logs, audit), `trust-experiments`
+//! (studies, E3, figures) and `trust-replay` (the replay page and GIF).
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -73,6 +74,31 @@ enum Cmd {
         /// Skip the plots.
         #[arg(long)]
         no_plots: bool,
+        /// Log the kept branches and the forecasts in every cycle record (the default for `run`
+        /// unless the scenario's `[log] branches` says otherwise).
+        #[arg(long, conflicts_with = "no_log_branches")]
+        log_branches: bool,
+        /// Do not log branches and forecasts.
+        #[arg(long)]
+        no_log_branches: bool,
+        /// Also write the replay (run.replay.html and run.replay.gif) next to the log.
+        #[arg(long)]
+        replay: bool,
+    },
+    /// Write the replay of a run log: one self-contained HTML page that plays the flight, and an
+    /// animated GIF of its top view (RUN.replay.html, RUN.replay.gif).
+    Replay {
+        /// The run log (JSON Lines).
+        log: PathBuf,
+        /// Output directory (default: the log's folder).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Width of the GIF (px).
+        #[arg(long, default_value_t = 480)]
+        gif_width: u32,
+        /// At most this many GIF frames (at least 0.5 s of flight apart).
+        #[arg(long, default_value_t = 48)]
+        gif_frames: usize,
     },
     /// Check scenario files and report every problem found (exit status 1 if any).
     Validate {
@@ -214,6 +240,9 @@ fn run_cli() -> Result<ExitCode> {
             time_limit,
             zero_timing,
             no_plots,
+            log_branches,
+            no_log_branches,
+            replay,
         } => {
             // Checked once, with the overrides applied, where the world is built (`run`).
             let mut s = Scenario::parse_file(&scenario)?;
@@ -239,7 +268,37 @@ fn run_cli() -> Result<ExitCode> {
                 }
                 s.time_limit_s = limit;
             }
-            run(&s, &out, zero_timing, !no_plots)
+            let branches = if log_branches {
+                true
+            } else if no_log_branches {
+                false
+            } else {
+                s.log.branches_or(true)
+            };
+            let options = RunFlags {
+                zero_timing,
+                plots: !no_plots,
+                log_branches: branches,
+                replay,
+            };
+            run(&s, &out, &options)
+        }
+        Cmd::Replay {
+            log,
+            out,
+            gif_width,
+            gif_frames,
+        } => {
+            let dir = out.unwrap_or_else(|| {
+                log.parent()
+                    .filter(|p| !p.as_os_str().is_empty())
+                    .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+            });
+            let mut params = trust_replay::ReplayParams::default();
+            params.gif.width_px = gif_width;
+            params.gif.max_frames = gif_frames;
+            write_replay_files(&log, &dir, &params)?;
+            Ok(ExitCode::SUCCESS)
         }
         Cmd::Ablate {
             scenario,
@@ -422,7 +481,29 @@ fn parse_preset(name: &str) -> Result<PlannerPreset> {
     })
 }
 
-fn run(s: &Scenario, out: &Path, zero_timing: bool, plots: bool) -> Result<ExitCode> {
+/// The switches of `trust-sim run` beyond the scenario.
+struct RunFlags {
+    zero_timing: bool,
+    plots: bool,
+    log_branches: bool,
+    replay: bool,
+}
+
+fn write_replay_files(log: &Path, dir: &Path, params: &trust_replay::ReplayParams) -> Result<()> {
+    let files = trust_replay::write_replay(log, dir, params)?;
+    println!(
+        "replay: {} ({:.0} kB), {} ({} frames, {}×{} px)",
+        files.html.display(),
+        files.html_bytes as f64 / 1e3,
+        files.gif.path.display(),
+        files.gif.frame_count,
+        files.gif.width_px,
+        files.gif.height_px
+    );
+    Ok(())
+}
+
+fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let tty = std::io::stderr().is_terminal();
     eprintln!("building the world of `{}` (seed {})...", s.name, s.seed);
@@ -431,8 +512,9 @@ fn run(s: &Scenario, out: &Path, zero_timing: bool, plots: bool) -> Result<ExitC
     let log_path = out.join("run.jsonl");
     let options = RunOptions {
         log_path: Some(log_path.clone()),
-        zero_timing,
+        zero_timing: flags.zero_timing,
         progress_every_s: Some(1.0),
+        log_branches: flags.log_branches,
     };
     let limit = s.time_limit_s;
     let flight = fly(&world, &planner, &options, |t| {
@@ -447,7 +529,7 @@ fn run(s: &Scenario, out: &Path, zero_timing: bool, plots: bool) -> Result<ExitC
     let json = serde_json::to_string_pretty(summary)?;
     std::fs::write(out.join("summary.json"), json + "\n")
         .with_context(|| format!("writing {}", out.join("summary.json").display()))?;
-    if plots {
+    if flags.plots {
         let h = header(&world, &planner.label, None);
         write_flight_plots(out, &h, &flight.record, world.static_points())?;
     }
@@ -479,5 +561,8 @@ fn run(s: &Scenario, out: &Path, zero_timing: bool, plots: bool) -> Result<ExitC
         summary.real_time_factor
     );
     println!("wrote {}", out.display());
+    if flags.replay {
+        write_replay_files(&log_path, out, &trust_replay::ReplayParams::default())?;
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -103,6 +103,8 @@
 //!   [`scenario::StaticShape`] (the TOML form, tagged by `kind`, is unchanged);
 //!   [`World::static_shape_specs`] returns it. `ShapeSpec::{shape, from_shape, is_valid}` are gone:
 //!   validation names the bad field of a shape ([`scenario::Scenario::validate`]).
+//! - Added (issue 20): the scenario section `[log]` ([`scenario::LogSection`], field
+//!   [`scenario::Scenario::log`]) switching the cycles' branches and forecasts in the run log.
 
 #![warn(missing_docs)]
 

@@ -463,6 +463,8 @@ fn run_trial(
             log_path: Some(log_path),
             zero_timing: false,
             progress_every_s: None,
+            // Studies keep their logs small: branches only when the scenario asks.
+            log_branches: s.log.branches_or(false),
         };
         let flight = fly(&w, &planner_spec, &options, |_| {})?;
         let s = &flight.summary;

@@ -93,6 +93,10 @@
 //! replan_rate_hz = 10.0
 //! log_rate_hz = 50.0
 //! latency = { kind = "fixed" }   # fixed (seconds = …, default the manager's) | measured
+//!
+//! [log]
+//! branches = true                # cycles carry branches + forecasts; unset: on for `trust-sim
+//!                                # run`, off for studies (see LogSection)
 //! ```
 //!
 //! Tagged tables use a `kind` key (`source` for point clouds) next to the variant's own fields;
@@ -180,6 +184,9 @@ pub struct Scenario {
     /// `[sim]`: physics, replanning and logging clocks, latency.
     #[serde(default)]
     pub sim: SimSection,
+    /// `[log]`: what the run log carries beyond the contract (issue 20).
+    #[serde(default)]
+    pub log: LogSection,
     /// The file it was read from (relative paths in it are resolved against its folder);
     /// `None` for a scenario made in code (paths relative to the current directory). Not part
     /// of the file.
@@ -189,6 +196,25 @@ pub struct Scenario {
 
 fn default_time_limit() -> f64 {
     60.0
+}
+
+/// Section `[log]`: optional content of the run log.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LogSection {
+    /// Whether every `cycle` record carries the kept branches (sampled) and the forecasts the
+    /// cycle planned against (`branch_samples`, `forecasts`; `docs/run-log.md`). `None` (the
+    /// default) leaves it to the command: on for `trust-sim run` (which also has
+    /// `--log-branches` / `--no-log-branches`), off for studies (ablate, E4, the suite), whose
+    /// logs stay small and byte-identical to those written before the fields existed.
+    pub branches: Option<bool>,
+}
+
+impl LogSection {
+    /// Whether to log branches, `default` being the command's choice when the file says nothing.
+    pub fn branches_or(&self, default: bool) -> bool {
+        self.branches.unwrap_or(default)
+    }
 }
 
 impl Scenario {
@@ -300,5 +326,30 @@ impl Scenario {
     pub fn to_toml_string(&self) -> Result<String, WorldError> {
         toml::to_string(self)
             .map_err(|e| WorldError::input("scenario", e, "a TOML-serializable scenario"))
+    }
+}
+
+#[cfg(test)]
+mod log_section_tests {
+    use super::*;
+
+    const BASE: &str = "name = \"t\"\n[world]\nbounds = { min = [0, 0, 0], max = [20, 20, 10] }\n\
+                        [mission]\nstart = [1, 10, 5]\ngoal = [19, 10, 5]\n";
+
+    #[test]
+    fn the_log_section_is_optional_typed_and_closed() {
+        let parse =
+            |extra: &str| Scenario::from_toml_str(&format!("{BASE}{extra}"), Path::new("t.toml"));
+        let none = parse("").unwrap();
+        assert_eq!(none.log.branches, None);
+        assert!(none.log.branches_or(true) && !none.log.branches_or(false));
+        let off = parse("[log]\nbranches = false\n").unwrap();
+        assert!(!off.log.branches_or(true));
+        let e = parse("[log]\nbranches = \"yes\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("t.toml") && e.contains("branches"), "{e}");
+        let e = parse("[log]\nbranch = true\n").unwrap_err().to_string();
+        assert!(e.contains("unknown field `branch`"), "{e}");
     }
 }

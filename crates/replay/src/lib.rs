@@ -1,0 +1,157 @@
+//! # trust-replay — watch a flight: one self-contained HTML page and an animated GIF from a run log
+//!
+//! Use it to *see* what a flight did, after the fact, from its run log alone (`trust-runlog`,
+//! schema `trust-sim-log/1`, `docs/run-log.md`): [`write_replay`] turns `RUN.jsonl` into
+//!
+//! - `RUN.replay.html` ([`page_html`]): one page with everything inline — the flight's data as
+//!   embedded JSON, the script and the style sheet — and no network access (no CDN, no fonts, no
+//!   images fetched). It plays the flight in a top (x–y) and a side (x–z) view on 2-D canvases:
+//!   static shapes (and the thinned static point cloud when the log names one), the true moving
+//!   obstacles with their shapes, the forecasts the planner held (centre and growing radius, when
+//!   the log has them), the flown path, the branches of the current cycle with the main one
+//!   highlighted, and the latest global route when the log carries one. Under the views: a
+//!   timeline with the cycles' events (switch, fallback, stalled, …), play/pause, a time slider,
+//!   a speed control, and the speed and clearance traces with a cursor. The page reads `#t=SECONDS`
+//!   from its address (paused at that time), and keeps a machine-readable status — script errors,
+//!   the time shown, the vehicle's position on the canvas — in the element `#replay-status`, which
+//!   the headless-browser check ([`browser`]) reads.
+//! - `RUN.replay.gif` ([`write_top_view_gif`]): the top view as an animated GIF through
+//!   `trust-plot` (plotters' GIF backend, pure Rust, the bundled font), small enough for a README.
+//!
+//! The branches and forecasts come from the cycles' optional `branch_samples` and `forecasts`
+//! (added in issue 20; written by `trust-sim run` unless `--no-log-branches`); a log without them
+//! replays without branches and forecasts. The clearance traces are recomputed from the states
+//! with the audit's own distance formulas ([`trust_runlog::audit::state_clearances`]).
+//!
+//! This crate sits beside the plots, on the far side of the simulator: it depends on
+//! `trust-runlog` and `trust-plot` and nothing depends on it but the `trust-sim` binary and xtask.
+//!
+//! # Changelog
+//!
+//! - New in issue 20.
+#![warn(missing_docs)]
+
+pub mod browser;
+mod data;
+mod error;
+mod frames;
+mod page;
+
+use std::path::{Path, PathBuf};
+
+pub use error::ReplayError;
+pub use frames::write_top_view_gif;
+pub use page::page_html;
+pub use trust_plot::GifWritten;
+use trust_runlog::RunLog;
+
+/// Settings of a replay (choices of ours, not the paper's: they keep the page of a 30 s E4 flight
+/// with 100 obstacles at a few MB and its GIF under 1 MB).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReplayParams {
+    /// Keep one state per this many seconds in the page (the log has 50 Hz; the page interpolates
+    /// linearly between kept states); `≥ 0`, 0 keeps all. Default 0.1 s.
+    pub state_step_s: f64,
+    /// Decimals kept for every number in the page's data. Default 2 (cm; a pixel of the views
+    /// is 5–10 cm).
+    pub decimals: i32,
+    /// The branches are drawn as polylines within this distance of the logged samples
+    /// (Ramer–Douglas–Peucker, m); `≥ 0`. Default 0.03 m.
+    pub branch_tolerance_m: f64,
+    /// A cycle's forecast is in the page when its obstacle is within this distance (plus its
+    /// radius) of the vehicle, or of a kept branch at the same time (m). Default 5 m; E4 has 100
+    /// obstacles and the page would otherwise carry all their forecasts in every cycle.
+    pub forecast_near_m: f64,
+    /// At most this many static points in the page (thinned in file order). Default 20 000.
+    pub max_points: usize,
+    /// The GIF.
+    pub gif: GifParams,
+}
+
+impl Default for ReplayParams {
+    fn default() -> Self {
+        ReplayParams {
+            state_step_s: 0.1,
+            decimals: 2,
+            branch_tolerance_m: 0.03,
+            forecast_near_m: 5.0,
+            max_points: 20_000,
+            gif: GifParams::default(),
+        }
+    }
+}
+
+/// Settings of the animated GIF.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GifParams {
+    /// Simulated seconds between frames, at least; `> 0`. Default 0.5 s.
+    pub frame_step_s: f64,
+    /// At most this many frames (the step grows for long flights); `≥ 2`. Default 48.
+    pub max_frames: usize,
+    /// Width of a frame (px, 200 to 8000). Default 480.
+    pub width_px: u32,
+    /// How long each frame shows (ms). Default 150 ms (about 3× real time at 0.5 s per frame).
+    pub frame_delay_ms: u32,
+}
+
+impl Default for GifParams {
+    fn default() -> Self {
+        GifParams {
+            frame_step_s: 0.5,
+            max_frames: 48,
+            width_px: 480,
+            frame_delay_ms: 150,
+        }
+    }
+}
+
+/// What [`write_replay`] wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReplayFiles {
+    /// The HTML page.
+    pub html: PathBuf,
+    /// Its size in bytes.
+    pub html_bytes: usize,
+    /// The GIF.
+    pub gif: GifWritten,
+}
+
+/// Reads the run log at `log_path` and writes `STEM.replay.html` and `STEM.replay.gif` into
+/// `out_dir` (created if needed), `STEM` being the log's file stem.
+///
+/// # Errors
+/// [`ReplayError`] naming the file: a log that cannot be read or is not a run log (with the line),
+/// an unreadable static points file, bad parameters, or an output that cannot be written.
+pub fn write_replay(
+    log_path: &Path,
+    out_dir: &Path,
+    params: &ReplayParams,
+) -> Result<ReplayFiles, ReplayError> {
+    let log = RunLog::read(log_path)?;
+    let log_dir = log_path.parent().unwrap_or(Path::new("."));
+    let stem = log_path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("run");
+    std::fs::create_dir_all(out_dir).map_err(|source| ReplayError::Write {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    let html = page_html(&log, log_dir, params)?;
+    let html_path = out_dir.join(format!("{stem}.replay.html"));
+    std::fs::write(&html_path, &html).map_err(|source| ReplayError::Write {
+        path: html_path.clone(),
+        source,
+    })?;
+    let gif = write_top_view_gif(
+        &log,
+        log_dir,
+        &out_dir.join(format!("{stem}.replay.gif")),
+        &params.gif,
+    )?;
+    Ok(ReplayFiles {
+        html: html_path,
+        html_bytes: html.len(),
+        gif,
+    })
+}
