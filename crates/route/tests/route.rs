@@ -112,8 +112,19 @@ fn a_crazyflie_room_with_thin_pillars_is_crossed_with_clearance() {
     let (s, g) = (Vec3::new(1.0, 1.0, 1.0), Vec3::new(7.0, 1.0, 1.5));
     let route = planner().plan(&map, &s, &g, 0.1).unwrap();
     assert_relative_eq!(route.clearance_m(), 0.15);
-    assert!(route.cell_m().unwrap() <= 0.1, "{:?}", route.cell_m());
+    // The coarse grid (4 × 0.075 m cells) is wide enough here.
+    assert!(route.cell_m().unwrap() <= 0.31, "{:?}", route.cell_m());
     assert_clear(&map, &route);
+    // The fine grid alone finds a route as well, with its 0.075 m cells.
+    let fine = RoutePlanner::new(RouteParams {
+        coarse_factor: 1.0,
+        ..RouteParams::default()
+    })
+    .unwrap()
+    .plan(&map, &s, &g, 0.1)
+    .unwrap();
+    assert!(fine.cell_m().unwrap() <= 0.1, "{:?}", fine.cell_m());
+    assert_clear(&map, &fine);
     // Through the gap between the wall's end (y = 4.5) and the far side (y = 6).
     assert!(route.points().iter().any(|p| p.y > 4.5));
     // A pillar straight between two points is avoided too.

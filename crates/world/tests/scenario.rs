@@ -270,9 +270,12 @@ fn clearances_follow_the_vehicle_radius_and_reproducibility_removes_budgets() {
         ..ctx(0.45)
     };
     let e = planner::effective(&r, &ctx).unwrap();
+    // The default tracking margin follows a_max (issue 19).
+    let m = planner::tracking_margin_for(ctx.limits.a_max);
+    assert!(m > 0.0 && m < 0.1);
     match &e.frontend {
         FrontendSpec::DevPrm(p) => {
-            assert_eq!(p.clearance, 0.45);
+            assert!((p.clearance - (0.45 + m)).abs() < 1e-12);
             assert!(p.surface_offset >= p.clearance);
             assert_eq!(p.budget_ms, REPRODUCIBLE_BUDGET_MS);
         }
@@ -284,7 +287,12 @@ fn clearances_follow_the_vehicle_radius_and_reproducibility_removes_budgets() {
         }
         other => panic!("{other:?}"),
     }
-    assert!((e.manager.safety.static_clearance_m - 0.62).abs() < 1e-12);
+    assert!((e.manager.safety.static_clearance_m - (0.62 + m)).abs() < 1e-12);
+    assert!((e.manager.safety.dynamic_clearance_m - m).abs() < 1e-12);
+    // An explicit margin replaces the rule.
+    let r0 = spec("tracking_margin_m = 0.0").resolve();
+    let e0 = planner::effective(&r0, &ctx).unwrap();
+    assert!((e0.manager.safety.static_clearance_m - 0.62).abs() < 1e-12);
     assert!(!e.manager.enforce_budget);
     assert_eq!(e.manager.seed, 9);
     // Larger values in the scenario are kept; non-reproducible runs keep their budgets.
