@@ -67,7 +67,7 @@ fn members() -> Vec<Member> {
 /// `runlog` knows none of the simulator's types either (a log is read without building a world;
 /// the scenario's static shapes are its `StaticShape`); `vehicle` knows nothing of the planner;
 /// `route` (the global route, issue 19) sits beside `minco`/`topo-prm` on `geometry` (and may use
-/// `core`).
+/// `core`); `export` (MCAP, issue 20) reads logs only (`runlog`), and only `sim` uses it.
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
     const PLANNING: &[&str] = &[
         "trust-geometry",
@@ -128,6 +128,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
         ),
         ("trust-plot", &[][..]),
         ("trust-runlog", &[][..]),
+        ("trust-export", &["trust-runlog"][..]),
         ("trust-vehicle", &["trust-core"][..]),
         ("trust-world", with(&["trust-vehicle", "trust-runlog"])),
         (
@@ -150,6 +151,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-vehicle",
                 "trust-world",
                 "trust-runlog",
+                "trust-export",
                 "trust-flight",
                 "trust-plot",
                 "trust-experiments",

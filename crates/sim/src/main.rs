@@ -4,6 +4,7 @@
 //! trust-sim run SCENARIO.toml [--planner NAME] [--seed S] [--out DIR] [--vehicle quadrotor|perfect]
 //! trust-sim validate SCENARIO.toml...
 //! trust-sim audit RUN.jsonl...
+//! trust-sim export RUN.jsonl --mcap FILE
 //! trust-sim ablate [--scenario FILE] [--trials N] [--seed S] [--planners a,b] [--variant V]
 //!                  [--out DIR] [--jobs J] [--shard K/M] [--time-limit T] [--no-plots]
 //! trust-sim ablate-merge --out DIR SHARD_DIR...
@@ -11,8 +12,8 @@
 //! ```
 //!
 //! The binary only parses the command line; the work is in `trust-world` (scenarios, worlds),
-//! `trust-flight` (the closed loop), `trust-runlog` (logs, audit) and `trust-experiments`
-//! (studies, E3, figures).
+//! `trust-flight` (the closed loop), `trust-runlog` (logs, audit), `trust-export` (MCAP) and
+//! `trust-experiments` (studies, E3, figures).
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -148,6 +149,15 @@ enum Cmd {
         /// Run logs (JSON Lines).
         #[arg(required = true)]
         logs: Vec<PathBuf>,
+    },
+    /// Export a run log for other tools: `--mcap FILE` writes an MCAP file that Foxglove (or
+    /// Lichtblick) replays in 3-D and `ros2 bag` reads (pose and path as ROS 2 messages).
+    Export {
+        /// The run log (JSON Lines).
+        log: PathBuf,
+        /// The MCAP file to write.
+        #[arg(long, value_name = "FILE")]
+        mcap: PathBuf,
     },
 }
 
@@ -321,6 +331,16 @@ fn run_cli() -> Result<ExitCode> {
             } else {
                 ExitCode::FAILURE
             })
+        }
+        Cmd::Export { log, mcap } => {
+            let summary = trust_export::export_file(&log, &mcap)?;
+            let total: u64 = summary.message_counts.values().sum();
+            println!(
+                "wrote {} ({total} messages on {} topics)",
+                mcap.display(),
+                summary.message_counts.len()
+            );
+            Ok(ExitCode::SUCCESS)
         }
     }
 }

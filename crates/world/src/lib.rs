@@ -113,6 +113,7 @@ pub mod planner;
 pub mod problem;
 mod sampling;
 pub mod scenario;
+pub mod script;
 pub mod seeds;
 pub mod sensing;
 pub mod traffic;
