@@ -63,8 +63,9 @@ pub const WORLD_FRAME: &str = "world";
 pub const VEHICLE_FRAME: &str = "vehicle";
 
 /// The branches the manager held in one cycle, as sampled polylines (main first), for
-/// `/scene/branches`. The run log's optional branch fields map onto this type; a log without
-/// them exports without the channel.
+/// `/scene/branches`. Callers map the cycles' sampled branches onto this type; without branches
+/// the file has no branch channel. ([`export_file`] and `trust-sim export` pass none yet: the
+/// run log's cycle records carry no sampled branches in this version.)
 #[derive(Debug, Clone, PartialEq)]
 pub struct Branches {
     /// Cycle time (s).
@@ -134,8 +135,8 @@ pub fn export_file(log_path: &Path, mcap_path: &Path) -> Result<ExportSummary, E
 ///
 /// # Errors
 /// [`ExportError::Input`] for a non-finite number, a negative time or branches out of order;
-/// [`ExportError::Io`] / [`ExportError::Mcap`] naming the file. Nothing is left half-written
-/// only in the sense that a failed export's file is not a valid MCAP file.
+/// [`ExportError::Io`] / [`ExportError::Mcap`] naming the file (input errors are found before
+/// the file is created; a write error may leave a partial file, which no MCAP reader accepts).
 pub fn export_mcap(
     log: &RunLog,
     branches: &[Branches],

@@ -180,8 +180,10 @@ fn pchip_tangent(d0: f64, d1: f64, h0: f64, h1: f64) -> f64 {
 }
 
 impl SampledPath {
-    /// The interpolant of `samples` (`[t, x, y, z]`), checked as [`check_samples`] checks them
-    /// (without a region).
+    /// The interpolant of `samples` (`[t, x, y, z]`), checked first: at least 2 and at most
+    /// [`MAX_SAMPLES`] samples, finite values within the scale policy, strictly increasing times,
+    /// and for a loop the last position equal to the first (the region is checked by the
+    /// scenario's validation).
     ///
     /// # Errors
     /// [`WorldError::Input`] naming the first bad sample under `field`.
@@ -281,7 +283,9 @@ pub struct FourierCurve {
 }
 
 impl FourierCurve {
-    /// The curve of `spec`, checked as [`check_fourier`] checks it (without a region).
+    /// The curve of `spec`, checked first: a period in `(0, 1e7]` s, finite centre, phase and
+    /// coefficients (within 1e6 m), at most [`MAX_HARMONICS`] per list (the region is checked by
+    /// the scenario's validation).
     ///
     /// # Errors
     /// [`WorldError::Input`] naming the first bad field under `field`.
