@@ -67,7 +67,8 @@ fn members() -> Vec<Member> {
 /// `runlog` knows none of the simulator's types either (a log is read without building a world;
 /// the scenario's static shapes are its `StaticShape`); `vehicle` knows nothing of the planner;
 /// `route` (the global route, issue 19) sits beside `minco`/`topo-prm` on `geometry` (and may use
-/// `core`); `replay` (issue 20) reads run logs and draws with `plot`, and only the binary uses it.
+/// `core`); `replay` (issue 20) reads run logs and draws with `plot`, and only the binary uses it;
+/// `export` (MCAP, issue 20) reads logs only (`runlog`), and only `sim` uses it.
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
     const PLANNING: &[&str] = &[
         "trust-geometry",
@@ -128,6 +129,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
         ),
         ("trust-plot", &[][..]),
         ("trust-runlog", &[][..]),
+        ("trust-export", &["trust-runlog"][..]),
         ("trust-vehicle", &["trust-core"][..]),
         ("trust-world", with(&["trust-vehicle", "trust-runlog"])),
         (
@@ -151,6 +153,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-vehicle",
                 "trust-world",
                 "trust-runlog",
+                "trust-export",
                 "trust-flight",
                 "trust-plot",
                 "trust-experiments",

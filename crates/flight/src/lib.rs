@@ -196,6 +196,7 @@ pub fn header(world: &World, planner_label: &str, points_file: Option<String>) -
                     shape: ObstacleKind::Sphere,
                     radius,
                     half_height: None,
+                    half_extents: None,
                 },
                 MovingShape::Cylinder {
                     radius,
@@ -205,6 +206,14 @@ pub fn header(world: &World, planner_label: &str, points_file: Option<String>) -
                     shape: ObstacleKind::Cylinder,
                     radius,
                     half_height: Some(half_height),
+                    half_extents: None,
+                },
+                MovingShape::Box { half_extents } => ObstacleInfo {
+                    id,
+                    shape: ObstacleKind::Box,
+                    radius: o.shape.radius(),
+                    half_height: None,
+                    half_extents: Some(half_extents),
                 },
             })
             .collect(),

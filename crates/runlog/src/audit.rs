@@ -209,6 +209,12 @@ fn clearance_at(h: &Header, grid: Option<&PointGrid>, s: &StateRecord) -> (f64, 
                 let hh = info.half_height.unwrap_or(0.0);
                 vertical_cylinder(&s.p, c[0], c[1], info.radius, c[2] - hh, c[2] + hh)
             }
+            ObstacleKind::Box => {
+                let e = info.half_extents.unwrap_or([0.0; 3]);
+                let min = [c[0] - e[0], c[1] - e[1], c[2] - e[2]];
+                let max = [c[0] + e[0], c[1] + e[1], c[2] + e[2]];
+                aligned_box(&s.p, &min, &max)
+            }
         } - radius;
         if d < dynamic_c {
             dynamic_c = d;
@@ -407,6 +413,7 @@ pub fn audit(log: &RunLog, log_dir: &Path) -> Result<Audit, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Record;
 
     #[test]
     fn closed_forms() {
@@ -420,6 +427,69 @@ mod tests {
         let b = |p: [f64; 3]| aligned_box(&p, &[0.0; 3], &[2.0, 2.0, 2.0]);
         assert!((b([5.0, 6.0, 1.0]) - 5.0).abs() < 1e-12);
         assert!((b([1.0, 1.0, 1.5]) + 0.5).abs() < 1e-12);
+    }
+
+    /// A log with one moving box: the audit measures the box itself, not a sphere or cylinder
+    /// around it (a point diagonally off a corner is clear of the box but inside its
+    /// circumscribing cylinder), and names the collision when the vehicle enters it.
+    #[test]
+    fn audit_measures_a_moving_box() {
+        let line = r#"{"type":"header","schema":"trust-sim-log/1","scenario":"box","seed":0,
+            "planner":"trust","bounds":{"min":[0,0,0],"max":[10,10,3]},"vehicle":{"radius":0.3},
+            "limits":{"v_max":2,"a_max":3},"start":[6.3,6.3,1],"goal":[9,9,1],
+            "goal_tolerance":0.2,"static_shapes":[],"static_points_file":null,
+            "obstacles":[{"id":0,"shape":"box","radius":1.4142135623730951,
+            "half_extents":[1,1,1]}]}"#
+            .replace('\n', "");
+        let Record::Header(header) = serde_json::from_str::<Record>(&line).unwrap() else {
+            panic!("a header");
+        };
+        let state = |t: f64, p: [f64; 3], box_x: f64| StateRecord {
+            t,
+            p,
+            v: [0.0; 3],
+            a: [0.0; 3],
+            obstacles: vec![[box_x, 5.0, 1.0]],
+        };
+        let clear = state(0.0, [6.3, 6.3, 1.0], 5.0);
+        let outcome = |status, with: Option<&str>, t, min_dyn| crate::Outcome {
+            status,
+            t,
+            flight_time_s: t,
+            path_length_m: 0.0,
+            min_clearance_static_m: 1e9,
+            min_clearance_dynamic_m: min_dyn,
+            max_speed: 0.0,
+            max_accel: 0.0,
+            with: with.map(str::to_string),
+            reason: None,
+            cycle_count: 0,
+        };
+        let corner = 0.3f64.hypot(0.3) - 0.3;
+        let log = RunLog {
+            header: header.clone(),
+            states: vec![clear.clone()],
+            cycles: Vec::new(),
+            outcome: outcome(Status::TimedOut, None, 0.0, corner),
+        };
+        let a = audit(&log, Path::new(".")).unwrap();
+        assert!(a.passed(), "{:?}", a.findings);
+        assert!((a.recomputed.min_clearance_dynamic_m - corner).abs() < 1e-12);
+        // The box moves 0.1 m towards +x: the vehicle is now 0.2 m from its face, 0.1 m inside
+        // its radius.
+        let log = RunLog {
+            header,
+            states: vec![clear, state(0.02, [6.3, 5.0, 1.0], 5.1)],
+            cycles: Vec::new(),
+            outcome: crate::Outcome {
+                path_length_m: 1.3,
+                ..outcome(Status::Collided, Some("obstacle:0"), 0.02, -0.1)
+            },
+        };
+        let a = audit(&log, Path::new(".")).unwrap();
+        assert!(a.passed(), "{:?}", a.findings);
+        assert_eq!(a.recomputed.with.as_deref(), Some("obstacle:0"));
+        assert!((a.recomputed.min_clearance_dynamic_m + 0.1).abs() < 1e-12);
     }
 
     #[test]

@@ -18,6 +18,8 @@
 //! - Added (issue 20): [`CycleRecord::branch_samples`] ([`BranchSamples`]) and
 //!   [`CycleRecord::forecasts`] ([`ForecastRecord`], [`ForecastShape`]), optional and absent
 //!   unless branch logging is on, so older logs read as before.
+//! - Issue 20: a moving obstacle may be a box — [`ObstacleKind::Box`] with
+//!   [`ObstacleInfo::half_extents`] (an addition; the audit measures the box).
 //! - [`StaticShape`] is also the scenario file's static shape (`trust_world::scenario::StaticShape`,
 //!   which replaced `ShapeSpec`); its serialized form in the log is unchanged.
 #![warn(missing_docs)]
@@ -100,13 +102,18 @@ pub enum StaticShape {
 pub struct ObstacleInfo {
     /// Index in every `state` record's `obstacles`.
     pub id: usize,
-    /// `"sphere"` or `"cylinder"`.
+    /// `"sphere"`, `"cylinder"` or (added) `"box"`.
     pub shape: ObstacleKind,
-    /// Radius (m).
+    /// Radius (m). For a box: `√(hx² + hy²)`, the radius of the vertical cylinder its
+    /// forecasts use (the truth is `half_extents`).
     pub radius: f64,
     /// Half of the height (cylinders only; centre at mid-height).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub half_height: Option<f64>,
+    /// Added: half extents `[hx, hy, hz]` of a box (boxes only; axis-aligned, centred at the
+    /// state's obstacle position).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_extents: Option<[f64; 3]>,
 }
 
 /// Shape of a moving obstacle.
@@ -117,6 +124,8 @@ pub enum ObstacleKind {
     Sphere,
     /// A vertical cylinder.
     Cylinder,
+    /// Added: an axis-aligned box (`half_extents`).
+    Box,
 }
 
 /// The first line.
@@ -554,8 +563,8 @@ pub struct RunLog {
 }
 
 impl RunLog {
-    /// Reads a log and checks the contract's structure: a header first (with the right schema),
-    /// an outcome last, exactly one of each, state times strictly increasing with steps ≤ 0.02 s,
+    /// Reads a log and checks the contract's structure: a header first (with the right schema,
+    /// every box obstacle with positive `half_extents`), an outcome last, exactly one of each, state times strictly increasing with steps ≤ 0.02 s,
     /// every state listing one position per header obstacle.
     ///
     /// # Errors
@@ -594,6 +603,18 @@ impl RunLog {
                     }
                     if h.schema != SCHEMA {
                         return Err(parse(format!("schema `{}`, expected `{SCHEMA}`", h.schema)));
+                    }
+                    for o in &h.obstacles {
+                        let sized = o
+                            .half_extents
+                            .is_some_and(|e| e.iter().all(|x| x.is_finite() && *x > 0.0));
+                        if o.shape == ObstacleKind::Box && !sized {
+                            return Err(parse(format!(
+                                "obstacle {}: a box needs `half_extents` [hx, hy, hz] > 0, \
+                                 got {:?}",
+                                o.id, o.half_extents
+                            )));
+                        }
                     }
                     header = Some(h);
                 }
@@ -684,6 +705,7 @@ mod tests {
                 shape: ObstacleKind::Cylinder,
                 radius: 0.4,
                 half_height: Some(1.5),
+                half_extents: None,
             }],
             sim: None,
         }

@@ -5,6 +5,7 @@
 //! trust-sim validate SCENARIO.toml...
 //! trust-sim audit RUN.jsonl...
 //! trust-sim replay RUN.jsonl [--out DIR] [--gif-width PX] [--gif-frames N]
+//! trust-sim export RUN.jsonl --mcap FILE
 //! trust-sim ablate [--scenario FILE] [--trials N] [--seed S] [--planners a,b] [--variant V]
 //!                  [--out DIR] [--jobs J] [--shard K/M] [--time-limit T] [--no-plots]
 //! trust-sim ablate-merge --out DIR SHARD_DIR...
@@ -15,7 +16,7 @@
 //!
 //! The binary only parses the command line; the work is in `trust-world` (scenarios, worlds),
 //! `trust-flight` (the closed loop), `trust-runlog` (logs, audit), `trust-experiments`
-//! (studies, E3, figures) and `trust-replay` (the replay page and GIF).
+//! (studies, E3, figures), `trust-replay` (the replay page and GIF) and `trust-export` (MCAP).
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -208,6 +209,15 @@ enum Cmd {
         /// Run logs (JSON Lines).
         #[arg(required = true)]
         logs: Vec<PathBuf>,
+    },
+    /// Export a run log for other tools: `--mcap FILE` writes an MCAP file that Foxglove (or
+    /// Lichtblick) replays in 3-D and `ros2 bag` reads (pose and path as ROS 2 messages).
+    Export {
+        /// The run log (JSON Lines).
+        log: PathBuf,
+        /// The MCAP file to write.
+        #[arg(long, value_name = "FILE")]
+        mcap: PathBuf,
     },
 }
 
@@ -461,6 +471,16 @@ fn run_cli() -> Result<ExitCode> {
             } else {
                 ExitCode::FAILURE
             })
+        }
+        Cmd::Export { log, mcap } => {
+            let summary = trust_export::export_file(&log, &mcap)?;
+            let total: u64 = summary.message_counts.values().sum();
+            println!(
+                "wrote {} ({total} messages on {} topics)",
+                mcap.display(),
+                summary.message_counts.len()
+            );
+            Ok(ExitCode::SUCCESS)
         }
     }
 }

@@ -8,7 +8,7 @@ use trust_predict::ObstacleShape;
 
 use crate::problem::{Problems, fmt_bounds, fmt_vec};
 use crate::scenario::{
-    E4Params, GeneratorSpec, MovingShapeKind, PointCloudSpec, Problem, RandomObstacles, Scenario,
+    E4Params, GeneratorSpec, PointCloudSpec, Problem, RandomObstacles, Scenario,
 };
 use crate::traffic::{Motion, MovingObstacle, MovingShape};
 
@@ -82,19 +82,15 @@ pub(crate) fn generate(s: &Scenario, bounds: &Aabb, seed: u64) -> Result<Layout,
     layout.generated_shape_count = layout.shapes.len();
     layout.shapes.extend(explicit);
     for (i, o) in s.obstacles.iter().enumerate() {
-        layout.obstacles.push(MovingObstacle {
-            shape: match o.shape {
-                MovingShapeKind::Sphere => MovingShape::Sphere { radius: o.radius_m },
-                MovingShapeKind::Cylinder => MovingShape::Cylinder {
-                    radius: o.radius_m,
-                    half_height: o.half_height_m.unwrap_or(0.0),
-                },
-            },
-            position: Vec3::from(o.position),
-            velocity: Vec3::from(o.velocity),
-            motion: o.motion.clone(),
-            region: o.region.map_or(*bounds, |r| r.aabb()),
-        });
+        let field = format!("obstacles[{i}]");
+        let region = o.region.map_or(*bounds, |r| r.aabb());
+        match o.moving_obstacle(&field, region, |p| s.resolve_path(p)) {
+            Ok(m) => layout.obstacles.push(m),
+            Err(p) => {
+                problems.list.push(p);
+                continue;
+            }
+        }
         layout.obstacle_origins.push(format!("obstacles[{i}]"));
     }
     for (i, g) in s.random_obstacles.iter().enumerate() {

@@ -3,7 +3,7 @@
 //! The first stage of the simulator's data path (scenario file → world → closed loop → run log →
 //! experiments; paper Sec. IV-D): [`scenario`] parses and checks the TOML file, [`World::build`]
 //! generates the layout and the planner's map from the seeds, [`traffic`] moves the true
-//! obstacles, [`sensing`] turns them into the forecasts the planner sees, and [`planner`] turns the
+//! obstacles (scripted ones along [`script`]), [`sensing`] turns them into the forecasts the planner sees, and [`planner`] turns the
 //! scenario's `[planner]` section into the parameters of the parts it names (the closed loop in
 //! `trust-flight` assembles them). Errors are [`WorldError`]s naming the file, field and value.
 //!
@@ -98,6 +98,13 @@
 //!   shows, without the layout checks (start and goal against the generated layout); those run
 //!   once, where the layout is generated: [`World::build`], [`check`] and [`load_checked`]
 //!   (`trust-sim validate`).
+//! - Issue 20: scripted obstacle motion and moving boxes. [`traffic::Motion`] gained `Samples`
+//!   (time-stamped samples, inline or from a CSV file) and `Fourier` (a closed curve), evaluated
+//!   by [`script`]; [`traffic::MovingShape`] gained `Box`. In the scenario file an
+//!   `[[obstacles]]` entry's `radius_m` and `position` became optional
+//!   ([`scenario::ObstacleSpec`]: `radius_m` is required for spheres and cylinders,
+//!   `half_extents` for boxes; `position` and `velocity` are not allowed with a scripted motion,
+//!   whose script gives them); validation names every bad sample (by index, or by CSV line).
 //! - `World::planner_map_arc` is removed (unused; [`World::planner_map`] gives the map).
 //! - `scenario::ShapeSpec` is replaced by the run log's `trust_runlog::StaticShape`, re-exported as
 //!   [`scenario::StaticShape`] (the TOML form, tagged by `kind`, is unchanged);
@@ -115,6 +122,7 @@ pub mod planner;
 pub mod problem;
 mod sampling;
 pub mod scenario;
+pub mod script;
 pub mod seeds;
 pub mod sensing;
 pub mod traffic;

@@ -24,6 +24,22 @@
 //! deviation (`a·T²/2 ≤ μ·T` for `T ≤ T_h`) exactly when `a ≤ 2μ/T_h`
 //! ([`ManeuverParams::covered_by`]). Vertical velocity (spheres only) is kept between reflections.
 //!
+//! # Scripted motion
+//!
+//! [`Motion::Samples`] and [`Motion::Fourier`] are deterministic truth ([`crate::script`]): the
+//! centre follows the script exactly (no reflections at the region's walls; validation checks that
+//! the script keeps the obstacle inside its region), the velocity is the script's derivative, and
+//! the fault level does not apply.
+//!
+//! # Boxes
+//!
+//! A moving obstacle may be an axis-aligned box ([`MovingShape::Box`]): collisions are judged on
+//! the box. Its forecasts ([`MovingShape::forecast_shape`]) use the vertical cylinder that
+//! circumscribes it — radius `√(hx² + hy²)`, half-height `hz` — which contains the box, is
+//! contained in its circumscribing sphere (radius `√(hx² + hy² + hz²)`), so it never blocks more
+//! space than the sphere would, and is a shape every forecast and cone already handles (growing
+//! in radius and half-height). A box does not rotate, so the cylinder stays conservative.
+//!
 //! # Fault level
 //!
 //! [`TrafficParams::fault_level`] `f ≥ 0` scales the acceleration and turn-rate bounds of every
@@ -44,11 +60,15 @@ use rand::{Rng as _, SeedableRng};
 use rand_distr::{Distribution, Exp};
 use serde::{Deserialize, Serialize};
 use trust_core::{Aabb, Rng, Vec3};
-use trust_geometry::{cylinder_sdf, sphere_sdf};
+use trust_geometry::{box_sdf, cylinder_sdf, sphere_sdf};
 use trust_predict::ObstacleShape;
 
 use crate::error::WorldError;
 use crate::problem::{Problems, fmt_bounds, fmt_vec};
+use crate::script::{
+    FOURIER_CHECK_SAMPLES, FourierCurve, FourierSpec, SampledPath, SamplesSpec, Script,
+    check_fourier, check_inside, check_samples,
+};
 use crate::seeds::mix_seed;
 
 /// True shape and size of a moving obstacle. A cylinder is vertical with its centre at
@@ -68,13 +88,21 @@ pub enum MovingShape {
         /// Half of the height (m), `> 0`.
         half_height: f64,
     },
+    /// An axis-aligned box, centred at the obstacle's centre.
+    Box {
+        /// Half extents `[hx, hy, hz]` (m), each `> 0`.
+        half_extents: [f64; 3],
+    },
 }
 
 impl MovingShape {
-    /// The radius (sphere or cylinder), the `r_o` of a forecast.
+    /// The radius of the forecast shape, a forecast's `r_o`: the sphere's or cylinder's radius;
+    /// for a box, `√(hx² + hy²)`, the radius of the vertical cylinder its forecasts use (module
+    /// docs).
     pub fn radius(&self) -> f64 {
         match *self {
             MovingShape::Sphere { radius } | MovingShape::Cylinder { radius, .. } => radius,
+            MovingShape::Box { half_extents: h } => h[0].hypot(h[1]),
         }
     }
 
@@ -86,6 +114,7 @@ impl MovingShape {
                 radius,
                 half_height,
             } => Vec3::new(radius, radius, half_height),
+            MovingShape::Box { half_extents } => Vec3::from(half_extents),
         }
     }
 
@@ -97,22 +126,31 @@ impl MovingShape {
                 radius,
                 half_height,
             } => cylinder_sdf(center, radius, half_height, p).0,
+            MovingShape::Box { half_extents } => {
+                let h = Vec3::from(half_extents);
+                box_sdf(&(center - h), &(center + h), p).0
+            }
         }
     }
 
-    /// The shape a forecast of this obstacle uses (its `r_o` is [`MovingShape::radius`]).
+    /// The shape a forecast of this obstacle uses (its `r_o` is [`MovingShape::radius`]): a box
+    /// is forecast as its circumscribing vertical cylinder (module docs).
     pub fn forecast_shape(&self) -> ObstacleShape {
         match *self {
             MovingShape::Sphere { .. } => ObstacleShape::Sphere,
             MovingShape::Cylinder { half_height, .. } => ObstacleShape::Cylinder { half_height },
+            MovingShape::Box { half_extents } => ObstacleShape::Cylinder {
+                half_height: half_extents[2],
+            },
         }
     }
 
-    /// `"sphere"` or `"cylinder"` (the run log's `shape`).
+    /// `"sphere"`, `"cylinder"` or `"box"` (the run log's `shape`).
     pub fn kind_name(&self) -> &'static str {
         match self {
             MovingShape::Sphere { .. } => "sphere",
             MovingShape::Cylinder { .. } => "cylinder",
+            MovingShape::Box { .. } => "box",
         }
     }
 }
@@ -176,6 +214,45 @@ pub enum Motion {
     ConstantVelocity {},
     /// Random maneuvers within bounds: `{ kind = "random-maneuvers", max_accel_m_s2 = 0.1, ... }`.
     RandomManeuvers(ManeuverParams),
+    /// Scripted: time-stamped samples, inline or from a CSV file: `{ kind = "samples", file =
+    /// "data/walker.csv", end = "hold" }` ([`crate::script`]).
+    Samples(SamplesSpec),
+    /// Scripted: a closed curve given by Fourier coefficients: `{ kind = "fourier", period_s =
+    /// 12, center = [x, y, z], cos = [[r, 0, 0]], sin = [[0, r, 0]] }` ([`crate::script`]).
+    Fourier(FourierSpec),
+}
+
+impl Motion {
+    /// Whether the motion is scripted (samples or a Fourier curve): the obstacle's position and
+    /// velocity come from the script.
+    pub fn is_scripted(&self) -> bool {
+        matches!(self, Motion::Samples(_) | Motion::Fourier(_))
+    }
+
+    /// The script ready to evaluate, for a scripted motion whose samples are loaded; `None` for
+    /// the other motions.
+    ///
+    /// # Errors
+    /// [`WorldError::Input`] naming the first bad sample or coefficient under `field`, or a
+    /// samples file that was not loaded ([`SamplesSpec::load`]).
+    pub fn script(&self, field: &str) -> Result<Option<Script>, WorldError> {
+        match self {
+            Motion::Samples(s) => {
+                if s.samples.is_empty() && s.file.is_some() {
+                    return Err(WorldError::input(
+                        format!("{field}.file"),
+                        format!("{:?} (not loaded)", s.file.clone().unwrap_or_default()),
+                        "samples loaded from the file (SamplesSpec::load) before the traffic is built",
+                    ));
+                }
+                Ok(Some(Script::Samples(SampledPath::new(
+                    field, &s.samples, s.end,
+                )?)))
+            }
+            Motion::Fourier(f) => Ok(Some(Script::Fourier(FourierCurve::new(field, f)?))),
+            _ => Ok(None),
+        }
+    }
 }
 
 impl Default for Motion {
@@ -221,6 +298,11 @@ impl MovingObstacle {
                 sizes_ok &= p.positive(&format!("{field}.radius_m"), radius);
                 sizes_ok &= p.positive(&format!("{field}.half_height_m"), half_height);
             }
+            MovingShape::Box { half_extents } => {
+                for (axis, h) in ["x", "y", "z"].iter().zip(half_extents) {
+                    sizes_ok &= p.positive(&format!("{field}.half_extents.{axis}"), h);
+                }
+            }
         }
         let pos_ok = p.finite_vec(&format!("{field}.position"), self.position.as_slice());
         let vel_ok = p.finite_vec(&format!("{field}.velocity"), self.velocity.as_slice());
@@ -246,7 +328,7 @@ impl MovingObstacle {
                         fmt_vec(e.as_slice())
                     ),
                 );
-            } else if pos_ok {
+            } else if pos_ok && !self.motion.is_scripted() {
                 let inside = (0..3).all(|i| {
                     self.position[i] >= r.min[i] + e[i] - 1e-9
                         && self.position[i] <= r.max[i] - e[i] + 1e-9
@@ -263,8 +345,63 @@ impl MovingObstacle {
                 }
             }
         }
+        let motion_field = format!("{field}.motion");
+        let e = self.shape.half_extents();
+        let inside_checkable = sizes_ok && region_ok;
+        match &self.motion {
+            Motion::Samples(s) => {
+                if s.samples.is_empty() && s.file.is_some() {
+                    p.push(
+                        format!("{motion_field}.file"),
+                        format!("{:?} (not loaded)", s.file.clone().unwrap_or_default()),
+                        "samples loaded from the file (SamplesSpec::load)",
+                    );
+                } else {
+                    let labels = s.labels(&motion_field);
+                    check_samples(&motion_field, &s.samples, &labels, s.end, p);
+                    if inside_checkable {
+                        // Every finite sample, whatever else is wrong with the track.
+                        let positions: Vec<(String, Vec3)> = labels
+                            .into_iter()
+                            .zip(&s.samples)
+                            .filter(|(_, q)| q.iter().all(|x| x.is_finite()))
+                            .map(|(l, q)| (l, Vec3::new(q[1], q[2], q[3])))
+                            .collect();
+                        check_inside(&positions, &e, r, &format!("{field}.region"), p);
+                    }
+                }
+            }
+            Motion::Fourier(f) => {
+                let fields_ok = check_fourier(&motion_field, f, p);
+                if fields_ok && inside_checkable {
+                    let curve = FourierCurve::new(&motion_field, f).ok();
+                    let first_out = curve.and_then(|c| {
+                        (0..FOURIER_CHECK_SAMPLES)
+                            .map(|k| {
+                                let t = f.period_s * k as f64 / FOURIER_CHECK_SAMPLES as f64;
+                                (t, c.evaluate(t).0)
+                            })
+                            .find(|(_, q)| {
+                                !(0..3).all(|i| {
+                                    q[i] >= r.min[i] + e[i] - 1e-9 && q[i] <= r.max[i] - e[i] + 1e-9
+                                })
+                            })
+                    });
+                    if let Some((t, q)) = first_out {
+                        check_inside(
+                            &[(format!("{motion_field} at t = {t} s"), q)],
+                            &e,
+                            r,
+                            &format!("{field}.region"),
+                            p,
+                        );
+                    }
+                }
+            }
+            _ => {}
+        }
         if let Motion::RandomManeuvers(m) = &self.motion {
-            m.check(&format!("{field}.motion"), p);
+            m.check(&motion_field, p);
             if let (Some([lo, hi]), true) = (m.speed_m_s, vel_ok) {
                 let s = self.velocity.norm();
                 if lo.is_finite() && hi.is_finite() && !(lo - 1e-9..=hi + 1e-9).contains(&s) {
@@ -307,6 +444,8 @@ struct Agent {
     dir: Vec3,
     speed: f64,
     maneuver: Option<ManeuverState>,
+    /// A scripted motion: the centre and velocity come from it.
+    script: Option<Script>,
 }
 
 #[derive(Debug, Clone)]
@@ -389,8 +528,9 @@ impl Traffic {
                 } else {
                     Vec3::x()
                 };
+                let script = o.motion.script(&format!("obstacles[{i}].motion"))?;
                 let maneuver = match &o.motion {
-                    Motion::ConstantVelocity {} => None,
+                    Motion::ConstantVelocity {} | Motion::Samples(_) | Motion::Fourier(_) => None,
                     Motion::RandomManeuvers(m) => {
                         let speed_range = m.speed_m_s.unwrap_or([speed, speed]);
                         let v_top = speed_range[1].max(speed);
@@ -428,13 +568,19 @@ impl Traffic {
                     dir,
                     speed,
                     maneuver,
+                    script,
                 })
             })
             .collect::<Result<Vec<_>, WorldError>>()?;
+        let initial = |k: usize| match &agents[k].script {
+            Some(s) => s.evaluate(0.0),
+            None => (obstacles[k].position, obstacles[k].velocity),
+        };
+        let (positions, velocities) = (0..obstacles.len()).map(initial).unzip();
         Ok(Traffic {
             t: 0.0,
-            positions: obstacles.iter().map(|o| o.position).collect(),
-            velocities: obstacles.iter().map(|o| o.velocity).collect(),
+            positions,
+            velocities,
             shapes: obstacles.iter().map(|o| o.shape).collect(),
             bounce_counts: vec![0; obstacles.len()],
             maneuver_counts: vec![0; obstacles.len()],
@@ -506,6 +652,10 @@ impl Traffic {
         }
         let t_end = self.t + dt;
         for (i, agent) in self.agents.iter_mut().enumerate() {
+            if let Some(script) = &agent.script {
+                (self.positions[i], self.velocities[i]) = script.evaluate(t_end);
+                continue;
+            }
             let mut t = self.t;
             let p = &mut self.positions[i];
             loop {

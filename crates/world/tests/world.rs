@@ -619,3 +619,72 @@ fn a_warmed_up_sensor_has_converged_tracks_at_take_off() {
             .is_err()
     );
 }
+
+/// Scripted obstacles follow their script exactly (no reflection, no maneuvers, no fault level),
+/// with the script's derivative as velocity; a moving box is judged on the box, and its forecast
+/// is the circumscribing vertical cylinder.
+#[test]
+fn scripted_obstacles_follow_their_script_and_boxes_are_boxes() {
+    let w = World::build(&scenario(
+        "name = \"scripted\"\n[world]\nbounds = { min = [0, 0, 0], max = [10, 8, 3] }\n\
+         [[obstacles]]\nshape = \"box\"\nhalf_extents = [0.4, 0.3, 0.5]\n\
+         motion = { kind = \"fourier\", period_s = 8, center = [5, 4, 1.5], \
+         cos = [[2, 0, 0]], sin = [[0, 0, 0], [0, 1.5, 0]] }\n\
+         [[obstacles]]\nshape = \"sphere\"\nradius_m = 0.3\n\
+         motion = { kind = \"samples\", end = \"hold\", \
+         samples = [[0.5, 1, 1, 1], [1.5, 2, 1, 1], [2.5, 2, 2, 1.5]] }\n\
+         [mission]\nstart = [0.5, 7.5, 1]\ngoal = [9.5, 7.5, 1]\n",
+    ))
+    .unwrap();
+    // The script's position at t = 0 is the obstacle's initial state.
+    let o = w.obstacles();
+    assert!((o[0].position - Vec3::new(7.0, 4.0, 1.5)).norm() < 1e-12);
+    assert_eq!(o[1].position, Vec3::new(1.0, 1.0, 1.0));
+    assert_eq!(o[1].velocity, Vec3::zeros());
+    let script = |i: usize| o[i].motion.script("m").unwrap().unwrap();
+    let (box_script, sphere_script) = (script(0), script(1));
+    // Fault level 3 would scale maneuvers; scripted truth ignores it.
+    let mut traffic = Traffic::new(o, 3.0, 5).unwrap();
+    for step in 1..=2000 {
+        traffic.step(0.002).unwrap();
+        let t = step as f64 * 0.002;
+        for (i, s) in [&box_script, &sphere_script].into_iter().enumerate() {
+            let (p, v) = s.evaluate(t);
+            // (The traffic's clock sums the steps; `t` here multiplies: last-bit differences.)
+            assert!(
+                (traffic.positions()[i] - p).norm() < 1e-9,
+                "obstacle {i} at t = {t}"
+            );
+            assert!(
+                (traffic.velocities()[i] - v).norm() < 1e-9,
+                "obstacle {i} at t = {t}"
+            );
+        }
+    }
+    assert_eq!(traffic.bounce_counts(), &[0, 0]);
+    assert_eq!(traffic.maneuver_counts(), &[0, 0]);
+    // Held at the last sample after t = 2.5 s.
+    assert_eq!(traffic.positions()[1], Vec3::new(2.0, 2.0, 1.5));
+    assert_eq!(traffic.velocities()[1], Vec3::zeros());
+    // The box: 0.1 m off a face is clear, inside is negative; off a corner it is the corner
+    // distance, not the cylinder's.
+    let c = traffic.positions()[0];
+    let shape = o[0].shape;
+    let d = shape.signed_distance(&c, &(c + Vec3::new(0.5, 0.0, 0.0)));
+    assert!((d - 0.1).abs() < 1e-12, "{d}");
+    assert!(shape.signed_distance(&c, &(c + Vec3::new(0.3, 0.2, 0.0))) < 0.0);
+    let corner = c + Vec3::new(0.45, 0.35, 0.0);
+    let d = shape.signed_distance(&c, &corner);
+    assert!((d - 0.05f64.hypot(0.05)).abs() < 1e-12, "{d}");
+    let near_face = c + Vec3::new(0.42, 0.1, 0.0);
+    assert!((shape.signed_distance(&c, &near_face) - 0.02).abs() < 1e-12);
+    assert!(
+        near_face.xy().metric_distance(&c.xy()) < shape.radius(),
+        "a point clear of the box can be inside the forecast cylinder (conservative)"
+    );
+    assert_eq!(
+        shape.forecast_shape(),
+        trust_predict::ObstacleShape::Cylinder { half_height: 0.5 }
+    );
+    assert!((shape.radius() - 0.5).abs() < 1e-12, "√(0.4² + 0.3²)");
+}

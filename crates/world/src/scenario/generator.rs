@@ -84,8 +84,19 @@ impl GeneratorSpec {
 }
 
 pub(crate) fn check_motion(field: &str, m: &Motion, p: &mut Problems) {
-    if let Motion::RandomManeuvers(m) = m {
-        m.check(field, p);
+    match m {
+        Motion::RandomManeuvers(m) => m.check(field, p),
+        Motion::Samples(_) | Motion::Fourier(_) => p.push(
+            format!("{field}.kind"),
+            if matches!(m, Motion::Samples(_)) {
+                "\"samples\""
+            } else {
+                "\"fourier\""
+            },
+            "\"constant-velocity\" or \"random-maneuvers\": a scripted motion belongs to one \
+             explicit [[obstacles]] entry, not to a generated group",
+        ),
+        Motion::ConstantVelocity {} => {}
     }
 }
 

@@ -46,12 +46,19 @@
 //! esdf_voxel_m = 0.2
 //!
 //! [[obstacles]]                  # an explicit moving obstacle
-//! shape = "cylinder"             # sphere | cylinder
-//! radius_m = 0.5
+//! shape = "cylinder"             # sphere | cylinder | box
+//! radius_m = 0.5                 # spheres and cylinders
 //! half_height_m = 1.5            # cylinders only
 //! position = [25, 15, 5]
 //! velocity = [0, -1.5, 0]
 //! motion = { kind = "random-maneuvers", max_accel_m_s2 = 0.1, speed_m_s = [1, 2] }
+//!
+//! [[obstacles]]                  # scripted (crate::script): no position/velocity, the script
+//! shape = "box"                  # gives them; an axis-aligned box (forecast as the vertical
+//! half_extents = [0.4, 0.4, 0.4] # cylinder around it, crate::traffic)
+//! motion = { kind = "fourier", period_s = 12, center = [20, 10, 4], cos = [[3, 0, 0]], sin = [[0, 3, 0]] }
+//! # motion = { kind = "samples", file = "data/walker.csv", end = "hold" }   # t,x,y,z lines
+//! # motion = { kind = "samples", samples = [[0, 1, 2, 1], [2, 3, 2, 1]], end = "loop" }
 //!
 //! [[random_obstacles]]           # a group drawn from the seed
 //! count = 4

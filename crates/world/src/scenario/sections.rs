@@ -6,8 +6,9 @@ use serde::{Deserialize, Serialize};
 use trust_core::{Aabb, Limits, Vec3};
 use trust_geometry::{AaBox, Cylinder, Shape, Sphere};
 
+use crate::problem::Problem;
 use crate::scenario::generator::GeneratorSpec;
-use crate::traffic::{Motion, MovingShape};
+use crate::traffic::{Motion, MovingObstacle, MovingShape};
 use trust_runlog::StaticShape;
 use trust_vehicle::{QuadrotorParams, Se3Gains};
 
@@ -222,24 +223,31 @@ pub enum MovingShapeKind {
     /// A vertical cylinder of radius `radius_m` and half-height `half_height_m`, centred at
     /// mid-height.
     Cylinder,
+    /// An axis-aligned box of half extents `half_extents` about its centre (forecast as its
+    /// circumscribing vertical cylinder, [`crate::traffic`]).
+    Box,
 }
 
 /// One explicit moving obstacle (`[[obstacles]]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObstacleSpec {
-    /// `"sphere"` or `"cylinder"`.
+    /// `"sphere"`, `"cylinder"` or `"box"`.
     pub shape: MovingShapeKind,
-    /// Radius (m), `> 0`.
-    pub radius_m: f64,
-    /// Half-height (m) of a cylinder, `> 0`; required for cylinders, not allowed for spheres.
+    /// Radius (m), `> 0`; required for spheres and cylinders, not allowed for boxes.
+    pub radius_m: Option<f64>,
+    /// Half-height (m) of a cylinder, `> 0`; required for cylinders, not allowed otherwise.
     pub half_height_m: Option<f64>,
-    /// Centre at `t = 0` (m).
-    pub position: [f64; 3],
-    /// Velocity at `t = 0` (m/s). Default at rest.
-    #[serde(default)]
-    pub velocity: [f64; 3],
-    /// Motion model. Default `{ kind = "constant-velocity" }`.
+    /// Half extents `[hx, hy, hz]` (m) of a box, each `> 0`; required for boxes, not allowed
+    /// otherwise.
+    pub half_extents: Option<[f64; 3]>,
+    /// Centre at `t = 0` (m); required, except for a scripted motion (`samples`, `fourier`), whose
+    /// script gives it (and then not allowed).
+    pub position: Option<[f64; 3]>,
+    /// Velocity at `t = 0` (m/s). Default at rest; not allowed with a scripted motion.
+    pub velocity: Option<[f64; 3]>,
+    /// Motion model. Default `{ kind = "constant-velocity" }`; `samples` and `fourier` script the
+    /// motion (`trust_world::script`).
     #[serde(default)]
     pub motion: Motion,
     /// The box it stays inside (reflecting at its walls). Default: the world bounds.
@@ -247,17 +255,76 @@ pub struct ObstacleSpec {
 }
 
 impl ObstacleSpec {
-    /// The true shape (a missing cylinder half-height reads as 0, which validation rejects).
+    /// The true shape (a missing size reads as 0, which validation rejects).
     pub fn moving_shape(&self) -> MovingShape {
+        let radius = self.radius_m.unwrap_or(0.0);
         match self.shape {
-            MovingShapeKind::Sphere => MovingShape::Sphere {
-                radius: self.radius_m,
-            },
+            MovingShapeKind::Sphere => MovingShape::Sphere { radius },
             MovingShapeKind::Cylinder => MovingShape::Cylinder {
-                radius: self.radius_m,
+                radius,
                 half_height: self.half_height_m.unwrap_or(0.0),
             },
+            MovingShapeKind::Box => MovingShape::Box {
+                half_extents: self.half_extents.unwrap_or([0.0; 3]),
+            },
         }
+    }
+}
+
+impl ObstacleSpec {
+    /// The obstacle as the traffic takes it, in `region`, with `field` (`obstacles[i]`) naming
+    /// it: a samples file is read (`resolve` maps its path, usually
+    /// [`crate::scenario::Scenario::resolve_path`]) and a scripted obstacle starts where its
+    /// script is at `t = 0`, with the script's velocity (the first sample when the samples are
+    /// invalid: validation names them). A missing position reads as the origin (validation
+    /// rejects it).
+    ///
+    /// # Errors
+    /// A [`Problem`] naming `FIELD.motion.file` when the samples file cannot be read or a line
+    /// does not parse (with its line number).
+    pub(crate) fn moving_obstacle(
+        &self,
+        field: &str,
+        region: Aabb,
+        resolve: impl Fn(&std::path::Path) -> PathBuf,
+    ) -> Result<MovingObstacle, Problem> {
+        let motion = match &self.motion {
+            Motion::Samples(spec) => Motion::Samples(spec.load(&resolve).map_err(|e| {
+                Problem::new(
+                    format!("{field}.motion.file"),
+                    format!(
+                        "{:?}",
+                        spec.file.clone().unwrap_or_default().display().to_string()
+                    ),
+                    format!("a readable CSV file of `t,x,y,z` lines ({e})"),
+                )
+            })?),
+            m => m.clone(),
+        };
+        let (mut position, mut velocity) = (
+            Vec3::from(self.position.unwrap_or_default()),
+            Vec3::from(self.velocity.unwrap_or_default()),
+        );
+        if motion.is_scripted() {
+            match motion.script(&format!("{field}.motion")) {
+                Ok(Some(script)) => (position, velocity) = script.evaluate(0.0),
+                _ => {
+                    if let Motion::Samples(s) = &motion
+                        && let Some(first) = s.samples.first()
+                    {
+                        position = Vec3::new(first[1], first[2], first[3]);
+                    }
+                    velocity = Vec3::zeros();
+                }
+            }
+        }
+        Ok(MovingObstacle {
+            shape: self.moving_shape(),
+            position,
+            velocity,
+            motion,
+            region,
+        })
     }
 }
 

@@ -179,39 +179,93 @@ impl Scenario {
     fn check_obstacles(&self, p: &mut Problems, bounds: Option<&Aabb>) {
         for (i, o) in self.obstacles.iter().enumerate() {
             let field = format!("obstacles[{i}]");
-            match (o.shape, o.half_height_m) {
-                (MovingShapeKind::Cylinder, None) => p.push(
-                    format!("{field}.half_height_m"),
-                    "(missing)",
-                    "a half-height > 0 for a cylinder",
-                ),
-                (MovingShapeKind::Sphere, Some(h)) => p.push(
-                    format!("{field}.half_height_m"),
-                    h,
-                    "no half-height for a sphere (use shape = \"cylinder\")",
-                ),
-                _ => {}
+            let before = p.list.len();
+            let shape = match o.shape {
+                MovingShapeKind::Sphere => "sphere",
+                MovingShapeKind::Cylinder => "cylinder",
+                MovingShapeKind::Box => "box",
+            };
+            let wants = |name: &str| match name {
+                "radius_m" => o.shape != MovingShapeKind::Box,
+                "half_height_m" => o.shape == MovingShapeKind::Cylinder,
+                _ => o.shape == MovingShapeKind::Box,
+            };
+            for (name, given) in [
+                ("radius_m", o.radius_m.map(|r| r.to_string())),
+                ("half_height_m", o.half_height_m.map(|h| h.to_string())),
+                ("half_extents", o.half_extents.map(|h| fmt_vec(&h))),
+            ] {
+                match (wants(name), given) {
+                    (true, None) => p.push(
+                        format!("{field}.{name}"),
+                        "(missing)",
+                        match name {
+                            "radius_m" => format!("a radius > 0 for a {shape}"),
+                            "half_height_m" => "a half-height > 0 for a cylinder".to_string(),
+                            _ => "half extents [hx, hy, hz] > 0 for a box".to_string(),
+                        },
+                    ),
+                    (false, Some(v)) => p.push(
+                        format!("{field}.{name}"),
+                        v,
+                        format!("no {name} for shape = \"{shape}\""),
+                    ),
+                    _ => {}
+                }
             }
+            let scripted = o.motion.is_scripted();
+            for (name, given) in [("position", o.position), ("velocity", o.velocity)] {
+                match (scripted, given) {
+                    (true, Some(v)) => p.push(
+                        format!("{field}.{name}"),
+                        fmt_vec(&v),
+                        "no position or velocity with a scripted motion (samples, fourier): the \
+                         script gives them",
+                    ),
+                    (false, None) if name == "position" => p.push(
+                        format!("{field}.position"),
+                        "(missing)",
+                        "the centre at t = 0 [x, y, z]",
+                    ),
+                    _ => {}
+                }
+            }
+            if let crate::traffic::Motion::Samples(s) = &o.motion {
+                match (s.samples.is_empty(), &s.file) {
+                    (false, Some(file)) => p.push(
+                        format!("{field}.motion"),
+                        format!("samples and file {:?}", file.display().to_string()),
+                        "either inline samples or a file, not both",
+                    ),
+                    (true, None) => p.push(
+                        format!("{field}.motion.samples"),
+                        "(missing)",
+                        "samples = [[t, x, y, z], ...] or file = \"track.csv\"",
+                    ),
+                    _ => {}
+                }
+            }
+            // Missing sizes were reported above; their zeros would be reported again.
+            let reported: Vec<String> = p.list[before..].iter().map(|q| q.field.clone()).collect();
             let region = match (&o.region, bounds) {
                 (Some(r), _) => Some(r.aabb()),
                 (None, Some(b)) => Some(*b),
                 (None, None) => None,
             };
             if let Some(region) = region {
-                let m = crate::traffic::MovingObstacle {
-                    shape: o.moving_shape(),
-                    position: Vec3::from(o.position),
-                    velocity: Vec3::from(o.velocity),
-                    motion: o.motion.clone(),
-                    region,
-                };
-                let mut sub = Problems::default();
-                m.check(&field, &mut sub);
-                // A missing half-height was reported above; its 0 would be reported again.
-                sub.list.retain(|q| {
-                    !(o.half_height_m.is_none() && q.field == format!("{field}.half_height_m"))
-                });
-                p.list.extend(sub.list);
+                match o.moving_obstacle(&field, region, |q| self.resolve_path(q)) {
+                    Ok(m) => {
+                        let mut sub = Problems::default();
+                        m.check(&field, &mut sub);
+                        sub.list.retain(|q| {
+                            !reported
+                                .iter()
+                                .any(|r| q.field == *r || q.field.starts_with(&format!("{r}.")))
+                        });
+                        p.list.extend(sub.list);
+                    }
+                    Err(problem) => p.list.push(problem),
+                }
             }
         }
         for (i, g) in self.random_obstacles.iter().enumerate() {
