@@ -64,8 +64,8 @@ pub const VEHICLE_FRAME: &str = "vehicle";
 
 /// The branches the manager held in one cycle, as sampled polylines (main first), for
 /// `/scene/branches`. Callers map the cycles' sampled branches onto this type; without branches
-/// the file has no branch channel. ([`export_file`] and `trust-sim export` pass none yet: the
-/// run log's cycle records carry no sampled branches in this version.)
+/// the file has no branch channel. [`export_file`] (and `trust-sim export`) takes them from the
+/// log's cycle records ([`branches_of`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Branches {
     /// Cycle time (s).
@@ -120,14 +120,35 @@ pub struct ExportSummary {
     pub message_counts: BTreeMap<String, u64>,
 }
 
-/// Reads the run log at `log_path` and writes `mcap_path` (module docs), without branches.
+/// Reads the run log at `log_path` and writes `mcap_path` (module docs), with the branches its
+/// cycle records carry ([`branches_of`]; none when the flight was logged without them).
 ///
 /// # Errors
 /// [`ExportError::Log`] naming the log file and line; [`ExportError::Io`] /
 /// [`ExportError::Mcap`] naming the MCAP file.
 pub fn export_file(log_path: &Path, mcap_path: &Path) -> Result<ExportSummary, ExportError> {
     let log = RunLog::read(log_path)?;
-    export_mcap(&log, &[], mcap_path)
+    export_mcap(&log, &branches_of(&log), mcap_path)
+}
+
+/// The sampled branches of `log`'s cycle records (`branch_samples`, written when branch logging
+/// is on), one [`Branches`] per cycle that carries any, main branch first; empty for a log
+/// without them.
+pub fn branches_of(log: &RunLog) -> Vec<Branches> {
+    log.cycles
+        .iter()
+        .filter_map(|c| {
+            let samples = c.branch_samples.as_ref()?;
+            Some(Branches {
+                t: c.t,
+                has_main: c.main.is_some() && !samples.is_empty(),
+                polylines: samples
+                    .iter()
+                    .map(|b| b.samples.iter().map(|s| [s[1], s[2], s[3]]).collect())
+                    .collect(),
+            })
+        })
+        .collect()
 }
 
 /// Writes `log` (and `branches`, in cycle order; may be empty) to the MCAP file `path` (module

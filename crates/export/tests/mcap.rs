@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use trust_export::{Branches, ExportError, export_file, export_mcap};
 use trust_runlog::{
-    Bounds, Header, LimitsInfo, LogWriter, ObstacleInfo, ObstacleKind, Outcome, Record, RunLog,
-    SCHEMA, StateRecord, StaticShape, Status, VehicleInfo,
+    Bounds, BranchSamples, CycleRecord, Header, LimitsInfo, LogWriter, ObstacleInfo, ObstacleKind,
+    Outcome, Record, RunLog, SCHEMA, StateRecord, StaticShape, Status, VehicleInfo,
 };
 
 fn dir(name: &str) -> PathBuf {
@@ -269,6 +269,57 @@ fn without_branches_there_is_no_branch_channel_and_a_log_file_exports() {
     let r = read(&path);
     assert_eq!(r.channels.len(), 7);
     assert!(!r.channels.contains_key("/scene/branches"));
+
+    // With sampled branches in its cycle records (branch logging on), the file export carries
+    // them on /scene/branches.
+    let mut with = l.clone();
+    with.cycles = (0..3)
+        .map(|k| {
+            let t = 0.5 * k as f64;
+            CycleRecord {
+                t,
+                wall_ms: 0.0,
+                main: Some(1),
+                branches: 1,
+                events: vec![],
+                frontend_ms: 0.0,
+                backend_ms: 0.0,
+                checker_ms: 0.0,
+                solve_count: 1,
+                effective_t: t,
+                branch_j: vec![1.0],
+                fallback_collision_free: None,
+                fallback_shortfall_m: None,
+                dropped: Default::default(),
+                route: None,
+                route_ms: None,
+                branch_samples: Some(vec![BranchSamples {
+                    id: 1,
+                    samples: vec![[t, 1.0, 1.0, 1.0], [t + 1.0, 2.0, 1.5, 1.0]],
+                }]),
+                forecasts: None,
+            }
+        })
+        .collect();
+    let b = trust_export::branches_of(&with);
+    assert_eq!(b.len(), 3);
+    assert_eq!(b[1].polylines, vec![vec![[1.0, 1.0, 1.0], [2.0, 1.5, 1.0]]]);
+    assert!(b[0].has_main);
+    let with_path = d.join("with.jsonl");
+    let mut w = LogWriter::create(&with_path).unwrap();
+    w.write(&Record::Header(with.header.clone())).unwrap();
+    let mut cycles = with.cycles.iter().peekable();
+    for s in &with.states {
+        while let Some(c) = cycles.next_if(|c| c.t <= s.t) {
+            w.write(&Record::Cycle(c.clone())).unwrap();
+        }
+        w.write(&Record::State(s.clone())).unwrap();
+    }
+    w.write(&Record::Outcome(with.outcome.clone())).unwrap();
+    w.finish().unwrap();
+    export_file(&with_path, &path).unwrap();
+    let r = read(&path);
+    assert!(r.channels.contains_key("/scene/branches"));
 
     // A broken log line is named with its file and line.
     let text = std::fs::read_to_string(&log_path).unwrap();
