@@ -117,6 +117,10 @@ struct Candidate {
     repaired: bool,
 }
 
+/// A route vertex turning by more than this (60°) is aimed at before the route's local goal
+/// ([`trust_route::GlobalRoute::first_sharp_turn`]; beyond the paper).
+const SHARP_TURN_RAD: f64 = std::f64::consts::FRAC_PI_3;
+
 /// Whether `v` failed by at most `margin` (m) of clearance, or only on the limits.
 fn narrowly_unsafe(v: &SafetyVerdict, margin: f64) -> bool {
     !v.safe
@@ -296,9 +300,22 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             return *goal;
         };
         let horizon_m = self.params.horizon_s * self.limits.v_max;
-        match route.local_goal(from, horizon_m) {
-            Ok(local) if route.length() - local.s > 1e-9 => local.point,
-            _ => *goal,
+        let Ok(s0) = route.progress(from) else {
+            return *goal;
+        };
+        match route.local_goal_from(s0, horizon_m) {
+            Ok(local) => {
+                // A sharp corner before the local goal is aimed at first (a shaft entrance: the
+                // pieces of a trajectory aimed beyond it cut through the slab). The vehicle is at
+                // the corner once within its clearance of it; then the aim moves on.
+                let at_corner = s0 + route.clearance_m().max(self.params.goal_reached_m);
+                match route.first_sharp_turn(at_corner, local.s, SHARP_TURN_RAD) {
+                    Some(corner) => corner.point,
+                    None if route.length() - local.s > 1e-9 => local.point,
+                    None => *goal,
+                }
+            }
+            Err(_) => *goal,
         }
     }
 

@@ -236,6 +236,32 @@ impl GlobalRoute {
         self.local_goal_from(proj.s, horizon_m)
     }
 
+    /// The first vertex with arc length in `(from_s, to_s)` where the route turns by more than
+    /// `min_turn_rad` (the angle between the incoming and the outgoing segment), or `None`. A
+    /// local planner that aims beyond such a corner cuts it (its trajectory pieces are longer
+    /// than the corner is sharp); aiming at the corner first brings the vehicle round it.
+    pub fn first_sharp_turn(
+        &self,
+        from_s: f64,
+        to_s: f64,
+        min_turn_rad: f64,
+    ) -> Option<RoutePoint> {
+        (1..self.points.len().saturating_sub(1))
+            .filter(|&i| self.cum[i] > from_s && self.cum[i] < to_s)
+            .find(|&i| {
+                let a = self.points[i] - self.points[i - 1];
+                let b = self.points[i + 1] - self.points[i];
+                let (na, nb) = (a.norm(), b.norm());
+                na > 0.0
+                    && nb > 0.0
+                    && (a.dot(&b) / (na * nb)).clamp(-1.0, 1.0).acos() > min_turn_rad
+            })
+            .map(|i| RoutePoint {
+                s: self.cum[i],
+                point: self.points[i],
+            })
+    }
+
     /// [`GlobalRoute::local_goal`] for a vehicle whose projection is already known to be at arc
     /// length `s` (e.g. from [`GlobalRoute::project_after`]).
     pub fn local_goal_from(&self, s: f64, horizon_m: f64) -> Result<RoutePoint, RouteError> {
