@@ -121,6 +121,34 @@ fn view(
         }
         v = v.polyline(line);
     }
+    // The global route (issue 19): the first one planned, and the last if the manager re-planned.
+    let routes: Vec<&Vec<[f64; 3]>> = record
+        .cycles
+        .iter()
+        .filter_map(|c| c.route.as_ref())
+        .collect();
+    let shown: Vec<(&Vec<[f64; 3]>, &str, Color)> = match routes.as_slice() {
+        [] => vec![],
+        [only] => vec![(only, "global route", Color::rgb(40, 160, 70))],
+        [first, .., last] => vec![
+            (first, "global route (first)", Color::rgb(40, 160, 70)),
+            (
+                last,
+                "global route (last re-plan)",
+                Color::rgb(150, 90, 200),
+            ),
+        ],
+    };
+    for (route, label, color) in shown {
+        let pts = route.iter().map(|p| plane.project(&p3(p))).collect();
+        v = v.polyline(
+            Polyline::new(pts)
+                .label(label)
+                .color(color)
+                .width_px(2)
+                .dashed(),
+        );
+    }
     let flown = record
         .states
         .iter()
