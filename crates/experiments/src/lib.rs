@@ -10,6 +10,9 @@
 //!
 //! # Changelog
 //!
+//! - Issue 19: [`suite`] (`trust-sim suite`): every scenario file of a folder with K seeds, one
+//!   table per class; the study's `Variant::Route`, and a study flies without the route otherwise;
+//!   the flight plots draw the route.
 //! - Moved out of `trust-sim` (issue 17): `trust_sim::{study, e3, flight_plots}` are
 //!   `trust_experiments::{study, e3, flight_plots}`.
 //! - `trust_sim::error::SimError` is split by stage; this crate's errors are [`ExperimentError`]s

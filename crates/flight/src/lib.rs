@@ -23,6 +23,8 @@
 //!
 //! # Changelog
 //!
+//! - Issue 19: cycle records carry the route the manager planned (`route`, `route_ms`) and a
+//!   fallback's shortfall (`fallback_shortfall_m`).
 //! - Moved out of `trust-sim` (issue 17): `trust_sim::run::{fly, header, RunOptions, RunSummary,
 //!   Flight, FlightRecord}` are at this crate's root.
 //! - `trust_sim::error::SimError` is split by stage; this crate's errors are [`FlightError`]s

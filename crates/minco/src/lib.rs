@@ -152,6 +152,9 @@
 //!
 //! # Changelog
 //!
+//! - Issue 19: UTF-MINCO's terminal pull is raised near the goal by the final-approach gain
+//!   ([`costs::final_approach_gain`], `PenaltyParams::goal_settle_m` = 0.02 m) so the free terminal
+//!   settles within 2 cm of the goal at any `a_max`; the reported `H_s` is unchanged.
 //! - `backend::guidance_radius(start, goal, horizon_s, &limits)` moved to
 //!   `trust_core::guidance_radius(start, goal, horizon_s, v_max)`, shared with DEV-PRM's goal
 //!   guidance surface; the Bernstein control points of the fused integration come from

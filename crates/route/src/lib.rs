@@ -11,7 +11,8 @@
 //!   [`trust_geometry::StaticMap`] (analytic shapes and/or voxel ESDF), for a vehicle radius.
 //! * [`GlobalRoute`] is the polyline with its arc length and the queries a mission manager needs:
 //!   [`GlobalRoute::local_goal`], [`GlobalRoute::progress`] (for a progress monitor),
-//!   [`GlobalRoute::remaining_length`], [`GlobalRoute::first_blocked`] /
+//!   [`GlobalRoute::remaining_length`], [`GlobalRoute::first_sharp_turn`] (a corner to aim at
+//!   before the local goal), [`GlobalRoute::first_blocked`] /
 //!   [`GlobalRoute::is_blocked`] (for a re-route when the map changes).
 //!
 //! Use it once before the first planning cycle and again when the vehicle stalls or the route is
@@ -34,6 +35,9 @@
 //!    error for voxels), every point of an edge between two free neighbours — within `h·√3/2`
 //!    of one end — is then at least `c` from the obstacles. The route is collision-free at `c`
 //!    without a line-of-sight query per edge.
+//!    The search runs **coarse to fine** ([`RouteParams::coarse_factor`]): first on cells 4 times
+//!    larger (a coarse free cell is farther from the obstacles, so its route is as safe), then on
+//!    the fine grid only when the coarse one finds nothing.
 //! 3. **Shortcut.** From each kept vertex the route jumps to the farthest following vertex that
 //!    a straight segment reaches with clearance `c` (checked with `segment_clear`), which
 //!    removes the grid's 45° staircase; a shortcut is only taken when clear at `c`, so it never

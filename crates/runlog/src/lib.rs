@@ -12,6 +12,8 @@
 //!
 //! # Changelog
 //!
+//! - Issue 19: [`CycleRecord::route`], [`CycleRecord::route_ms`],
+//!   [`CycleRecord::fallback_shortfall_m`] (optional, absent when not applicable).
 //! - Moved out of `trust-sim` (issue 17): `trust_sim::runlog` is this crate's root and
 //!   `trust_sim::audit` is [`audit`]; the run-log errors are [`LogError`]s, no longer wrapped in
 //!   `SimError`.
