@@ -84,6 +84,7 @@
 //! - Issue 19: `[planner.route]` (`planner::RouteSpec`, on by default) and
 //!   `planner.tracking_margin_m` (default `planner::tracking_margin_for(a_max)`), applied by
 //!   `planner::effective` to the safety check, the backend and the frontends.
+//!
 //! Issue 17 split `trust-sim` along the data path; this crate holds its first stage.
 //!
 //! - Moves: `trust_sim::{scenario, planner, sensing, traffic}` are `trust_world::{scenario,
