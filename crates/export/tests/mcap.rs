@@ -290,6 +290,7 @@ fn without_branches_there_is_no_branch_channel_and_a_log_file_exports() {
                 branch_j: vec![1.0],
                 fallback_collision_free: None,
                 fallback_shortfall_m: None,
+                fallback_along: None,
                 dropped: Default::default(),
                 route: None,
                 route_ms: None,

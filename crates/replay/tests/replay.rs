@@ -123,6 +123,7 @@ fn write_log(path: &Path, t_end: f64, with_branches: bool) {
                 branch_j: vec![1.0, 2.0],
                 fallback_collision_free: (k == 50).then_some(true),
                 fallback_shortfall_m: None,
+                fallback_along: None,
                 dropped: Dropped::default(),
                 route: None,
                 route_ms: None,

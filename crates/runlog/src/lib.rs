@@ -218,6 +218,11 @@ pub struct CycleRecord {
     /// fails to keep the required clearance under the forecasts.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback_shortfall_m: Option<f64>,
+    /// Added, only on fallback cycles: what the fallback flies — `committed`, `branch`,
+    /// `candidate` or `straight` (braking along it), `evade` (a rejected trajectory as it is) or
+    /// `escape` (a short manoeuvre to rest out of the way).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback_along: Option<String>,
     /// Added: what the safety check dropped this cycle, by the first violation's cause.
     #[serde(default, skip_serializing_if = "Dropped::is_empty")]
     pub dropped: Dropped,
@@ -759,6 +764,7 @@ mod tests {
             branch_j: vec![1.0, 2.0],
             fallback_collision_free: None,
             fallback_shortfall_m: None,
+            fallback_along: None,
             dropped: Dropped::default(),
             route: None,
             route_ms: None,
