@@ -430,3 +430,70 @@ fn assembled_planners_plan_in_the_shipped_worlds() {
     }
     plan_once(&World::build(&e4).unwrap(), false);
 }
+
+#[test]
+fn a_random_flight_draws_its_start_and_goal_from_the_seed() {
+    let text = r#"
+name = "random_flight"
+seed = 0
+[world]
+bounds = { min = [0, 0, 0], max = [8, 6, 3] }
+[[static.shapes]]
+kind = "cylinder"
+center = [4.0, 3.0]
+radius = 0.5
+z_min = 0.0
+z_max = 3.0
+[mission]
+goal_tolerance_m = 0.15
+random = { region = { min = [0.5, 0.5, 0.8], max = [7.5, 5.5, 1.8] }, min_distance_m = 4.0, clearance_m = 0.3 }
+[vehicle]
+radius_m = 0.1
+"#;
+    let s = Scenario::from_toml_str(text, Path::new("random.toml")).unwrap();
+    assert!(s.validate().is_empty(), "{:?}", s.validate());
+    let pillar = |p: [f64; 3]| ((p[0] - 4.0).powi(2) + (p[1] - 3.0).powi(2)).sqrt() - 0.5;
+    let mut seen = Vec::new();
+    for seed in 0..20 {
+        let t = s.with_seed(seed);
+        let (a, g) = (t.mission.start, t.mission.goal);
+        for p in [a, g] {
+            assert!(
+                p[0] >= 0.5 && p[0] <= 7.5 && p[2] >= 0.8 && p[2] <= 1.8,
+                "{p:?}"
+            );
+            assert!(
+                pillar(p) >= 0.4,
+                "seed {seed}: {p:?} is {} from the pillar",
+                pillar(p)
+            );
+        }
+        let d = ((a[0] - g[0]).powi(2) + (a[1] - g[1]).powi(2) + (a[2] - g[2]).powi(2)).sqrt();
+        assert!(d >= 4.0, "seed {seed}: {d}");
+        // The same seed draws the same mission; the world, traffic and noise streams are the
+        // seed's as before.
+        assert_eq!(s.with_seed(seed).mission, t.mission);
+        assert_eq!(t.seeds(), trust_world::Seeds::from_trial(seed));
+        seen.push(a);
+    }
+    seen.sort_by(|x, y| x[0].total_cmp(&y[0]));
+    seen.dedup();
+    assert_eq!(seen.len(), 20, "every seed flies another mission");
+    // Without `random`, start and goal are required, and the error says so.
+    let e = Scenario::from_toml_str(
+        "name = \"x\"\n[world]\nbounds = { min = [0, 0, 0], max = [8, 6, 3] }\n[mission]\ngoal = [1, 1, 1]\n",
+        Path::new("x.toml"),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("start"), "{e}");
+    // An impossible distance is named.
+    let far = text.replace("min_distance_m = 4.0", "min_distance_m = 40.0");
+    let s = Scenario::from_toml_str(&far, Path::new("far.toml")).unwrap();
+    let problems = s.validate();
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.field == "mission.random.min_distance_m"),
+        "{problems:?}"
+    );
+}

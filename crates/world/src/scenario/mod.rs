@@ -134,8 +134,8 @@ use trust_core::Aabb;
 pub use crate::problem::Problem;
 pub use generator::{E1Params, E2Params, E3Params, E4Params, GeneratorSpec};
 pub use sections::{
-    BoundsSpec, Latency, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec, RandomObstacles,
-    SimSection, StaticSection, VehicleModel, VehicleSection, WorldSection,
+    BoundsSpec, Latency, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec, RandomEndpoints,
+    RandomObstacles, SimSection, StaticSection, VehicleModel, VehicleSection, WorldSection,
 };
 
 /// A static obstacle of `[[static.shapes]]`: the run log's type (see [`StaticSection::shapes`]).
@@ -236,7 +236,7 @@ impl Scenario {
             message: e.to_string().trim_end().to_string(),
         })?;
         s.path = Some(origin.to_path_buf());
-        Ok(s)
+        Ok(s.with_seed(s.seed))
     }
 
     /// Reads and parses a scenario file without validating it.
@@ -274,10 +274,23 @@ impl Scenario {
     /// The same scenario with another trial seed (Monte Carlo trials).
     #[must_use]
     pub fn with_seed(&self, seed: u64) -> Scenario {
-        Scenario {
+        let mut s = Scenario {
             seed,
             ..self.clone()
+        };
+        // A random flight draws its start and goal from the seed.
+        if let (Some(random), Some(bounds)) = (&s.mission.random, s.bounds()) {
+            let shapes: Vec<trust_geometry::Shape> = s
+                .static_map
+                .shapes
+                .iter()
+                .map(sections::geometry_shape)
+                .collect();
+            let (start, goal) = random.draw(seed, &bounds, &shapes, s.vehicle.radius_m);
+            s.mission.start = start;
+            s.mission.goal = goal;
         }
+        s
     }
 
     /// The seeds of this trial's random streams.

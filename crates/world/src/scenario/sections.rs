@@ -387,17 +387,124 @@ impl Default for RandomObstacles {
     }
 }
 
-/// Section `[mission]`.
+/// Section `[mission]`: a start and a goal, given or drawn from the trial seed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, try_from = "RawMission")]
 pub struct Mission {
-    /// Start position (m); the vehicle starts at rest at `t = 0`.
+    /// Start position (m); the vehicle starts at rest at `t = 0`. Drawn from the seed with
+    /// `random` (then optional in the file).
     pub start: [f64; 3],
-    /// Goal position (m).
+    /// Goal position (m). Drawn from the seed with `random` (then optional in the file).
     pub goal: [f64; 3],
     /// Arrival radius around the goal (m), `> 0`. Default 0.5 m (the run-log contract's example).
     #[serde(default = "default_goal_tolerance")]
     pub goal_tolerance_m: f64,
+    /// "Random flight": draw the start and the goal from the trial seed ([`RandomEndpoints`]);
+    /// every seed flies another mission in the same scene.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub random: Option<RandomEndpoints>,
+}
+
+/// `[mission] random = { ... }`: the start and the goal drawn uniformly in `region` from the
+/// trial seed (a stream of its own, so the world, the traffic and the noise of a seed do not
+/// change), each at least `vehicle.radius_m + clearance_m` from every explicit static shape
+/// (`[[static.shapes]]`), and at least `min_distance_m` apart. Up to 10 000 draws per point; if
+/// none fits, the best draw is kept and validation names the problem.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RandomEndpoints {
+    /// Where to draw (`{min, max}`); default: the world bounds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub region: Option<BoundsSpec>,
+    /// Least distance between the start and the goal (m). Default 0.
+    #[serde(default)]
+    pub min_distance_m: f64,
+    /// Clearance beyond the vehicle radius from the explicit static shapes (m). Default 0.
+    #[serde(default)]
+    pub clearance_m: f64,
+}
+
+/// The file's `[mission]` before the draw: start and goal are required without `random`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMission {
+    start: Option<[f64; 3]>,
+    goal: Option<[f64; 3]>,
+    #[serde(default = "default_goal_tolerance")]
+    goal_tolerance_m: f64,
+    #[serde(default)]
+    random: Option<RandomEndpoints>,
+}
+
+impl TryFrom<RawMission> for Mission {
+    type Error = String;
+
+    fn try_from(raw: RawMission) -> Result<Self, String> {
+        let (start, goal) = match (raw.start, raw.goal, &raw.random) {
+            (Some(s), Some(g), _) => (s, g),
+            // Drawn from the seed once the scenario is read (Scenario::with_seed).
+            (s, g, Some(_)) => (s.unwrap_or([0.0; 3]), g.unwrap_or([0.0; 3])),
+            (None, _, None) => return Err("missing field `start` (give it, or `random`)".into()),
+            (_, None, None) => return Err("missing field `goal` (give it, or `random`)".into()),
+        };
+        Ok(Mission {
+            start,
+            goal,
+            goal_tolerance_m: raw.goal_tolerance_m,
+            random: raw.random,
+        })
+    }
+}
+
+impl RandomEndpoints {
+    /// Draws `(start, goal)` for trial seed `seed` in `bounds` (the world bounds, used without a
+    /// `region`), clear of `shapes` by `radius + clearance_m`.
+    pub fn draw(
+        &self,
+        seed: u64,
+        bounds: &Aabb,
+        shapes: &[Shape],
+        radius: f64,
+    ) -> ([f64; 3], [f64; 3]) {
+        use rand::{Rng as _, SeedableRng};
+        let region = self.region.as_ref().map_or(*bounds, BoundsSpec::aabb);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(crate::seeds::mix_seed(seed, 5));
+        let need = radius + self.clearance_m;
+        let clear = |p: &Vec3| {
+            shapes
+                .iter()
+                .map(|s| s.signed_distance(p))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let point = |rng: &mut rand_chacha::ChaCha8Rng, ok: &dyn Fn(&Vec3) -> bool| {
+            let mut best: Option<(f64, Vec3)> = None;
+            for _ in 0..10_000 {
+                let p = Vec3::new(
+                    uniform(rng, region.min.x, region.max.x),
+                    uniform(rng, region.min.y, region.max.y),
+                    uniform(rng, region.min.z, region.max.z),
+                );
+                let c = clear(&p);
+                if c >= need && ok(&p) {
+                    return p;
+                }
+                if best.is_none_or(|(b, _)| c > b) {
+                    best = Some((c, p));
+                }
+            }
+            best.map_or(region.min, |(_, p)| p)
+        };
+        fn uniform(rng: &mut rand_chacha::ChaCha8Rng, lo: f64, hi: f64) -> f64 {
+            if hi > lo {
+                rng.random_range(lo..hi)
+            } else {
+                lo
+            }
+        }
+        let start = point(&mut rng, &|_| true);
+        let goal = point(&mut rng, &|p| (p - start).norm() >= self.min_distance_m);
+        (start.into(), goal.into())
+    }
 }
 
 fn default_goal_tolerance() -> f64 {

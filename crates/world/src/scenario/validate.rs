@@ -318,6 +318,48 @@ impl Scenario {
             }
         }
         p.positive("mission.goal_tolerance_m", m.goal_tolerance_m);
+        if let Some(r) = &m.random {
+            p.non_negative("mission.random.min_distance_m", r.min_distance_m);
+            p.non_negative("mission.random.clearance_m", r.clearance_m);
+            if let Some(region) = &r.region {
+                let ok = p.finite_vec("mission.random.region.min", &region.min)
+                    & p.finite_vec("mission.random.region.max", &region.max);
+                let (lo, hi) = (Vec3::from(region.min), Vec3::from(region.max));
+                if ok && (0..3).any(|i| lo[i] > hi[i]) {
+                    p.push(
+                        "mission.random.region",
+                        fmt_bounds(&region.min, &region.max),
+                        "min <= max on every axis",
+                    );
+                } else if ok
+                    && let Some(b) = bounds
+                    && !(b.contains(&lo) && b.contains(&hi))
+                {
+                    p.push(
+                        "mission.random.region",
+                        fmt_bounds(&region.min, &region.max),
+                        format!(
+                            "a box inside world.bounds {}",
+                            fmt_bounds(b.min.as_slice(), b.max.as_slice())
+                        ),
+                    );
+                }
+            }
+            if let Some(b) = bounds {
+                let (a, g) = (Vec3::from(m.start), Vec3::from(m.goal));
+                if r.min_distance_m.is_finite() && (a - g).norm() < r.min_distance_m {
+                    p.push(
+                        "mission.random.min_distance_m",
+                        r.min_distance_m,
+                        format!(
+                            "a distance the region allows: the best of 10 000 draws in {} is                              {:.3} m",
+                            fmt_bounds(b.min.as_slice(), b.max.as_slice()),
+                            (a - g).norm()
+                        ),
+                    );
+                }
+            }
+        }
     }
 
     fn check_vehicle(&self, p: &mut Problems) {
