@@ -958,7 +958,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let mut best: Option<(usize, SafetyVerdict)> = None;
         let rank =
             |v: &SafetyVerdict| (v.violation.map_or(f64::INFINITY, |x| x.t), v.min_margin_m());
-        for (i, (_, traj)) in options.iter().enumerate() {
+        for (i, (kind, traj)) in options.iter().enumerate() {
             let v = assess_trajectory(
                 traj,
                 scene,
@@ -967,6 +967,12 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 &self.limits,
                 &self.params.safety,
             );
+            // A rejected trajectory that breaks the speed or acceleration limits is no way out
+            // (without this, one rejected only for its limits passed as "collision-free" and the
+            // vehicle flew it: up to 1.08 a_max in the rooms with people).
+            if *kind == "evade" && v.over_limits {
+                continue;
+            }
             if v.violation.is_none() {
                 best = Some((i, v));
                 break;
