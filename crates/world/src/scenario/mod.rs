@@ -70,6 +70,8 @@
 //! start = [2, 10, 3]
 //! goal = [38, 10, 3]
 //! goal_tolerance_m = 0.5
+//! # "random flight": start and goal drawn from the seed instead (sections::RandomEndpoints)
+//! # random = { region = { min = [1, 1, 1], max = [39, 19, 9] }, min_distance_m = 20, clearance_m = 0.3 }
 //!
 //! [vehicle]
 //! radius_m = 0.3
@@ -82,8 +84,12 @@
 //! # frontend = { kind = "v-prm", budget_ms = 20 }   # dev-prm | v-prm | straight-line | sparse-a-star
 //! # backend = { kind = "minco" }                    # utf-minco | minco
 //! # checker = { kind = "uvd" }                      # tvd | uvd
+//! # tracking_margin_m = 0.02                        # default 0.01 + 0.0015 a_max (crate::planner)
 //! # [planner.manager]                               # merged onto the preset's ManagerParams
 //! # horizon_s = 3.0
+//! # [planner.route]                                 # the global route, on by default;
+//! # enabled = false                                 # false: the paper's setting (aim at the goal)
+//! # [planner.route.params]                          # trust_route::RouteParams
 //!
 //! [sensing]
 //! rate_hz = 20.0
