@@ -9,7 +9,7 @@
 //!   a vehicle pushed off its route by traffic gets a route from where it is, not a projection
 //!   onto a corridor it left.
 //!
-//! Each plan is reported as [`crate::Event::Rerouted`] (length, vertices, why, time) or, when
+//! Each plan is reported as [`crate::Event::Rerouted`] (why, length, vertices) or, when
 //! the route planner fails (unreachable goal, a cap), [`crate::Event::RouteFailed`] with the
 //! typed error's message; the manager then keeps the previous route, or flies without one (the
 //! paper's setting: every query aims at the final goal). The planning time is the cycle's

@@ -993,4 +993,38 @@ fn with_a_route_a_wide_wall_ahead_is_flown_around_to_the_goal() {
     assert!(arrived < 150, "{arrived}");
     // It never touched the wall (the safety check passed every committed plan).
     assert!(reports.iter().all(|r| r.fallback.is_none()));
+
+    // The same with the manager planning its own route (a router): it plans on the first cycle,
+    // says so, and arrives as well.
+    let mut m = planner(ManagerParams::trust());
+    m.set_router(Some(
+        trust_manager::Router::new(trust_route::RouteParams::default(), 0.3).unwrap(),
+    ));
+    let reports = fly(&mut m, &map, goal, State::at_rest(0.0, start), 150, |_| {
+        Vec::new()
+    });
+    assert!(
+        matches!(
+            reports[0].events.first(),
+            Some(Event::Rerouted { reason, vertex_count, .. }) if reason == "first" && *vertex_count >= 3
+        ),
+        "{:?}",
+        reports[0].events
+    );
+    assert!(reports[0].timing.route_ms > 0.0);
+    assert!(
+        reports[1..]
+            .iter()
+            .all(|r| !r.events.iter().any(|e| matches!(e, Event::Rerouted { .. }))),
+        "no re-plan without a stall"
+    );
+    assert!(
+        reports
+            .iter()
+            .any(|r| (r.replan_start.p - goal).norm() < 0.5),
+        "arrives with its own route"
+    );
+    // A bad radius is a typed error naming the field.
+    let e = trust_manager::Router::new(trust_route::RouteParams::default(), f64::NAN).unwrap_err();
+    assert!(e.to_string().contains("route.radius_m"), "{e}");
 }
