@@ -322,10 +322,7 @@ fn run_cli() -> Result<ExitCode> {
             time_limit,
             no_plots,
         } => {
-            let planners = planners
-                .iter()
-                .map(|p| parse_preset(p.trim()))
-                .collect::<Result<Vec<_>>>()?;
+            let planners = parse_presets(&planners)?;
             let scenario_name = Scenario::load(&scenario)?.name;
             let config = StudyConfig {
                 scenario,
@@ -365,10 +362,7 @@ fn run_cli() -> Result<ExitCode> {
             time_limit,
             no_plots,
         } => {
-            let planners = planners
-                .iter()
-                .map(|p| parse_preset(p.trim()))
-                .collect::<Result<Vec<_>>>()?;
+            let planners = parse_presets(&planners)?;
             let config = SuiteConfig {
                 files: expand_paths(&scenarios)?,
                 seeds,
@@ -493,6 +487,11 @@ fn print_study(out: &Path, flights: usize) -> Result<ExitCode> {
     println!("{}", head.trim_end());
     println!("\n{flights} flight(s); wrote {}", out.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// `--planners a,b,…` as presets, in order.
+fn parse_presets(names: &[String]) -> Result<Vec<PlannerPreset>> {
+    names.iter().map(|p| parse_preset(p.trim())).collect()
 }
 
 fn parse_preset(name: &str) -> Result<PlannerPreset> {
