@@ -19,14 +19,13 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use trust_flight::{RunOptions, fly};
 use trust_plot::{Bar, BarChart, Color, Figure};
 use trust_world::World;
 use trust_world::planner::PlannerPreset;
 use trust_world::scenario::Scenario;
 
 use crate::ExperimentError;
-use crate::study::{create_dir, write_json, write_text};
+use crate::study::{create_dir, fly_logged, write_json, write_text};
 
 /// What a suite flies.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -342,18 +341,7 @@ fn fly_one(class: &str, s: &Scenario, out: &Path) -> Result<SuiteRow, Experiment
         s.planner.name.name(),
         s.seed
     );
-    let log_path = out.join(&rel);
-    if let Some(dir) = log_path.parent() {
-        create_dir(dir)?;
-    }
-    let options = RunOptions {
-        log_path: Some(log_path),
-        zero_timing: false,
-        progress_every_s: None,
-        // A study: branches only when the file asks (`[log] branches = true`).
-        log_branches: s.log.branches_or(false),
-    };
-    let flight = fly(&world, &planner, &options, |_| {})?;
+    let flight = fly_logged(&world, s, &planner, &out.join(&rel))?;
     let sm = &flight.summary;
     let o = &sm.outcome;
     let distance = (world.goal() - world.start()).norm();

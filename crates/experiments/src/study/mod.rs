@@ -455,18 +455,7 @@ fn run_trial(
         };
         let planner_spec = s.resolve_planner();
         let rel = format!("logs/{}/trial-{trial:04}.jsonl", planner.name());
-        let log_path = out.join(&rel);
-        if let Some(dir) = log_path.parent() {
-            create_dir(dir)?;
-        }
-        let options = RunOptions {
-            log_path: Some(log_path),
-            zero_timing: false,
-            progress_every_s: None,
-            // Studies keep their logs small: branches only when the scenario asks.
-            log_branches: s.log.branches_or(false),
-        };
-        let flight = fly(&w, &planner_spec, &options, |_| {})?;
+        let flight = fly_logged(&w, &s, &planner_spec, &out.join(&rel))?;
         let s = &flight.summary;
         let o = &s.outcome;
         rows.push(RunRow {
@@ -504,6 +493,26 @@ fn sort_rows(rows: &mut [RunRow], planners: &[PlannerPreset]) {
             .unwrap_or(usize::MAX)
     };
     rows.sort_by_key(|r| (r.trial, rank(&r.planner)));
+}
+
+/// One flight of a study or the suite, logged to `log_path` (its folder created). Studies keep
+/// their logs small: branches only when the scenario asks (`[log] branches = true`).
+pub(crate) fn fly_logged(
+    world: &World,
+    scenario: &Scenario,
+    planner: &trust_world::planner::ResolvedPlanner,
+    log_path: &Path,
+) -> Result<trust_flight::Flight, ExperimentError> {
+    if let Some(dir) = log_path.parent() {
+        create_dir(dir)?;
+    }
+    let options = RunOptions {
+        log_path: Some(log_path.to_path_buf()),
+        zero_timing: false,
+        progress_every_s: None,
+        log_branches: scenario.log.branches_or(false),
+    };
+    Ok(fly(world, planner, &options, |_| {})?)
 }
 
 pub(crate) fn progress_bar(show: bool, total: u64) -> indicatif::ProgressBar {
