@@ -324,10 +324,14 @@ pub fn fly(
         mut manager,
     } = set_up(world, planner)?;
     let hover = Reference::hover(start);
+    // The controller keeps the commanded acceleration within the vehicle's limit unless the
+    // scenario's gains say otherwise.
+    let mut gains = scenario.vehicle.gains;
+    gains.max_accel_m_s2 = gains.max_accel_m_s2.or(Some(scenario.vehicle.limits.a_max));
     let mut vehicle: Box<dyn Vehicle> = match scenario.vehicle.model {
         VehicleModel::Quadrotor => Box::new(ControlledQuadrotor::starting_on(
             scenario.vehicle.quadrotor,
-            scenario.vehicle.gains,
+            gains,
             0.0,
             &hover,
         )?),

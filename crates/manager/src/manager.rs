@@ -11,7 +11,7 @@ use trust_core::{
 };
 
 use crate::ManagerParams;
-use crate::brake::{brake_along, brake_straight, escape_maneuvers};
+use crate::brake::{brake_along, brake_straight, dash_maneuvers, escape_maneuvers};
 use crate::progress::ProgressMonitor;
 use crate::report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
@@ -954,7 +954,15 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         if let Ok(escapes) = escape_maneuvers(start, &directions, reach, &self.limits, hold_s) {
             options.extend(escapes.into_iter().map(|t| ("escape", t)));
         }
+        // And dashes in the same directions: 0.9 v_max reached at once, held for a quarter of the
+        // horizon, then braking (a person walking at the vehicle's own speed reaches a vehicle
+        // that escapes to rest before it is out of the way).
+        let cruise_s = 0.25 * self.params.horizon_s;
+        if let Ok(dashes) = dash_maneuvers(start, &directions, cruise_s, &self.limits, hold_s) {
+            options.extend(dashes.into_iter().map(|t| ("dash", t)));
+        }
         // The first collision-free option; else the one that collides latest, then least deeply.
+        let jerk_limit = a_max / crate::brake::RAMP_S;
         let mut best: Option<(usize, SafetyVerdict)> = None;
         let rank =
             |v: &SafetyVerdict| (v.violation.map_or(f64::INFINITY, |x| x.t), v.min_margin_m());
@@ -970,7 +978,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             // A rejected trajectory that breaks the speed or acceleration limits is no way out
             // (without this, one rejected only for its limits passed as "collision-free" and the
             // vehicle flew it: up to 1.08 a_max in the rooms with people).
-            if *kind == "evade" && v.over_limits {
+            if *kind == "evade" && (v.over_limits || max_jerk(traj) > jerk_limit) {
                 continue;
             }
             if v.violation.is_none() {
@@ -1005,6 +1013,19 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             stop_time,
         })
     }
+}
+
+/// Largest jerk norm of `traj` (m/s³), 16 samples per piece.
+fn max_jerk(traj: &PolyTraj) -> f64 {
+    let mut worst = 0.0_f64;
+    let mut t = traj.t_start();
+    for d in traj.durations() {
+        for k in 0..=16 {
+            worst = worst.max(traj.jerk(t + d * k as f64 / 16.0).norm());
+        }
+        t += d;
+    }
+    worst
 }
 
 /// Checks the inputs of [`Manager::step`].

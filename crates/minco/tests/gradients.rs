@@ -346,6 +346,21 @@ proptest! {
         // above, but such a case says nothing about the penalty's gradient, so it is discarded.
         prop_assume!(value > 0.0, "the limits must be violated");
     }
+
+    /// The jerk part of the feasibility penalty alone (speed and acceleration limits far away)
+    /// w.r.t. every coefficient and duration: `∂L/∂j` through the moments and `∂L/∂j · snap`.
+    #[test]
+    fn jerk_limit_gradient(seed in any::<u64>(), n in 1usize..5, kappa in 2usize..9, j_max in 0.2..3.0f64) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let flat = random_pieces(&mut rng, n);
+        let durations: Vec<f64> = (0..n).map(|_| rng.random_range(0.4..1.2)).collect();
+        let limits = Limits::new(1e3, 1e3).expect("limits");
+        let value = check_integrand(
+            &mut || Box::new(FeasibilityTerm::new(limits, 1e-2).with_jerk_limit(Some(j_max))),
+            kappa, 0.0, &flat, &durations,
+        )?;
+        prop_assume!(value > 0.0, "the jerk limit must be violated");
+    }
 }
 
 /// A random UTF-MINCO / MINCO test problem: start state, goal, waypoints, terminal, duration.
@@ -414,11 +429,13 @@ fn penetrated_map(rng: &mut ChaCha8Rng, traj: &PolyTraj) -> StaticMap {
     big_map().with_shapes(shapes).expect("valid shapes")
 }
 
-fn utf_params(weights: CostWeights) -> UtfMincoParams {
-    UtfMincoParams {
+fn utf_params(weights: CostWeights, jerk_ramp_s: f64) -> UtfMincoParams {
+    let mut p = UtfMincoParams {
         weights,
         ..UtfMincoParams::default()
-    }
+    };
+    p.penalty.jerk_ramp_s = jerk_ramp_s;
+    p
 }
 
 /// The full UTF-MINCO objective w.r.t. all decision variables (waypoints, `p_f`, `v_f`, `τ`).
@@ -429,7 +446,7 @@ fn check_utf(
     obstacles: bool,
     limits: Limits,
 ) -> Result<(), TestCaseError> {
-    check_utf_with_surface(seed, n, weights, obstacles, limits, false)
+    check_utf_with_surface(seed, n, weights, obstacles, limits, false, 0.0)
 }
 
 /// [`check_utf`], optionally with the goal guidance surface of a receding-horizon request placed
@@ -441,10 +458,11 @@ fn check_utf_with_surface(
     obstacles: bool,
     limits: Limits,
     surface: bool,
+    jerk_ramp_s: f64,
 ) -> Result<(), TestCaseError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let prob = random_problem(&mut rng, n);
-    let params = utf_params(weights);
+    let params = utf_params(weights, jerk_ramp_s);
     let surface_radius = if surface {
         ((prob.end - prob.goal).norm() + rng.random_range(-1.5..1.5)).max(0.1)
     } else {
@@ -603,8 +621,19 @@ proptest! {
     #[test]
     fn utf_minco_guidance_surface_gradient(seed in any::<u64>(), n in 1usize..6) {
         let limits = Limits::new(3.0, 4.0).expect("limits");
-        check_utf_with_surface(seed, n, CostWeights::default(), true, limits, true)?;
-        check_utf_with_surface(seed, n, only("terminal"), false, limits, true)?;
+        check_utf_with_surface(seed, n, CostWeights::default(), true, limits, true, 0.0)?;
+        check_utf_with_surface(seed, n, only("terminal"), false, limits, true, 0.0)?;
+    }
+
+    /// Full UTF-MINCO objective and the feasibility term alone with the jerk limit on
+    /// (`PenaltyParams::jerk_ramp_s`; `a_max / 0.1 s` = 10 m/s³ at 1 m/s², violated by the random
+    /// problems), w.r.t. every decision variable: the jerk term's moments and its `∂L/∂j · snap`
+    /// part of `∂I/∂T` in the objective's fused integration.
+    #[test]
+    fn utf_minco_jerk_limit_gradient(seed in any::<u64>(), n in 1usize..6) {
+        let limits = Limits::new(3.0, 1.0).expect("limits");
+        check_utf_with_surface(seed, n, CostWeights::default(), true, limits, false, 0.1)?;
+        check_utf_with_surface(seed, n, only("feasibility"), false, limits, false, 0.1)?;
     }
 
     /// Full MINCO objective with penetrated obstacles w.r.t. every decision variable.
@@ -625,7 +654,7 @@ fn split_evaluation_needs_a_finite_cost_first() {
     let map = big_map();
     let scene = Scene::new(&map, &[], prob.start.t).expect("scene");
     let limits = Limits::new(3.0, 4.0).expect("limits");
-    let params = utf_params(CostWeights::default());
+    let params = utf_params(CostWeights::default(), 0.0);
     let mut f = UtfMincoObjective::new(&scene, &prob.start, prob.goal, limits, &params, n)
         .expect("objective");
     let mut x = vec![0.0; f.dimension()];

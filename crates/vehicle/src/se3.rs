@@ -83,6 +83,14 @@ pub struct Se3Gains {
     /// case, 3.3 g − (15 m/s² + g) = 7.6 m/s². Acts only when `|e_v + c|` exceeds
     /// `7.5 / k_v` = 1.3 m/s.
     pub max_feedback_m_s2: f64,
+    /// Largest norm (m/s²) of the commanded acceleration `a_d + feedback` (the thrust's specific
+    /// force minus gravity), scaled down to it keeping the direction: the vehicle's acceleration
+    /// limit, as a flight stack enforces it (our addition). A jerky reference otherwise makes the
+    /// feedback push the vehicle beyond its limit while the attitude catches up (up to 1.2
+    /// `a_max` in the rooms with people). Default `None` (no cap); the closed loop
+    /// (`trust-flight`) sets it to the scenario's `a_max` when a scenario leaves it out.
+    #[serde(default)]
+    pub max_accel_m_s2: Option<f64>,
 }
 
 impl Default for Se3Gains {
@@ -94,6 +102,7 @@ impl Default for Se3Gains {
             k_omega: 36.0,
             max_approach_speed_m_s: 5.0,
             max_feedback_m_s2: 7.5,
+            max_accel_m_s2: None,
         }
     }
 }
@@ -107,6 +116,9 @@ impl Se3Gains {
         check_positive("k_omega", self.k_omega)?;
         check_positive("max_approach_speed_m_s", self.max_approach_speed_m_s)?;
         check_positive("max_feedback_m_s2", self.max_feedback_m_s2)?;
+        if let Some(cap) = self.max_accel_m_s2 {
+            check_positive("max_accel_m_s2", cap)?;
+        }
         Ok(())
     }
 }
@@ -151,7 +163,11 @@ impl Se3Controller {
         let e_v = state.v - r.v;
         let correction = clamp_norm(e_x * (k.k_x / k.k_v), k.max_approach_speed_m_s);
         let feedback = clamp_norm(-(e_v + correction) * k.k_v, k.max_feedback_m_s2);
-        let force = feedback + r.a + Vec3::z() * self.gravity_m_s2;
+        let accel = match k.max_accel_m_s2 {
+            Some(cap) => clamp_norm(feedback + r.a, cap),
+            None => feedback + r.a,
+        };
+        let force = accel + Vec3::z() * self.gravity_m_s2;
         let desired = desired_frame(&force, &r.j, r.yaw, &rot);
 
         let thrust = self.mass_kg * force.dot(&rot.column(2));

@@ -274,6 +274,13 @@ impl BackendSpec {
         })
     }
 
+    fn pieces_mut(&mut self) -> &mut trust_minco::PieceParams {
+        match self {
+            BackendSpec::UtfMinco(x) => &mut x.pieces,
+            BackendSpec::Minco(x) => &mut x.pieces,
+        }
+    }
+
     fn penalty_mut(&mut self) -> &mut trust_minco::PenaltyParams {
         match self {
             BackendSpec::UtfMinco(x) => &mut x.penalty,
@@ -649,6 +656,10 @@ pub struct PlannerSpec {
     /// raised to at least that (module docs). Default `None`: [`tracking_margin_for`] the
     /// vehicle's `a_max`.
     pub tracking_margin_m: Option<f64>,
+    /// Acceleration headroom `h`: the planner plans and checks with `a_max·(1 − h)`, leaving the
+    /// rest of the vehicle's `a_max` to its controller (module docs). Default `None`:
+    /// [`DEFAULT_ACCEL_HEADROOM`].
+    pub accel_headroom: Option<f64>,
     /// Replaces the preset's frontend.
     pub frontend: Option<FrontendSpec>,
     /// Replaces the preset's backend.
@@ -692,6 +703,7 @@ impl Default for PlannerSpec {
             reproducible: true,
             clearance_margin_m: 0.1,
             tracking_margin_m: None,
+            accel_headroom: None,
             frontend: None,
             backend: None,
             checker: None,
@@ -721,6 +733,12 @@ pub struct ResolvedPlanner {
     pub clearance_margin_m: f64,
     /// See [`PlannerSpec::tracking_margin_m`].
     pub tracking_margin_m: Option<f64>,
+    /// See [`PlannerSpec::accel_headroom`].
+    pub accel_headroom: Option<f64>,
+    /// The backend is the preset's (not replaced by the scenario): [`effective`] sets its piece
+    /// length to [`PRESET_PIECE_DURATION_S`]` · v_max`.
+    #[serde(default)]
+    pub preset_backend: bool,
     /// The route planner's parameters when the route is on ([`PlannerSpec::route`]); `None`
     /// flies the paper's setting (every query aims at the final goal).
     pub route: Option<RouteParams>,
@@ -763,6 +781,8 @@ impl PlannerSpec {
             reproducible: self.reproducible,
             clearance_margin_m: self.clearance_margin_m,
             tracking_margin_m: self.tracking_margin_m,
+            accel_headroom: self.accel_headroom,
+            preset_backend: self.backend.is_none(),
             route: self.route.enabled.then(|| self.route.params.clone()),
         }
     }
@@ -775,6 +795,15 @@ impl PlannerSpec {
         p.non_negative("planner.clearance_margin_m", self.clearance_margin_m);
         if let Some(m) = self.tracking_margin_m {
             p.non_negative("planner.tracking_margin_m", m);
+        }
+        if let Some(h) = self.accel_headroom
+            && !(0.0..=0.5).contains(&h)
+        {
+            p.list.push(Problem {
+                field: "planner.accel_headroom".into(),
+                value: format!("{h}"),
+                expected: "a fraction in [0, 0.5]".into(),
+            });
         }
         let r = self.resolve();
         r.frontend.check(&mut p);
@@ -802,6 +831,30 @@ impl PlannerSpec {
 /// above every measurement; the braking test asserts it.
 pub fn tracking_margin_for(a_max: f64) -> f64 {
     0.01 + 0.0015 * a_max
+}
+
+/// Duration (s) of one backend piece at `v_max` in the presets: [`effective`] sets the preset
+/// backend's `pieces.target_piece_length_m` to `0.7 s · v_max` — E4's measured 7 m at 10 m/s
+/// (`trust_minco::PieceParams`), 0.7 m at a Crazyflie's 1 m/s. With 7 m pieces a 4 m room
+/// horizon was one piece, too stiff to pass between people.
+pub const PRESET_PIECE_DURATION_S: f64 = 0.7;
+
+/// The default acceleration headroom: the planner plans and checks with `0.9·a_max`.
+///
+/// The controller needs acceleration beyond the plan's to correct its tracking error while the
+/// attitude catches up with a swing of the planned acceleration: on the default quadrotor a
+/// reversal of `±0.9 a_max` at the presets' jerk limit ([`PRESET_JERK_RAMP_S`]) peaks at 0.96
+/// `a_max` (3 m/s²) and 0.93 `a_max` (15 m/s²) (`crates/flight/tests/accel_headroom.rs`); at the
+/// full `a_max` the rooms with people reached 1.14 `a_max`. A fraction of `a_max`, hence
+/// scale-free.
+pub const DEFAULT_ACCEL_HEADROOM: f64 = 0.1;
+
+/// The limits the planner plans and checks with: `a_max·(1 − headroom)`, `v_max` unchanged.
+pub fn planning_limits(limits: Limits, headroom: f64) -> Limits {
+    Limits {
+        v_max: limits.v_max,
+        a_max: limits.a_max * (1.0 - headroom.clamp(0.0, 0.5)),
+    }
 }
 
 /// A route-parameter error as a problem under `planner.route.params`.
@@ -889,6 +942,9 @@ pub fn effective(
         }
         FrontendSpec::StraightLine(_) => {}
     }
+    if out.preset_backend {
+        out.backend.pieces_mut().target_piece_length_m = PRESET_PIECE_DURATION_S * ctx.limits.v_max;
+    }
     let penalty = out.backend.penalty_mut();
     penalty.static_clearance_m = penalty
         .static_clearance_m
@@ -925,8 +981,17 @@ pub fn closed_loop_backend() -> UtfMincoParams {
     let mut p = UtfMincoParams::default();
     p.weights.time = 60.0;
     p.weights.terminal = 60.0;
+    p.penalty.jerk_ramp_s = PRESET_JERK_RAMP_S;
     p
 }
+
+/// The presets' jerk limit as a ramp time: UTF-MINCO penalizes jerk above `a_max / 0.3 s`
+/// (`trust_minco::PenaltyParams::jerk_ramp_s`). Measured on the default quadrotor
+/// (`crates/flight/tests/accel_headroom.rs`): a planned swing of the acceleration by `0.9 a_max`
+/// in either direction overshoots by under 6 % of the swing when it takes 0.4 s, by 14 % in
+/// 0.2 s and by 19 % in 0.1 s; MINCO's time-optimal branches started at the old acceleration and
+/// swung in well under 0.1 s, and the suite's flights among people reached 1.2 `a_max`.
+pub const PRESET_JERK_RAMP_S: f64 = 0.3;
 
 /// Builds the manager of `resolved` for a vehicle and trial ([`effective`] parameters).
 ///
@@ -937,7 +1002,11 @@ pub fn build(resolved: &ResolvedPlanner, ctx: &PlannerContext) -> Result<AnyMana
     let frontend = eff.frontend.build()?;
     let backend = eff.backend.build()?;
     let checker = eff.checker.build()?;
-    let mut manager = Manager::new(frontend, backend, checker, ctx.limits, eff.manager)?;
+    let limits = planning_limits(
+        ctx.limits,
+        eff.accel_headroom.unwrap_or(DEFAULT_ACCEL_HEADROOM),
+    );
+    let mut manager = Manager::new(frontend, backend, checker, limits, eff.manager)?;
     if let Some(params) = eff.route {
         manager.set_router(Some(Router::new(params, ctx.vehicle_radius_m)?));
     }

@@ -64,7 +64,15 @@ fn every_shipped_scenario_validates_and_builds() {
         }
         let world = World::build(&s).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let manager = planner::build(&resolved, &world.planner_context()).unwrap();
-        assert_eq!(manager.limits(), &world.limits());
+        // The manager plans with the acceleration headroom below the vehicle's limit.
+        let headroom = resolved
+            .accel_headroom
+            .unwrap_or(planner::DEFAULT_ACCEL_HEADROOM);
+        assert_eq!(
+            manager.limits(),
+            &planner::planning_limits(world.limits(), headroom)
+        );
+        assert!(manager.limits().a_max < world.limits().a_max);
         world.traffic().unwrap();
         world.sensing().unwrap();
     }

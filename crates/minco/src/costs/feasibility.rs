@@ -16,6 +16,10 @@ pub fn norm_violation(x: &Vec3, x_max: f64) -> (f64, Vec3) {
 /// `L_d = f_max(φ_v) + f_max(φ_a)` with `φ_v = vᵀv/v_max² − 1`, `φ_a = aᵀa/a_max² − 1`
 /// (paper eq. design-of-Id; gradients eq. gradients-of-Id — the time derivatives `2aᵀv/v_max²`
 /// and `2jᵀa/a_max²` follow from `∂L/∂v · a` and `∂L/∂a · j` in the integrator).
+///
+/// Beyond the paper, an optional jerk limit adds `f_max(φ_j)` with `φ_j = jᵀj/j_max² − 1`
+/// ([`FeasibilityTerm::with_jerk_limit`]; its time derivative `2 jᵀs/j_max²` follows from
+/// `∂L/∂j · snap`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FeasibilityTerm {
     limits: Limits,
@@ -23,6 +27,9 @@ pub struct FeasibilityTerm {
     /// `1/v_max²` and `1/a_max²`, precomputed (no division per sample).
     inv_v2: f64,
     inv_a2: f64,
+    /// The jerk limit (m/s³), if any, and `1/j_max²` (0 without a limit).
+    jerk_max: Option<f64>,
+    inv_j2: f64,
 }
 
 impl FeasibilityTerm {
@@ -33,6 +40,45 @@ impl FeasibilityTerm {
             smoothing: SmoothedL1::new(smoothing),
             inv_v2: 1.0 / (limits.v_max * limits.v_max),
             inv_a2: 1.0 / (limits.a_max * limits.a_max),
+            jerk_max: None,
+            inv_j2: 0.0,
+        }
+    }
+
+    /// The same penalty with a jerk limit `j_max` (m/s³; `None`, zero or non-finite: none).
+    pub fn with_jerk_limit(mut self, jerk_max: Option<f64>) -> Self {
+        match jerk_max.filter(|j| j.is_finite() && *j > 0.0) {
+            Some(j) => {
+                self.jerk_max = Some(j);
+                self.inv_j2 = 1.0 / (j * j);
+            }
+            None => {
+                self.jerk_max = None;
+                self.inv_j2 = 0.0;
+            }
+        }
+        self
+    }
+
+    /// The jerk limit (m/s³), if any.
+    pub fn jerk_limit(&self) -> Option<f64> {
+        self.jerk_max
+    }
+
+    /// Unweighted `f_max(φ_j)` at jerk `j` (0 without a jerk limit); adds `weight · ∂/∂j` into
+    /// `grad_j`.
+    #[inline(always)]
+    pub(crate) fn jerk_at(&self, j: &Vec3, weight: f64, grad_j: &mut Vec3) -> f64 {
+        if self.jerk_max.is_none() {
+            return 0.0;
+        }
+        let phi = j.norm_squared() * self.inv_j2 - 1.0;
+        if phi > 0.0 {
+            let (value, slope) = self.smoothing.eval(phi);
+            *grad_j += j * (2.0 * self.inv_j2 * weight * slope);
+            value
+        } else {
+            0.0
         }
     }
 
@@ -78,7 +124,7 @@ impl Integrand for FeasibilityTerm {
     #[inline]
     fn sample(&mut self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
         let (v, a) = self.at(&s.v, &s.a, 1.0, &mut grad.v, &mut grad.a);
-        v + a
+        v + a + self.jerk_at(&s.j, 1.0, &mut grad.j)
     }
 }
 

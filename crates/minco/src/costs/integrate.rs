@@ -584,14 +584,15 @@ impl Moments {
     }
 
     /// Adds the moments of one derivative order `d` (0: position, 1: velocity, 2:
-    /// acceleration) for the partial derivative `g` at a node of weight `w` and powers `u`.
+    /// acceleration, 3: jerk) for the partial derivative `g` at a node of weight `w` and powers `u`.
     #[inline(always)]
     fn add_order(&mut self, order: usize, g: &Vec3, w: f64, u: &[f64; 6]) {
         let gw = g * w;
         let moments: &mut [Vec3] = match order {
             0 => &mut self.p,
             1 => &mut self.v,
-            _ => &mut self.a,
+            2 => &mut self.a,
+            _ => &mut self.j,
         };
         for (m, ue) in moments.iter_mut().zip(u) {
             *m += gw * *ue;

@@ -145,6 +145,12 @@ pub struct PenaltyParams {
     pub braking_tail_decel_fraction: f64,
     /// See [`PenaltyParams::braking_tail_decel_fraction`].
     pub braking_tail_delay_s: f64,
+    /// Jerk limit as a ramp time (s): the feasibility penalty `I_d` also penalizes jerk above
+    /// `a_max / jerk_ramp_s` ([`PenaltyParams::jerk_limit`]); 0 (the default, the paper's
+    /// `I_d`) switches it off. Beyond the paper: a quadrotor's attitude lags a reference whose
+    /// acceleration swings faster than that, and its true acceleration overshoots the plan's
+    /// (`trust_world::planner::closed_loop_backend` sets 0.3 s).
+    pub jerk_ramp_s: f64,
 }
 
 impl Default for PenaltyParams {
@@ -174,11 +180,18 @@ impl Default for PenaltyParams {
             braking_tail_samples: 8,
             braking_tail_decel_fraction: 0.9,
             braking_tail_delay_s: 0.1,
+            jerk_ramp_s: 0.0,
         }
     }
 }
 
 impl PenaltyParams {
+    /// The jerk limit (m/s³) for `a_max`: `a_max / jerk_ramp_s`, or `None` when
+    /// `jerk_ramp_s` is 0.
+    pub fn jerk_limit(&self, a_max: f64) -> Option<f64> {
+        (self.jerk_ramp_s > 0.0).then(|| a_max / self.jerk_ramp_s)
+    }
+
     /// Checks every field; the error names `{prefix}.{field}`. Accepted ranges (derived from the
     /// scale policy, [`trust_core::scale`], and probed on the E2 scenes):
     ///
@@ -192,7 +205,7 @@ impl PenaltyParams {
     /// | `terminal_position_gains`, `terminal_velocity_gains` | each component `[0, 1e6]` |
     /// | `terminal_norm_epsilon` | `[1e-6, 1e6]` ([`TERMINAL_NORM_EPSILON_RANGE`]) |
     /// | `braking_tail_decel_fraction` | `(0, 1]` |
-    /// | `braking_tail_delay_s` | `[0, 1e7]` s (a duration) |
+    /// | `braking_tail_delay_s`, `jerk_ramp_s` | `[0, 1e7]` s (a duration) |
     pub fn validate(&self, prefix: &str) -> Result<(), PlanError> {
         let field = |name: &str| format!("{prefix}.{name}");
         check_count(
@@ -264,6 +277,7 @@ impl PenaltyParams {
             self.braking_tail_delay_s,
             Quantity::Duration,
         )?;
+        check_scaled(&field("jerk_ramp_s"), self.jerk_ramp_s, Quantity::Duration)?;
         Ok(())
     }
 }

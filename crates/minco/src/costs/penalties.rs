@@ -20,6 +20,8 @@ pub struct PenaltyIntegrals {
     pub speed: f64,
     /// Acceleration, part of `I_d`.
     pub acceleration: f64,
+    /// Jerk beyond the optional jerk limit (`PenaltyParams::jerk_ramp_s`), part of `I_d`.
+    pub jerk: f64,
 }
 
 impl PenaltyIntegrals {
@@ -28,9 +30,9 @@ impl PenaltyIntegrals {
         self.dynamic + self.static_map
     }
 
-    /// `I_d` = speed + acceleration.
+    /// `I_d` = speed + acceleration (+ jerk, with a jerk limit).
     pub fn feasibility(&self) -> f64 {
-        self.speed + self.acceleration
+        self.speed + self.acceleration + self.jerk
     }
 }
 
@@ -67,7 +69,8 @@ impl<'a> PenaltyIntegrand<'a> {
                 params.smoothing,
             ),
             static_map: StaticObstacleTerm::new(map, params.static_clearance_m, params.smoothing),
-            feasibility: FeasibilityTerm::new(limits, params.smoothing),
+            feasibility: FeasibilityTerm::new(limits, params.smoothing)
+                .with_jerk_limit(params.jerk_limit(limits.a_max)),
             obstacle_weight: weights.obstacle,
             feasibility_weight: weights.feasibility,
             dynamic_active: false,
@@ -91,6 +94,12 @@ impl<'a> PenaltyIntegrand<'a> {
     pub(crate) fn squared_limits(&self) -> (f64, f64) {
         let l = self.feasibility.limits();
         (l.v_max * l.v_max, l.a_max * l.a_max)
+    }
+
+    /// `j_max²` of the feasibility term, if it has a jerk limit.
+    #[inline]
+    pub(crate) fn squared_jerk_limit(&self) -> Option<f64> {
+        self.feasibility.jerk_limit().map(|j| j * j)
     }
 
     /// Sets `flags[k]` for every node `k` (position `(x[k], y[k], z[k])`, time `t[k]`) that
@@ -182,6 +191,16 @@ impl<'a> PenaltyIntegrand<'a> {
         self.integrals.speed += w * lv;
         self.integrals.acceleration += w * la;
         wd * (lv + la)
+    }
+
+    /// `λ_d L_j` at jerk `j` of a node of quadrature weight `w` (0 without a jerk limit); adds
+    /// `λ_d ∂/∂j` into `grad_j`, records the unweighted integral.
+    #[inline(always)]
+    pub(crate) fn jerk_at(&mut self, j: &Vec3, w: f64, grad_j: &mut Vec3) -> f64 {
+        let wd = self.feasibility_weight;
+        let lj = self.feasibility.jerk_at(j, wd, grad_j);
+        self.integrals.jerk += w * lj;
+        wd * lj
     }
 }
 
@@ -299,6 +318,8 @@ impl Integrand for PenaltyIntegrand<'_> {
     #[inline]
     fn sample(&mut self, s: &SampleState, grad: &mut SampleGrad) -> f64 {
         let obstacles = self.obstacles_at(&s.p, s.t, s.weight, &mut grad.p, &mut grad.t);
-        obstacles + self.feasibility_at(&s.v, &s.a, s.weight, &mut grad.v, &mut grad.a)
+        obstacles
+            + self.feasibility_at(&s.v, &s.a, s.weight, &mut grad.v, &mut grad.a)
+            + self.jerk_at(&s.j, s.weight, &mut grad.j)
     }
 }

@@ -75,6 +75,7 @@ pub(super) struct NodeColumns {
     position: Columns,
     velocity: Columns,
     acceleration: Columns,
+    jerk: Columns,
     /// Absolute node times.
     t: Vec<f64>,
     /// Nodes that need the full evaluation.
@@ -91,6 +92,7 @@ impl NodeColumns {
             position: Columns::new(m),
             velocity: Columns::new(m),
             acceleration: Columns::new(m),
+            jerk: Columns::new(m),
             t: vec![0.0; m],
             flags: vec![false; m],
         }
@@ -107,6 +109,12 @@ impl NodeColumns {
             let (u1, u2, u3, u4, u5) = (&u1[..m], &u2[..m], &u3[..m], &u4[..m], &u5[..m]);
             let k0 = c[0][axis];
             match c.len() {
+                3 => {
+                    let (k1, k2) = (c[1][axis], c[2][axis]);
+                    for i in 0..m {
+                        out[i] = k0 + k1 * u1[i] + k2 * u2[i];
+                    }
+                }
                 4 => {
                     let (k1, k2, k3) = (c[1][axis], c[2][axis], c[3][axis]);
                     for i in 0..m {
@@ -224,6 +232,7 @@ impl PieceRule for FlaggedNodes<'_, '_> {
             ctx.kappa,
             ctx.u_powers,
             ctx.columns,
+            ctx.coeffs,
         ))
     }
 }
@@ -243,6 +252,7 @@ fn flag_nodes(
         position,
         velocity,
         acceleration,
+        jerk,
         t,
         flags,
     } = columns;
@@ -250,6 +260,7 @@ fn flag_nodes(
     position.filled = false;
     velocity.filled = false;
     acceleration.filled = false;
+    jerk.filled = false;
     let (v2_max, a2_max) = penalties.squared_limits();
     if !within_by_hull(&bernstein_points(&piece.v), &piece.v, v2_max) {
         NodeColumns::evaluate(powers, &piece.v, velocity);
@@ -258,6 +269,12 @@ fn flag_nodes(
     if !within_by_hull(&bernstein_points(&piece.a), &piece.a, a2_max) {
         NodeColumns::evaluate(powers, &piece.a, acceleration);
         NodeColumns::flag_norm_above(flags, acceleration, a2_max * (1.0 - LIMIT_FILTER_MARGIN));
+    }
+    if let Some(j2_max) = penalties.squared_jerk_limit()
+        && !within_by_hull(&bernstein_points(&piece.j), &piece.j, j2_max)
+    {
+        NodeColumns::evaluate(powers, &piece.j, jerk);
+        NodeColumns::flag_norm_above(flags, jerk, j2_max * (1.0 - LIMIT_FILTER_MARGIN));
     }
     if obstacles {
         NodeColumns::evaluate(powers, &piece.p, position);
@@ -311,7 +328,9 @@ fn penalty_piece(
     kappa: usize,
     u_powers: &[[f64; 6]],
     columns: &NodeColumns,
+    coeffs: &[Vec3],
 ) -> PieceIntegral {
+    let jerk_limited = penalties.squared_jerk_limit().is_some();
     let inv_kappa = 1.0 / kappa as f64;
     let h = duration * inv_kappa;
     let mut out = PieceIntegral::ZERO;
@@ -341,6 +360,16 @@ fn penalty_piece(
                 out.coupling += weight * gt;
             }
         }
+        // The jerk term last, as the generic path sums it.
+        let mut gj = Vec3::zeros();
+        if jerk_limited {
+            let j = columns.jerk.at(k, || piece.jerk(u));
+            let lj = penalties.jerk_at(&j, weight, &mut gj);
+            if lj != 0.0 || gj != Vec3::zeros() {
+                touched = true;
+                value += lj;
+            }
+        }
         if !touched {
             continue;
         }
@@ -356,6 +385,12 @@ fn penalty_piece(
             out.moments.add_order(2, &ga, weight, u);
         }
         along += gt;
+        if gj != Vec3::zeros() {
+            out.moments.add_order(3, &gj, weight, u);
+            let s = u[1] * duration;
+            let snap = coeffs[4] * 24.0 + coeffs[5] * (120.0 * s);
+            along += gj.dot(&snap);
+        }
         out.grad_t += omega * inv_kappa * value + weight * u[1] * along;
     }
     out
@@ -384,8 +419,8 @@ mod tests {
         (0..6).rev().fold(Vec3::zeros(), |acc, k| acc * s + c[k])
     }
 
-    /// Value, `∂I/∂c`, `∂I/∂T` and the four unweighted integrals of one integration.
-    type Outcome = (f64, Vec<Vec3>, Vec<f64>, [f64; 4]);
+    /// Value, `∂I/∂c`, `∂I/∂T` and the five unweighted integrals of one integration.
+    type Outcome = (f64, Vec<Vec3>, Vec<f64>, [f64; 5]);
 
     /// Generic and fused integration of the same penalties over the same trajectory.
     fn both(
@@ -394,13 +429,17 @@ mod tests {
         forecasts: &[Forecast],
         map: &StaticMap,
         limits: Limits,
+        jerk_ramp_s: f64,
     ) -> [Outcome; 2] {
         let view = PiecewiseView {
             t_start: 0.3,
             coeffs,
             durations,
         };
-        let params = PenaltyParams::default();
+        let params = PenaltyParams {
+            jerk_ramp_s,
+            ..PenaltyParams::default()
+        };
         let weights = CostWeights::default();
         let n = durations.len();
         let mut integrator = TrapezoidIntegrator::new(params.samples_per_piece);
@@ -423,7 +462,7 @@ mod tests {
                 value,
                 gc,
                 gt,
-                [i.dynamic, i.static_map, i.speed, i.acceleration],
+                [i.dynamic, i.static_map, i.speed, i.acceleration, i.jerk],
             )
         })
     }
@@ -433,7 +472,8 @@ mod tests {
 
         /// The filters never skip a node that contributes: on random trajectories that cross,
         /// graze and miss moving and static obstacles of every kind and exceed the speed and
-        /// acceleration limits at some nodes, the fused path equals the generic one bit for bit
+        /// acceleration limits (and, with a jerk ramp, the jerk limit) at some nodes, the fused
+        /// path equals the generic one bit for bit
         /// (the same nodes, the same sums in the same order).
         #[test]
         fn fused_path_equals_the_generic_one(
@@ -442,6 +482,7 @@ mod tests {
             hits in proptest::collection::vec((0.0..1.0f64, 0.05..0.9f64, -0.6..0.6f64, any::<bool>()), 4),
             v_max in 0.5..4.0f64,
             a_max in 1.0..8.0f64,
+            jerk_ramp_s in prop_oneof![Just(0.0), 0.05..2.0f64],
         ) {
             let coeffs: Vec<Vec3> = raw.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
             let total: f64 = durations.iter().sum();
@@ -469,7 +510,7 @@ mod tests {
             let bounds = trust_core::Aabb { min: Vec3::repeat(-50.0), max: Vec3::repeat(50.0) };
             let map = StaticMap::from_shapes(bounds, shapes).expect("shapes");
             let limits = Limits::new(v_max, a_max).expect("limits");
-            let [generic, fused] = both(&coeffs, &durations, &forecasts, &map, limits);
+            let [generic, fused] = both(&coeffs, &durations, &forecasts, &map, limits, jerk_ramp_s);
             prop_assert_eq!(generic.0.to_bits(), fused.0.to_bits(), "value {} vs {}", generic.0, fused.0);
             prop_assert_eq!(&generic.1, &fused.1);
             prop_assert_eq!(&generic.2, &fused.2);
@@ -501,12 +542,15 @@ mod tests {
         })
         .expect("bounds");
         let limits = Limits::new(1.0, 2.0).expect("limits");
-        let [generic, fused] = both(&coeffs, &durations, &forecasts, &map, limits);
-        assert!(generic.3[0] > 0.0 && generic.3[2] > 0.0, "{:?}", generic.3);
-        assert_eq!(generic.0.to_bits(), fused.0.to_bits());
-        assert_eq!(generic.1, fused.1);
-        assert_eq!(generic.2, fused.2);
-        assert_eq!(generic.3, fused.3);
+        for jerk_ramp_s in [0.0, 0.3] {
+            let [generic, fused] = both(&coeffs, &durations, &forecasts, &map, limits, jerk_ramp_s);
+            assert!(generic.3[0] > 0.0 && generic.3[2] > 0.0, "{:?}", generic.3);
+            assert_eq!(generic.3[4] > 0.0, jerk_ramp_s > 0.0, "{:?}", generic.3);
+            assert_eq!(generic.0.to_bits(), fused.0.to_bits());
+            assert_eq!(generic.1, fused.1);
+            assert_eq!(generic.2, fused.2);
+            assert_eq!(generic.3, fused.3);
+        }
     }
 
     #[test]
