@@ -274,6 +274,13 @@ impl BackendSpec {
         })
     }
 
+    fn weights_mut(&mut self) -> &mut trust_minco::CostWeights {
+        match self {
+            BackendSpec::UtfMinco(x) => &mut x.weights,
+            BackendSpec::Minco(x) => &mut x.weights,
+        }
+    }
+
     fn pieces_mut(&mut self) -> &mut trust_minco::PieceParams {
         match self {
             BackendSpec::UtfMinco(x) => &mut x.pieces,
@@ -833,6 +840,35 @@ pub fn tracking_margin_for(a_max: f64) -> f64 {
     0.01 + 0.0015 * a_max
 }
 
+/// The presets' backend at the vehicle's scale (every other backend parameter is already
+/// relative, or an absolute justified where it is defined):
+///
+/// | parameter | rule | 1 m/s, 3 m/s² | E4: 10 m/s, 15 m/s² |
+/// |---|---|---|---|
+/// | terminal weight `λ_s` | `λ_t · (10 m/s) / v_max` | 600 | 60 |
+/// | piece length | [`PRESET_PIECE_DURATION_S`]` · v_max` | 0.7 m | 7 m |
+/// | `d_ε` (`goal_radius_m`) | three braking distances, `1.5 v_max²/a_max` | 0.5 m | 10 m |
+/// | guidance smoothing | `0.1 s · v_max` | 0.1 m | 1 m |
+///
+/// `λ_t/λ_s` is the speed below which standing still costs less than flying toward the aim: with
+/// the fixed 60 / 60 (1 m/s) a vehicle with `v_max` ≤ 0.8 m/s stayed at the start in an empty
+/// room (the optimizer returned 0.04 s stubs), and one at 1 m/s crawled across a hall at 3× the
+/// ideal time. Scaled, it is `v_max / 10` at every scale; at E4's limits every value is the one
+/// measured there.
+fn scale_preset_backend(backend: &mut BackendSpec, limits: &Limits) {
+    let v = limits.v_max;
+    let weights = backend.weights_mut();
+    weights.terminal = weights.time * PRESET_TERMINAL_SPEED_M_S / v;
+    backend.pieces_mut().target_piece_length_m = PRESET_PIECE_DURATION_S * v;
+    let penalty = backend.penalty_mut();
+    penalty.goal_radius_m = 1.5 * v * v / limits.a_max;
+    penalty.guidance_smoothing_m = 0.1 * v;
+}
+
+/// `λ_s = λ_t · 10 m/s / v_max` in the presets ([`scale_preset_backend`]): E4's measured 60 / 60
+/// at 10 m/s.
+pub const PRESET_TERMINAL_SPEED_M_S: f64 = 10.0;
+
 /// Duration (s) of one backend piece at `v_max` in the presets: [`effective`] sets the preset
 /// backend's `pieces.target_piece_length_m` to `0.7 s · v_max` — E4's measured 7 m at 10 m/s
 /// (`trust_minco::PieceParams`), 0.7 m at a Crazyflie's 1 m/s. With 7 m pieces a 4 m room
@@ -943,7 +979,7 @@ pub fn effective(
         FrontendSpec::StraightLine(_) => {}
     }
     if out.preset_backend {
-        out.backend.pieces_mut().target_piece_length_m = PRESET_PIECE_DURATION_S * ctx.limits.v_max;
+        scale_preset_backend(&mut out.backend, &ctx.limits);
     }
     let penalty = out.backend.penalty_mut();
     penalty.static_clearance_m = penalty
