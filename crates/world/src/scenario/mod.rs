@@ -286,12 +286,39 @@ impl Scenario {
         };
         // A random flight draws its start and goal from the seed.
         if let (Some(random), Some(bounds)) = (&s.mission.random, s.bounds()) {
-            let shapes: Vec<trust_geometry::Shape> = s
+            use trust_geometry::{AaBox, Cylinder, Shape, Sphere};
+            // Clear of the static shapes and of the explicit moving obstacles where they are at
+            // t = 0 (a start inside a person is invalid).
+            let mut shapes: Vec<Shape> = s
                 .static_map
                 .shapes
                 .iter()
                 .map(sections::geometry_shape)
                 .collect();
+            for o in &s.obstacles {
+                let Some(p) = o.position else { continue };
+                let center = trust_core::Vec3::from(p);
+                shapes.push(match o.moving_shape() {
+                    crate::traffic::MovingShape::Sphere { radius } => {
+                        Shape::Sphere(Sphere { center, radius })
+                    }
+                    crate::traffic::MovingShape::Cylinder {
+                        radius,
+                        half_height,
+                    } => Shape::Cylinder(Cylinder {
+                        center,
+                        radius,
+                        half_height,
+                    }),
+                    crate::traffic::MovingShape::Box { half_extents } => {
+                        let h = trust_core::Vec3::from(half_extents);
+                        Shape::AaBox(AaBox {
+                            min: center - h,
+                            max: center + h,
+                        })
+                    }
+                });
+            }
             let (start, goal) = random.draw(seed, &bounds, &shapes, s.vehicle.radius_m);
             s.mission.start = start;
             s.mission.goal = goal;

@@ -352,8 +352,12 @@ impl Scenario {
                         "mission.random.min_distance_m",
                         r.min_distance_m,
                         format!(
-                            "a distance the region allows: the best of 10 000 draws in {} is                              {:.3} m",
-                            fmt_bounds(b.min.as_slice(), b.max.as_slice()),
+                            "a distance the region allows: the farthest clear pair of 200 x 200 \
+                             draws in {} is {:.3} m apart",
+                            match &r.region {
+                                Some(region) => fmt_bounds(&region.min, &region.max),
+                                None => fmt_bounds(b.min.as_slice(), b.max.as_slice()),
+                            },
                             (a - g).norm()
                         ),
                     );
