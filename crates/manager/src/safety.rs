@@ -365,6 +365,17 @@ impl Margins {
     }
 }
 
+/// `bounds` shrunk by `by` on every side, to the mid-plane on an axis thinner than `2·by`.
+fn shrunk(bounds: &Aabb, by: f64) -> Aabb {
+    let mut out = *bounds;
+    for a in 0..3 {
+        let d = by.min(0.5 * (bounds.max[a] - bounds.min[a])).max(0.0);
+        out.min[a] += d;
+        out.max[a] -= d;
+    }
+    out
+}
+
 fn check_window(
     traj: &PolyTraj,
     scene: &Scene<'_>,
@@ -375,7 +386,9 @@ fn check_window(
     full: bool,
 ) -> SafetyVerdict {
     let window = Window::new(traj, scene, from, until, params);
-    let bounds = scene.map.bounds();
+    // The vehicle's body stays inside the bounds (a room's walls): its centre within the bounds
+    // shrunk by the static clearance (to their mid-plane where they are thinner than that).
+    let bounds = &shrunk(scene.map.bounds(), params.static_clearance_m);
     let (max_speed, max_accel) = traj.max_speed_and_acceleration(16);
     let tol = 1.0 + params.limit_tolerance;
     let over_limits = max_speed > limits.v_max * tol || max_accel > limits.a_max * tol;
@@ -405,7 +418,7 @@ fn check_window(
         match m.hit(bounds, &p) {
             Some((with, margin)) => {
                 // Escaping an overlap present at the start: allowed while the clearance grows.
-                let escaping = inside && with != Hit::Bounds && margin >= previous - 1e-9;
+                let escaping = inside && margin >= previous - 1e-9;
                 if !escaping {
                     verdict.safe = false;
                     if verdict.violation.is_none() {
