@@ -95,7 +95,7 @@ pub use params::{ManagerParams, ReanchorParams, SafetyParams};
 pub use progress::{ProgressMonitor, ProgressParams, StallRule};
 pub use report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
-    Origin, StepReport,
+    Origin, STUB_FRACTION, StepReport,
 };
 pub use routing::Router;
 pub use safety::{Hit, SafetyVerdict, Violation, assess_trajectory, check_trajectory};

@@ -15,7 +15,7 @@ use crate::brake::{brake_along, brake_straight, dash_maneuvers, escape_maneuvers
 use crate::progress::ProgressMonitor;
 use crate::report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
-    Origin, StepReport,
+    Origin, STUB_FRACTION, StepReport,
 };
 use crate::safety::{
     SafetyVerdict, assess_trajectory, check_trajectory, forecasts_near, window_bounds,
@@ -585,6 +585,13 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 });
                 None
             }
+            Ok((solution, _)) if self.is_stub(&solution.traj, &cycle.goal) => {
+                cycle.events.push(Event::DroppedStub {
+                    id,
+                    duration_s: solution.traj.duration(),
+                });
+                None
+            }
             Ok((solution, verdict)) if verdict.safe => Some((solution, verdict)),
             Ok((solution, verdict)) => {
                 cycle
@@ -737,7 +744,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     ) -> Option<Branch> {
         let plan = self.committed.as_ref()?;
         let previous = self.branches.iter().find(|b| b.id == id)?;
-        if previous.solution.traj != *plan || plan.t_end() <= start.t {
+        if previous.solution.traj != *plan || plan.t_end() <= start.t || self.is_stub(plan, goal) {
             return None;
         }
         let verdict = check_trajectory(
@@ -842,6 +849,15 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     }
 
     /// Whether `traj` ends within [`ManagerParams::goal_reached_m`] of `goal`.
+    /// A stub ([`Event::DroppedStub`]): shorter than [`STUB_FRACTION`] of the horizon, not
+    /// reaching the goal, which is farther from its start than that time at `v_max`.
+    fn is_stub(&self, traj: &PolyTraj, goal: &Vec3) -> bool {
+        let short = STUB_FRACTION * self.params.horizon_s;
+        traj.duration() < short
+            && !self.reaches(traj, goal)
+            && (traj.position(traj.t_start()) - goal).norm() > short * self.limits.v_max
+    }
+
     fn reaches(&self, traj: &PolyTraj, goal: &Vec3) -> bool {
         shortfall(traj, goal) <= self.params.goal_reached_m
     }

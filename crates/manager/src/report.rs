@@ -117,6 +117,18 @@ pub enum Event {
         /// The branch, or `None` for a candidate from the frontend.
         id: Option<BranchId>,
     },
+    /// A safe trajectory was dropped as a stub (beyond the paper): shorter than
+    /// [`STUB_FRACTION`] of the horizon, not reaching the goal although the goal is farther than
+    /// that time at `v_max`. The optimizer returns one when every way toward the aim violates a
+    /// forecast; ranked by `J` it beats every real branch (it costs no time and keeps the
+    /// terminal cost), and the vehicle hovered while a person walked into it. Without a branch
+    /// the fallback moves it out of the way instead.
+    DroppedStub {
+        /// The branch, or `None` for a candidate from the frontend.
+        id: Option<BranchId>,
+        /// Its duration (s).
+        duration_s: f64,
+    },
     /// A branch fell off the end of the queue (more than `N`).
     DroppedPopBack {
         /// The branch.
@@ -199,6 +211,10 @@ pub enum Event {
     },
 }
 
+/// A trajectory shorter than this fraction of the planning horizon that does not reach the goal
+/// is a stub ([`Event::DroppedStub`]): 0.2 s at the default 4 s.
+pub const STUB_FRACTION: f64 = 0.05;
+
 impl Event {
     /// A short tag for logs (`"switched"`, `"fallback"`, ...).
     pub fn tag(&self) -> &'static str {
@@ -211,6 +227,7 @@ impl Event {
             Event::MergedEquivalent { .. } => "merged_equivalent",
             Event::DroppedCollision { .. } => "dropped_collision",
             Event::Repaired { .. } => "repaired",
+            Event::DroppedStub { .. } => "dropped_stub",
             Event::DroppedPopBack { .. } => "dropped_popback",
             Event::SolveFailed { .. } => "solve_failed",
             Event::FrontendFailed { .. } => "frontend_failed",

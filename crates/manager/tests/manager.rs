@@ -800,8 +800,10 @@ impl TrajectoryBackend for StopsFirst {
 
     fn optimize(&self, req: &TrajRequest<'_>, _scene: &Scene<'_>) -> Result<Solution, PlanError> {
         let s = &req.start;
-        // The standing branch's duration: J = 0.1 s + d/v_max, as the kept branch's in the stall.
-        const HOLD_S: f64 = 0.1;
+        // The standing branch's duration: J = 0.3 s + d/v_max, as the kept branch's in the stall
+        // (0.3 s: longer than a stub, `trust_manager::STUB_FRACTION` of the horizon, which is
+        // dropped before it is ranked).
+        const HOLD_S: f64 = 0.3;
         Ok(match req.initial {
             trust_core::InitialGuess::WarmStart(traj) => {
                 let end = traj.position(traj.t_end());
@@ -842,7 +844,7 @@ fn a_branch_that_reaches_the_goal_outranks_one_that_stops_short() {
     let reports = fly(&mut m, &map, goal, start, 40, |_| Vec::new());
     // The first cycle has only the standing branch.
     assert_eq!(reports[0].branches.len(), 1);
-    assert!(reports[0].branches[0].j < 1.2, "{:?}", reports[0].branches);
+    assert!(reports[0].branches[0].j < 1.4, "{:?}", reports[0].branches);
     // The reaching branch replaces it in its class although its J is larger, and leads.
     let r = &reports[1];
     let replaced = r.events.iter().find_map(|e| match e {
@@ -899,11 +901,11 @@ impl TrajectoryBackend for Hesitant {
         let s = &req.start;
         Ok(match req.initial {
             trust_core::InitialGuess::WarmStart(traj) => {
-                let duration = (traj.t_end() - s.t).max(0.1);
+                let duration = (traj.t_end() - s.t).max(0.3);
                 StopsFirst::to_rest(s, traj.position(traj.t_end()), duration, &req.goal)
             }
             trust_core::InitialGuess::Guide(path) if path.points.len() == 2 => {
-                StopsFirst::to_rest(s, s.p, 0.1, &req.goal)
+                StopsFirst::to_rest(s, s.p, 0.3, &req.goal)
             }
             trust_core::InitialGuess::Guide(_) => {
                 let d = 8.0;
@@ -1027,4 +1029,82 @@ fn with_a_route_a_wide_wall_ahead_is_flown_around_to_the_goal() {
     // A bad radius is a typed error naming the field.
     let e = trust_manager::Router::new(trust_route::RouteParams::default(), f64::NAN).unwrap_err();
     assert!(e.to_string().contains("route.radius_m"), "{e}");
+}
+
+/// A backend that always answers with a 0.04 s hover at the start: what UTF-MINCO returned when
+/// every way toward the aim crossed a growing forecast.
+struct Stub;
+
+impl TrajectoryBackend for Stub {
+    fn name(&self) -> &str {
+        "stub"
+    }
+
+    fn optimize(&self, req: &TrajRequest<'_>, _scene: &Scene<'_>) -> Result<Solution, PlanError> {
+        let s = req.start;
+        let traj = PolyTraj::hold(s.t, s.p, 0.04)?;
+        Ok(Solution {
+            traj,
+            costs: CostBreakdown {
+                ht: 0.04,
+                hs: (s.p - req.goal).norm(),
+                ..CostBreakdown::default()
+            },
+            stats: SolveStats {
+                iteration_count: 0,
+                evaluation_count: 1,
+                elapsed: std::time::Duration::ZERO,
+                status: SolveStatus::Converged,
+            },
+            violations: Vec::new(),
+        })
+    }
+}
+
+#[test]
+fn a_stub_far_from_the_goal_is_dropped_and_the_fallback_flies() {
+    // Ranked by J the stub (0.04 s, terminal cost d / v_max) beat every real branch and the
+    // vehicle hovered while a person walked into it: it is dropped as a stub instead.
+    let map = open_air();
+    let mut m = Manager::new(
+        StraightLine,
+        Stub,
+        Tvd::default(),
+        Limits::default(),
+        reproducible(ManagerParams::single_branch()),
+    )
+    .unwrap();
+    let start = State {
+        t: 0.0,
+        p: Vec3::new(5.0, 0.0, 5.0),
+        v: Vec3::zeros(),
+        a: Vec3::zeros(),
+    };
+    let scene = Scene::new(&map, &[], 0.0).unwrap();
+    let r = m
+        .step(0.0, &start, &Vec3::new(95.0, 0.0, 5.0), &scene)
+        .unwrap();
+    assert!(
+        r.events.iter().any(|e| matches!(e, Event::DroppedStub { duration_s, .. } if (*duration_s - 0.04).abs() < 1e-9)),
+        "{:?}",
+        r.events
+    );
+    assert!(r.main.is_none() && r.fallback.is_some());
+    // On the goal a short hover is no stub: it is the plan.
+    let mut m = Manager::new(
+        StraightLine,
+        Stub,
+        Tvd::default(),
+        Limits::default(),
+        reproducible(ManagerParams::single_branch()),
+    )
+    .unwrap();
+    let r = m.step(0.0, &start, &start.p, &scene).unwrap();
+    assert!(
+        !r.events
+            .iter()
+            .any(|e| matches!(e, Event::DroppedStub { .. })),
+        "{:?}",
+        r.events
+    );
 }
