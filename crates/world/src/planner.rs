@@ -1022,11 +1022,13 @@ pub fn closed_loop_backend() -> UtfMincoParams {
 }
 
 /// The presets' jerk limit as a ramp time: UTF-MINCO penalizes jerk above `a_max / 0.3 s`
-/// (`trust_minco::PenaltyParams::jerk_ramp_s`). Measured on the default quadrotor
-/// (`crates/flight/tests/accel_headroom.rs`): a planned swing of the acceleration by `0.9 a_max`
-/// in either direction overshoots by under 6 % of the swing when it takes 0.4 s, by 14 % in
-/// 0.2 s and by 19 % in 0.1 s; MINCO's time-optimal branches started at the old acceleration and
-/// swung in well under 0.1 s, and the suite's flights among people reached 1.2 `a_max`.
+/// (`trust_minco::PenaltyParams::jerk_ramp_s`). The quadrotor's attitude lags a fast swing of the
+/// planned acceleration and its true acceleration overshoots: a reversal of `±0.9 a_max` peaks at
+/// 1.17 / 1.03 / 0.96 `a_max` with a ramp of 0.1 / 0.2 / 0.3 s at 3 m/s², 1.07 / 0.99 / 0.93 at
+/// 15 m/s² (`crates/flight/tests/accel_headroom.rs`). MINCO's time-optimal branches swung in well
+/// under 0.1 s (rooms with people: 1.2 `a_max`). 0.2 s kept the accelerations within 5 % too,
+/// but the rooms with people had more failures (19 against 13 of 120 flights, seeds 100–119 of
+/// six room files) and up to 1.06 `a_max`; E4 flies a little faster with it.
 pub const PRESET_JERK_RAMP_S: f64 = 0.3;
 
 /// Builds the manager of `resolved` for a vehicle and trial ([`effective`] parameters).
