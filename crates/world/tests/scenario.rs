@@ -527,3 +527,18 @@ fn every_seed_of_a_random_flight_is_valid() {
         }
     }
 }
+
+/// The suite (`scenarios/suite/`, one file per class of issue 19) and its variants
+/// (`scenarios/variants/`, two more per class with other geometry, sizes and limits) load and
+/// validate.
+#[test]
+fn every_suite_and_variant_file_validates() {
+    for dir in ["suite", "variants"] {
+        let files = toml_files(&scenarios_dir().join(dir));
+        assert!(files.len() >= 11, "{dir}: {files:?}");
+        for path in files {
+            let s = Scenario::load(&path).unwrap_or_else(|e| panic!("{e}"));
+            assert!(s.validate().is_empty(), "{}", path.display());
+        }
+    }
+}
