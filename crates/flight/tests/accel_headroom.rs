@@ -116,8 +116,17 @@ fn the_overshoot_depends_on_the_ramp_at_every_scale() {
         };
         let (slow, medium, fast) = (peak(0.3), peak(0.2), peak(0.1));
         eprintln!("a_max {a_max}: ramp 0.3 s {slow:.3}, 0.2 s {medium:.3}, 0.1 s {fast:.3}");
-        assert!(slow < 1.0 && medium < 1.05, "a_max {a_max}: {slow}, {medium}");
-        assert!(fast > medium && medium > slow, "a_max {a_max}: {fast}, {medium}, {slow}");
-        assert!(fast > 1.05, "a_max {a_max}: a 0.1 s ramp overshoots, {fast}");
+        assert!(
+            slow < 1.0 && medium < 1.05,
+            "a_max {a_max}: {slow}, {medium}"
+        );
+        assert!(
+            fast > medium && medium > slow,
+            "a_max {a_max}: {fast}, {medium}, {slow}"
+        );
+        assert!(
+            fast > 1.05,
+            "a_max {a_max}: a 0.1 s ramp overshoots, {fast}"
+        );
     }
 }
