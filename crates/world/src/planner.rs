@@ -865,8 +865,8 @@ fn scale_preset_backend(backend: &mut BackendSpec, limits: &Limits) {
     penalty.guidance_smoothing_m = 0.1 * v;
 }
 
-/// `λ_s = λ_t · 10 m/s / v_max` in the presets ([`scale_preset_backend`]): E4's measured 60 / 60
-/// at 10 m/s.
+/// `λ_s = λ_t · 10 m/s / v_max` in the presets ([`effective`] scales the preset backend): E4's
+/// measured 60 / 60 at 10 m/s.
 pub const PRESET_TERMINAL_SPEED_M_S: f64 = 10.0;
 
 /// Duration (s) of one backend piece at `v_max` in the presets: [`effective`] sets the preset
@@ -928,7 +928,10 @@ pub struct PlannerContext {
 }
 
 /// The parameters actually used: `resolved` with the clearances raised to the vehicle's
-/// (module docs), the reproducible-mode budgets applied, and `manager.seed = ctx.seed`.
+/// (module docs), a preset's backend scaled to the vehicle's limits (terminal weight
+/// `λ_t·`[`PRESET_TERMINAL_SPEED_M_S`]`/v_max`, piece length [`PRESET_PIECE_DURATION_S`]` ·
+/// v_max`, `d_ε = 1.5 v_max²/a_max`, guidance smoothing `0.1 s · v_max`: E4's measured values at
+/// 10 m/s and 15 m/s²), the reproducible-mode budgets applied, and `manager.seed = ctx.seed`.
 ///
 /// # Errors
 /// [`WorldError::Input`] for a negative or non-finite radius or map error.
