@@ -405,6 +405,26 @@ fn an_enclosed_goal_is_approached_without_collision_and_never_reached() {
     }
 }
 
+/// A converged one-evaluation solution for `traj`: `H_t` its duration, `H_s` its end's distance
+/// to `goal`.
+fn converged(traj: PolyTraj, goal: &Vec3) -> Solution {
+    Solution {
+        costs: CostBreakdown {
+            ht: traj.duration(),
+            hs: (traj.position(traj.t_end()) - goal).norm(),
+            ..CostBreakdown::default()
+        },
+        traj,
+        stats: SolveStats {
+            iteration_count: 0,
+            evaluation_count: 1,
+            elapsed: std::time::Duration::ZERO,
+            status: SolveStatus::Converged,
+        },
+        violations: Vec::new(),
+    }
+}
+
 /// A backend that ignores obstacles: it continues the start state for 4 s (constant
 /// acceleration), so every trajectory drives into whatever is ahead.
 struct Blind;
@@ -424,21 +444,8 @@ impl TrajectoryBackend for Blind {
             Vec3::zeros(),
             Vec3::zeros(),
         ];
-        Ok(Solution {
-            traj: PolyTraj::new(s.t, vec![4.0], vec![piece])?,
-            costs: CostBreakdown {
-                ht: 4.0,
-                hs: (s.p + s.v * 4.0 - req.goal).norm(),
-                ..CostBreakdown::default()
-            },
-            stats: SolveStats {
-                iteration_count: 0,
-                evaluation_count: 1,
-                elapsed: std::time::Duration::ZERO,
-                status: SolveStatus::Converged,
-            },
-            violations: Vec::new(),
-        })
+        let traj = PolyTraj::new(s.t, vec![4.0], vec![piece])?;
+        Ok(converged(traj, &req.goal))
     }
 }
 
@@ -1042,22 +1049,7 @@ impl TrajectoryBackend for Stub {
 
     fn optimize(&self, req: &TrajRequest<'_>, _scene: &Scene<'_>) -> Result<Solution, PlanError> {
         let s = req.start;
-        let traj = PolyTraj::hold(s.t, s.p, 0.04)?;
-        Ok(Solution {
-            traj,
-            costs: CostBreakdown {
-                ht: 0.04,
-                hs: (s.p - req.goal).norm(),
-                ..CostBreakdown::default()
-            },
-            stats: SolveStats {
-                iteration_count: 0,
-                evaluation_count: 1,
-                elapsed: std::time::Duration::ZERO,
-                status: SolveStatus::Converged,
-            },
-            violations: Vec::new(),
-        })
+        Ok(converged(PolyTraj::hold(s.t, s.p, 0.04)?, &req.goal))
     }
 }
 
