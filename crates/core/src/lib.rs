@@ -94,8 +94,8 @@ pub use scene::Scene;
 pub use solution::{CostBreakdown, RankingWeights, Solution, SolveStats, SolveStatus};
 pub use state::{Limits, State};
 pub use traits::{
-    HomotopyChecker, InitialGuess, PathFrontend, PathQuery, SearchResult, SearchStats, TrajRequest,
-    TrajectoryBackend,
+    HomotopyChecker, InitialGuess, MAX_EXPLORATION, PathFrontend, PathQuery, SearchResult,
+    SearchStats, TrajRequest, TrajectoryBackend,
 };
 pub use traj::{Derivative, MAX_DERIVATIVE_BOUND, Piece, PolyTraj, eval_piece};
 pub use verify::{VERIFY_MAX_SAMPLES, VERIFY_STEP_S, Violation, verify_trajectory};

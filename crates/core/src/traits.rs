@@ -23,7 +23,16 @@ pub struct PathQuery {
     pub limits: Limits,
     /// Planning horizon `T_h` (s): predictive directional cones and the goal guidance surface use it.
     pub horizon_s: f64,
+    /// How widely to explore, `1` normally: a sampling frontend multiplies its sampling region's
+    /// inflation, its sample budgets and its time budget by it (DEV-PRM, V-PRM); frontends
+    /// without a sampling region ignore it. The manager passes 2 while the flight is stalled.
+    /// Accepted: `[1, MAX_EXPLORATION]`.
+    pub exploration: f64,
 }
+
+/// The largest accepted [`PathQuery::exploration`]: sixteen times the sampling region and the
+/// budgets is already a search over a different problem.
+pub const MAX_EXPLORATION: f64 = 16.0;
 
 impl PathQuery {
     /// Checks every field.
@@ -37,6 +46,13 @@ impl PathQuery {
             self.horizon_s,
             Quantity::PositiveDuration,
         )?;
+        if !(1.0..=MAX_EXPLORATION).contains(&self.exploration) {
+            return Err(PlanError::invalid(
+                "query.exploration",
+                self.exploration,
+                format!("a factor in [1, {MAX_EXPLORATION}]"),
+            ));
+        }
         Ok(())
     }
 }

@@ -592,6 +592,7 @@ fn core_limits_state(g: &mut Gen, _: &Fixtures) -> Outcome {
         goal: g.v3(),
         limits: Limits::default(),
         horizon_s: g.num(0.1, 5.0),
+        exploration: g.num(-1.0, 20.0),
     };
     let _ = q.validate();
     Outcome::Ok
@@ -787,6 +788,7 @@ fn topo_frontends(g: &mut Gen, fx: &Fixtures) -> Outcome {
             a_max: g.num(1.0, 15.0),
         },
         horizon_s: g.num(0.5, 5.0),
+        exploration: if g.chance(0.5) { 1.0 } else { g.num(1.0, 3.0) },
     };
     let mut rng = <trust_core::Rng as rand::SeedableRng>::seed_from_u64(g.index(1000) as u64);
     let which = g.index(4);
@@ -1007,6 +1009,7 @@ pub fn valid_query(g: &mut Gen, map: &StaticMap) -> PathQuery {
         goal: p(g),
         limits: Limits::default(),
         horizon_s: 3.0,
+        exploration: 1.0,
     }
 }
 

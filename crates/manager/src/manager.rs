@@ -379,6 +379,18 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     ) -> Result<StepReport, PlanError> {
         let mut spans = Spans::start();
         check_step_input(now, measured, goal, scene)?;
+        let with_images;
+        let imaged: Vec<Forecast>;
+        let scene = if self.params.wall_images {
+            imaged = forecasts_with_wall_images(scene, now, now + 2.0 * self.params.horizon_s);
+            with_images = Scene {
+                forecasts: &imaged,
+                ..*scene
+            };
+            &with_images
+        } else {
+            scene
+        };
         let mut cycle = self.begin_cycle(now, measured, goal, spans.started);
         self.update_route(&mut cycle, measured, scene, &mut spans);
 
@@ -532,6 +544,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             goal: *goal,
             limits: self.limits,
             horizon_s: self.params.horizon_s,
+            exploration: if cycle.stalled { 2.0 } else { 1.0 },
         };
         let solver = Solver {
             backend: &self.backend,
@@ -1042,6 +1055,17 @@ fn max_jerk(traj: &PolyTraj) -> f64 {
         t += d;
     }
     worst
+}
+
+/// The scene's forecasts followed by their mirror images at the map bounds' walls over
+/// `[from, until]` ([`trust_predict::wall_images`]).
+fn forecasts_with_wall_images(scene: &Scene<'_>, from: f64, until: f64) -> Vec<Forecast> {
+    let walls = scene.map.bounds();
+    let mut all = scene.forecasts.to_vec();
+    for f in scene.forecasts {
+        all.extend(trust_predict::wall_images(f, walls, from, until));
+    }
+    all
 }
 
 /// Checks the inputs of [`Manager::step`].

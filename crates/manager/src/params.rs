@@ -29,6 +29,12 @@ pub struct ManagerParams {
     /// obstacle's whole sweep over the horizon — so in crowded moments it can find no path while a
     /// trajectory passing behind an obstacle exists in space-time. Default `true`.
     pub straight_guide_when_empty: bool,
+    /// Forecast the moving obstacles as staying inside the map's bounds: each cycle the manager
+    /// adds the mirror images of every forecast at the bounds' walls over twice the horizon
+    /// ([`trust_predict::wall_images`]), so a person walking at a room's wall is expected back
+    /// along the reflected line (beyond the paper). A constant-velocity forecast walks them through
+    /// the wall, and a vehicle crossing behind them meets them on their way back. Default `true`.
+    pub wall_images: bool,
     /// Evaluation budget (cost evaluations) of a warm-started re-solve (FwdMarch, BwdReplan);
     /// `None`: the backend's own. The branch is refined again next cycle, so a re-solve need not
     /// converge fully. Default 100 (beyond the paper): flight times as without a cap at about
@@ -125,6 +131,7 @@ impl ManagerParams {
             history: true,
             max_explored_paths: 5,
             straight_guide_when_empty: true,
+            wall_images: true,
             warm_max_evaluations: Some(100),
             sub_branch_max_evaluations: Some(50),
             cold_max_evaluations: None,

@@ -552,6 +552,45 @@ fn braking_fallback_when_every_branch_collides() {
     assert!(r.fallback.as_ref().is_some_and(|f| f.collision_free));
 }
 
+/// An obstacle walking toward the map's wall y = 10 (it turns there, at y = 9, at t = 0.5 s)
+/// crosses the blind plan's line at x = 29 just when the vehicle gets there (t = 3 s), on its way
+/// back; its constant-velocity forecast is at y = 19 by then. With the wall images
+/// (`ManagerParams::wall_images`, the default) the plan is dropped; without, it is kept.
+#[test]
+fn an_obstacle_turning_at_a_wall_is_expected_back() {
+    let map = open_air();
+    let walker = [Forecast::new(
+        ObstacleShape::Sphere,
+        Vec3::new(29.0, 7.0, 5.0),
+        Vec3::new(0.0, 4.0, 0.0),
+        0.0,
+        1.0,
+        0.3,
+        0.0,
+    )
+    .unwrap()];
+    let scene = Scene::new(&map, &walker, 0.0).unwrap();
+    let goal = Vec3::new(95.0, 0.0, 5.0);
+    let plan_kept = |wall_images: bool| {
+        let mut m = Manager::new(
+            StraightLine,
+            Blind,
+            Tvd::default(),
+            Limits::default(),
+            reproducible(ManagerParams {
+                wall_images,
+                ..ManagerParams::single_branch()
+            }),
+        )
+        .unwrap();
+        let r = m.step(0.0, &cruising(8.0), &goal, &scene).unwrap();
+        r.main.is_some()
+    };
+    assert!(ManagerParams::default().wall_images);
+    assert!(plan_kept(false));
+    assert!(!plan_kept(true));
+}
+
 /// A frontend that never finds a path.
 struct Nothing;
 

@@ -17,6 +17,8 @@
 //!   path, and every user of the cone (DEV-PRM, UVD, TVD, safety checks) shares them.
 //! * [`CvEkf`] — the dynamic-obstacle estimator of paper Sec. IV ("EKF"): constant-velocity model,
 //!   position measurements with dropouts, and `mu` derived from the velocity covariance.
+//! * [`wall_images`] — the mirror images of a forecast at the walls of the box its obstacle stays
+//!   inside: a person walking at a room's wall turns there (beyond the paper).
 //! * [`convex`] — the minimizers behind the PDC queries (closed forms over intervals and polygons,
 //!   cutting planes along a segment, segment–segment distance), reusable on their own.
 //!
@@ -52,9 +54,11 @@ mod ekf;
 mod error;
 mod forecast;
 pub mod pdc;
+mod walls;
 
 pub use ekf::{CvEkf, EkfParams, MAX_ACCEL_PSD, MAX_SIGMA_SCALE};
 pub use error::PredictError;
 pub use forecast::{Forecast, ObstacleShape};
 pub use pdc::{CLEAR_TOLERANCE, Pdc, frame_along, round_cone_sdf};
 pub use trust_geometry::{Aabb, Vec3};
+pub use walls::{MAX_REFLECTIONS_PER_AXIS, wall_images};

@@ -127,6 +127,22 @@ pub(crate) struct PrmSetup {
 }
 
 impl PrmSetup {
+    /// This setup for a query that explores `factor` (≥ 1) times as widely
+    /// ([`PathQuery::exploration`]): the sampling box's inflation, the sample budgets and the time
+    /// budget multiplied by it (counts capped at the scale policy's sample count).
+    fn explored(&self, factor: f64) -> PrmSetup {
+        let count = |n: usize| {
+            ((n as f64 * factor).round() as usize).min(trust_core::scale::MAX_SAMPLE_COUNT)
+        };
+        PrmSetup {
+            inflate: self.inflate * factor,
+            budget_ms: self.budget_ms * factor,
+            max_samples: count(self.max_samples),
+            stall_samples: count(self.stall_samples),
+            ..*self
+        }
+    }
+
     /// The roadmap's time budget.
     fn budget(&self, prefix: &str) -> Result<Duration, PlanError> {
         Duration::try_from_secs_f64(self.budget_ms / 1000.0).map_err(|_| {
@@ -281,6 +297,13 @@ pub(crate) fn run(
     if let Some(answer) = check_or_trivial_answer(query, scene, since)? {
         return Ok(answer);
     }
+    let explored;
+    let setup = if query.exploration > 1.0 {
+        explored = setup.explored(query.exploration);
+        &explored
+    } else {
+        setup
+    };
     let start = query.start.p;
     let deadline = since + setup.budget("prm")?;
 

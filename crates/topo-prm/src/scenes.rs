@@ -231,6 +231,7 @@ pub fn random_dynamic_scene(
             goal,
             limits: params.limits,
             horizon_s: params.horizon_s,
+            exploration: 1.0,
         },
     })
 }

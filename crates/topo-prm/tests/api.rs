@@ -27,6 +27,7 @@ fn query(start: Vec3, goal: Vec3) -> PathQuery {
         goal,
         limits: Limits::default(),
         horizon_s: 2.0,
+        exploration: 1.0,
     }
 }
 

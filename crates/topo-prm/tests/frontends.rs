@@ -29,6 +29,7 @@ fn query(start: Vec3, goal: Vec3, horizon_s: f64) -> PathQuery {
         goal,
         limits: Limits::default(),
         horizon_s,
+        exploration: 1.0,
     }
 }
 
@@ -259,5 +260,49 @@ fn prms_find_several_classes_where_there_are_several() {
                 w.name
             );
         }
+    }
+}
+
+/// `PathQuery::exploration` widens DEV-PRM's sampling box: a full-height wall 17 m to either side
+/// of the line to the goal is beyond the default box's 10 m lateral inflation, and within twice
+/// it. (The time budget is made large so that only the sample counts bind: deterministic.)
+#[test]
+fn exploration_widens_the_sampling_box() {
+    let wall =
+        Shape::from(AaBox::new(Vec3::new(9.8, 3.0, 0.0), Vec3::new(10.2, 37.0, 10.0)).unwrap());
+    let map = StaticMap::from_shapes(bounds(Vec3::new(40.0, 40.0, 10.0)), vec![wall]).unwrap();
+    let scene = Scene::new(&map, &[], 0.0).unwrap();
+    let frontend = DevPrm::new(DevPrmParams {
+        goal_guidance_surface: false,
+        budget_ms: 60_000.0,
+        ..DevPrmParams::default()
+    })
+    .unwrap();
+    let paths_with = |exploration: f64| {
+        let q = PathQuery {
+            exploration,
+            ..query(Vec3::new(2.0, 20.0, 5.0), Vec3::new(18.0, 20.0, 5.0), 2.0)
+        };
+        frontend
+            .search(&q, &scene, &mut Rng::seed_from_u64(5))
+            .unwrap()
+            .paths
+    };
+    assert!(paths_with(1.0).is_empty());
+    let wide = paths_with(2.0);
+    assert!(!wide.is_empty());
+    assert!(
+        wide.iter()
+            .all(|p| p.points.iter().any(|v| !(3.0..=37.0).contains(&v.y)))
+    );
+    for bad in [0.5, f64::NAN, 17.0] {
+        let q = PathQuery {
+            exploration: bad,
+            ..query(Vec3::new(2.0, 20.0, 5.0), Vec3::new(18.0, 20.0, 5.0), 2.0)
+        };
+        let e = frontend
+            .search(&q, &scene, &mut Rng::seed_from_u64(5))
+            .unwrap_err();
+        assert!(e.to_string().contains("query.exploration"), "{e}");
     }
 }

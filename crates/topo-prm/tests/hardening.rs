@@ -180,6 +180,7 @@ fn devprm_surface_offset_extremes_are_rejected_at_construction_or_work() {
         goal: Vec3::new(10.0, 0.0, 0.0),
         limits: Limits::default(),
         horizon_s: 2.0,
+        exploration: 1.0,
     };
     for offset in [0.3, 1e3, trust_core::scale::MAX_LENGTH_M] {
         let f = DevPrm::new(DevPrmParams {

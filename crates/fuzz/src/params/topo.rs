@@ -103,6 +103,7 @@ fn valid_query(g: &mut Gen, map: &trust_core::StaticMap) -> trust_core::PathQuer
         goal,
         limits: trust_core::Limits::default(),
         horizon_s: 3.0,
+        exploration: 1.0,
     }
 }
 
