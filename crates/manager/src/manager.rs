@@ -193,6 +193,8 @@ pub struct Manager<F, B, H> {
     /// The goal the last route was planned toward (planned or failed), so a failing plan is not
     /// retried every cycle.
     routed_goal: Option<Vec3>,
+    /// When the last route was planned (or failed), s.
+    routed_at: f64,
 }
 
 impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
@@ -235,6 +237,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             route: None,
             router: None,
             routed_goal: None,
+            routed_at: f64::NEG_INFINITY,
             cycle_count: 0,
         })
     }
@@ -436,8 +439,9 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     }
 
     /// Plans the global route with the router ([`Manager::set_router`]) when there is none
-    /// toward this goal yet, or when the progress monitor has just declared a stall; the
-    /// progress monitor is carried over to the new route's arc length.
+    /// toward this goal yet, when the progress monitor has just declared a stall, and every
+    /// horizon while the stall lasts; the progress monitor is carried over to the new route's
+    /// arc length.
     fn update_route(
         &mut self,
         cycle: &mut Cycle,
@@ -449,9 +453,12 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             return;
         };
         let goal = cycle.goal;
+        // While the stall lasts the route is planned again every horizon (a route that failed,
+        // or one that leads into a dead end, is not kept for the rest of the flight).
+        let again = cycle.stalled && measured.t - self.routed_at >= self.params.horizon_s;
         let reason = if self.routed_goal.is_none_or(|g| (g - goal).norm() > 1e-9) {
             RouteReason::First
-        } else if cycle.newly_stalled {
+        } else if cycle.newly_stalled || again {
             RouteReason::Stalled
         } else {
             return;
@@ -461,6 +468,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         });
         cycle.events.push(event);
         self.routed_goal = Some(goal);
+        self.routed_at = measured.t;
         if let Some(route) = route {
             let before = self.progress_at(&measured.p, &goal);
             self.route = Some(route);
@@ -990,6 +998,24 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         if let Ok(dashes) = dash_maneuvers(start, &directions, cruise_s, &self.limits, hold_s) {
             options.extend(dashes.into_iter().map(|t| ("dash", t)));
         }
+        // The options are judged against the forecasts grown for a quarter of the horizon and
+        // then held: the fallback is chosen again next cycle from new observations, and against
+        // an uncertainty growing without end every option collides at last, so the latest
+        // collision won — fleeing along a person's path instead of stepping out of it.
+        let grow_for = FALLBACK_GROWTH_FRACTION * self.params.horizon_s;
+        let held: Vec<Forecast> = scene
+            .forecasts
+            .iter()
+            .map(|f| Forecast {
+                r_safe: f.r_safe + f.mu * grow_for,
+                mu: 0.0,
+                ..*f
+            })
+            .collect();
+        let judged = Scene {
+            forecasts: &held,
+            ..*scene
+        };
         // The first collision-free option; else the one that collides latest, then least deeply.
         let jerk_limit = a_max / crate::brake::RAMP_S;
         let mut best: Option<(usize, SafetyVerdict)> = None;
@@ -998,7 +1024,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         for (i, (kind, traj)) in options.iter().enumerate() {
             let v = assess_trajectory(
                 traj,
-                scene,
+                &judged,
                 start.t,
                 traj.t_end(),
                 &self.limits,
@@ -1043,6 +1069,10 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         })
     }
 }
+
+/// The fallback judges its options against the forecasts grown for this fraction of the horizon
+/// (1 s at 4 s) and then held ([`Manager`]'s fallback).
+const FALLBACK_GROWTH_FRACTION: f64 = 0.25;
 
 /// Largest jerk norm of `traj` (m/s³), 16 samples per piece.
 fn max_jerk(traj: &PolyTraj) -> f64 {

@@ -591,6 +591,50 @@ fn an_obstacle_turning_at_a_wall_is_expected_back() {
     assert!(!plan_kept(true));
 }
 
+/// A ball rolling at a vehicle at rest, twice as fast as the vehicle can fly, its forecast growing
+/// fast: the fallback steps out of its path rather than fleeing along it (judged against
+/// forecasts that grow for ever, every option collided and fleeing, colliding latest, won).
+#[test]
+fn the_fallback_steps_out_of_a_faster_obstacles_path() {
+    let map = open_air();
+    let limits = Limits {
+        v_max: 1.0,
+        a_max: 3.0,
+    };
+    let mut m = Manager::new(
+        StraightLine,
+        Blind,
+        Tvd::default(),
+        limits,
+        reproducible(ManagerParams::single_branch()),
+    )
+    .unwrap();
+    let ball = [Forecast::new(
+        ObstacleShape::Sphere,
+        Vec3::new(46.0, 0.0, 5.0),
+        Vec3::new(2.0, 0.0, 0.0),
+        0.0,
+        0.5,
+        0.2,
+        0.6,
+    )
+    .unwrap()];
+    let scene = Scene::new(&map, &ball, 0.0).unwrap();
+    let start = State::at_rest(0.0, Vec3::new(50.0, 0.0, 5.0));
+    let r = m
+        .step(0.0, &start, &Vec3::new(95.0, 0.0, 5.0), &scene)
+        .unwrap();
+    let fallback = r.fallback.expect("every branch collides");
+    let plan = m.plan().unwrap();
+    let moved = plan.position(plan.t_end()) - start.p;
+    // Out of the ball's path: farther aside than its radius plus margin (0.7 m).
+    assert!(
+        moved.y.hypot(moved.z) > 0.7,
+        "{} moved {moved:?}",
+        fallback.along
+    );
+}
+
 /// A frontend that never finds a path.
 struct Nothing;
 

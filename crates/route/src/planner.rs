@@ -447,11 +447,14 @@ impl RoutePlanner {
         // the coarse grid finds none (a passage too narrow for it) does the fine grid search.
         let mut expanded_before = 0;
         if p.coarse_factor > 1.0 {
+            // The coarse grid coarsens to fit the cell cap like the fine one: a world too large
+            // for the fine grid at its coarsest (a 320 × 320 × 45 m city with a 0.25 m vehicle)
+            // is still routed, on the coarse grid.
             let coarse = h0 * p.coarse_factor;
-            match self.grid_route(map, &ends, coarse, coarse, deadline) {
+            match self.grid_route(map, &ends, coarse, coarse * p.max_coarsening, deadline) {
                 Ok(route) => return Ok(route),
                 Err(RouteError::Unreachable { expanded, .. }) => expanded_before = expanded,
-                Err(RouteError::NoFreeCell { .. }) => {}
+                Err(RouteError::NoFreeCell { .. } | RouteError::TooManyCells { .. }) => {}
                 Err(e) => return Err(e),
             }
         }

@@ -427,3 +427,30 @@ fn regression_seed_5240_big_map_ends_in_a_typed_answer() {
         Err(e) => panic!("with the cap out of the way: {e}"),
     }
 }
+
+/// A world too large for the fine grid at its coarsest is still routed on the coarse grid,
+/// which coarsens to fit the cap like the fine one (holdout: a 320 × 320 × 45 m city with a
+/// 0.25 m vehicle had no route and the vehicle stopped at a building). The wide wall with
+/// 20 000 cells: the fine grid (0.225 m cells, at most 0.9 m) needs 2.1 M.
+#[test]
+fn a_world_too_large_for_the_fine_grid_is_routed_on_the_coarse_one() {
+    let map = wide_wall();
+    let (s, g) = (Vec3::new(2.0, 30.0, 5.0), Vec3::new(100.0, 30.0, 5.0));
+    let capped = RouteParams {
+        max_cells: 20_000,
+        ..RouteParams::default()
+    };
+    let fine_only = RoutePlanner::new(RouteParams {
+        coarse_factor: 1.0,
+        ..capped.clone()
+    })
+    .unwrap();
+    let e = fine_only.plan(&map, &s, &g, 0.3).unwrap_err();
+    assert!(matches!(e, RouteError::TooManyCells { .. }), "{e}");
+    let route = RoutePlanner::new(capped)
+        .unwrap()
+        .plan(&map, &s, &g, 0.3)
+        .unwrap();
+    assert_clear(&map, &route);
+    assert!(route.points().iter().any(|p| p.y < 15.0 || p.y > 45.0));
+}

@@ -298,8 +298,9 @@ pub struct Dropped {
     pub bounds: usize,
     /// Only the speed or acceleration limit was exceeded.
     pub limits: usize,
-    /// Of the above, those whose trajectory was clear and only the braking after its end was
-    /// not (`trust_manager::SafetyParams::braking_tail`).
+    /// Of the above, those whose trajectory was clear and only what follows its end was not:
+    /// the braking of one that ends moving (`trust_manager::SafetyParams::braking_tail`) or the
+    /// rest hold of one that ends at rest (`trust_manager::SafetyParams::rest_hold_s`).
     #[serde(default)]
     pub braking_tail: usize,
 }
