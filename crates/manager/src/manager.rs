@@ -1016,11 +1016,19 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             forecasts: &held,
             ..*scene
         };
-        // The first collision-free option; else the one that collides latest, then least deeply.
+        // The first collision-free option; else, clear of the static map and the bounds before
+        // all (they are known, the forecasts are guesses: a vehicle that dodged a person into a
+        // door frame hit it), the one that collides latest, then least deeply.
         let jerk_limit = a_max / crate::brake::RAMP_S;
         let mut best: Option<(usize, SafetyVerdict)> = None;
-        let rank =
-            |v: &SafetyVerdict| (v.violation.map_or(f64::INFINITY, |x| x.t), v.min_margin_m());
+        let rank = |v: &SafetyVerdict| {
+            let static_clear = v.min_static_margin_m >= 0.0;
+            (
+                u8::from(static_clear),
+                v.violation.map_or(f64::INFINITY, |x| x.t),
+                v.min_margin_m(),
+            )
+        };
         for (i, (kind, traj)) in options.iter().enumerate() {
             let v = assess_trajectory(
                 traj,

@@ -49,7 +49,8 @@ pub struct SafetyVerdict {
     /// No violation in the window and within the limits' tolerance.
     pub safe: bool,
     /// Smallest static clearance minus the required one over the checked instants (m; `+∞` for an
-    /// empty map).
+    /// empty map), and minus how far the vehicle's centre leaves the bounds (shrunk by the static
+    /// clearance) where it does.
     pub min_static_margin_m: f64,
     /// Smallest dynamic clearance minus the required one (m; `+∞` without nearby forecasts).
     pub min_dynamic_margin_m: f64,
@@ -470,6 +471,11 @@ fn check_window(
         let p = traj.position(t);
         let m = window.margins(scene, &p, t, params);
         verdict.min_static_margin_m = verdict.min_static_margin_m.min(m.static_m);
+        if !bounds.contains(&p) {
+            verdict.min_static_margin_m = verdict
+                .min_static_margin_m
+                .min(-bounds.distance_to_point(&p));
+        }
         verdict.min_dynamic_margin_m = verdict.min_dynamic_margin_m.min(m.dynamic_m);
         match m.hit(bounds, &p) {
             Some((with, margin)) => {
