@@ -97,9 +97,11 @@ pub struct E3Summary {
 /// file-system or plotting failures.
 pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, ExperimentError> {
     let world = World::build(scenario)?;
-    // The paper's table: the branches of one cycle aimed at the final goal, no global route.
+    // The paper's table: the branches of one cycle aimed at the final goal, no global route,
+    // constant-velocity forecasts without their wall images.
     let mut resolved = scenario.resolve_planner();
     resolved.route = None;
+    resolved.manager.wall_images = false;
     let trust_flight::Setup {
         sensing,
         mut manager,
