@@ -1006,11 +1006,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let held: Vec<Forecast> = scene
             .forecasts
             .iter()
-            .map(|f| Forecast {
-                r_safe: f.r_safe + f.mu * grow_for,
-                mu: 0.0,
-                ..*f
-            })
+            .map(|f| f.growth_held_after(grow_for))
             .collect();
         let judged = Scene {
             forecasts: &held,

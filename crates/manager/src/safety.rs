@@ -271,11 +271,7 @@ fn check(
         let held: Vec<Forecast> = scene
             .forecasts
             .iter()
-            .map(|f| Forecast {
-                r_safe: f.inflation(rest.t.min(f.t0 + params.rest_hold_s)),
-                mu: 0.0,
-                ..*f
-            })
+            .map(|f| f.growth_held_after((rest.t - f.t0).min(params.rest_hold_s)))
             .collect();
         let frozen = Scene {
             forecasts: &held,

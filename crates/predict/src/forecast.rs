@@ -137,6 +137,19 @@ impl Forecast {
         self.v0
     }
 
+    /// This forecast with its growth held after `duration` seconds from `t0`: the same motion,
+    /// `r_safe` raised to `r_safe + mu·max(duration, 0)` and `mu` zero. For a judgement that the
+    /// next observations will revise anyway (the manager's fallback and its rest hold): grown
+    /// without end, the uncertainty swallows every place near an obstacle's path.
+    #[inline]
+    pub fn growth_held_after(&self, duration: f64) -> Forecast {
+        Forecast {
+            r_safe: self.r_safe + self.mu * duration.max(0.0),
+            mu: 0.0,
+            ..*self
+        }
+    }
+
     /// Inflation added to the base shape at time `t`: `r_safe + mu·max(t − t0, 0)`.
     #[inline]
     pub fn inflation(&self, t: f64) -> f64 {
@@ -317,6 +330,20 @@ mod tests {
             k = k.min((dr - dz).abs() / 2.0);
         }
         k
+    }
+
+    #[test]
+    fn held_growth_stops_at_the_given_age() {
+        let f = cylinder(Vec3::zeros(), Vec3::x(), 0.9, 0.5);
+        let held = f.growth_held_after(2.0);
+        held.validate().unwrap();
+        assert_eq!(held.center(7.0), f.center(7.0));
+        // The same size up to t0 + 2, then constant.
+        assert_relative_eq!(held.radius(3.0), f.radius(3.0), epsilon = 1e-12);
+        assert_relative_eq!(held.radius(9.0), f.radius(3.0), epsilon = 1e-12);
+        assert!(held.radius(2.0) >= f.radius(2.0));
+        assert_eq!(held.radius_rate(5.0), 0.0);
+        assert_eq!(f.growth_held_after(-1.0).r_safe, f.r_safe);
     }
 
     #[test]
