@@ -92,20 +92,23 @@ fn a_planned_reversal_at_the_jerk_limit_stays_within_five_percent_of_a_max() {
     }
 }
 
-/// The overshoot depends on how fast the acceleration swings, hardly on the scale: a reversal
-/// of `±0.9 a_max` peaks (in units of `a_max`) at
+/// The overshoot depends on how fast the acceleration swings, and less at larger scales: a
+/// reversal of `±0.9 a_max` peaks (in units of `a_max`) at
 ///
 /// | `a_max` | ramp 0.05 s | 0.1 s | 0.15 s | 0.2 s | 0.3 s |
 /// |---|---|---|---|---|---|
-/// | 2 | 1.221 | 1.174 | 1.099 | 1.034 | 0.961 |
-/// | 3 | 1.215 | 1.169 | 1.095 | 1.032 | 0.960 |
-/// | 8 | 1.126 | 1.130 | 1.067 | 1.013 | 0.948 |
-/// | 15 | 1.007 | 1.074 | 1.030 | 0.989 | 0.933 |
+/// | 2 | 1.193 (1.221) | 1.149 (1.174) | 1.078 (1.099) | 1.016 (1.034) | 0.961 |
+/// | 3 | 1.156 (1.215) | 1.115 (1.169) | 1.050 (1.095) | 1.005 (1.032) | 0.960 |
+/// | 8 | 1.012 (1.126) | 1.013 (1.130) | 1.008 (1.067) | 1.003 (1.013) | 0.948 |
+/// | 15 | 1.000 (1.007) | 1.009 (1.074) | 1.005 (1.030) | 0.989 | 0.933 |
 ///
-/// (the ramp is the time to swing by `a_max`; faster swings than 0.05 s at 15 m/s² are beyond
-/// the body-rate limit and are not followed at all). At the presets' 0.3 s every scale stays
-/// below `a_max`; at 0.2 s within 3.4 % (and the rooms with people had more failures, 19 vs 13
-/// in 120 flights, so the presets keep 0.3 s).
+/// (the ramp is the time to swing by `a_max`; in brackets without the controller's thrust cap,
+/// `Se3Gains::max_accel_m_s2` applied to the thrust along the actual body axis; faster swings
+/// than 0.05 s at 15 m/s² are beyond the body-rate limit and are not followed at all). What is
+/// left at small `a_max` is the attitude's own overshoot: tilted past `asin(a_max/g)` no thrust
+/// keeps the acceleration within `a_max`. At the presets' 0.3 s every scale stays below
+/// `a_max`; at the braking's 0.2 s within 1.6 % (the presets keep 0.3 s: at 0.2 s the rooms with
+/// people had more failures, 19 vs 13 in 120 flights).
 #[test]
 fn the_overshoot_depends_on_the_ramp_at_every_scale() {
     for a_max in [2.0, 3.0, 8.0, 15.0] {
@@ -117,16 +120,12 @@ fn the_overshoot_depends_on_the_ramp_at_every_scale() {
         let (slow, medium, fast) = (peak(0.3), peak(0.2), peak(0.1));
         eprintln!("a_max {a_max}: ramp 0.3 s {slow:.3}, 0.2 s {medium:.3}, 0.1 s {fast:.3}");
         assert!(
-            slow < 1.0 && medium < 1.05,
+            slow < 1.0 && medium < 1.02,
             "a_max {a_max}: {slow}, {medium}"
         );
         assert!(
             fast > medium && medium > slow,
             "a_max {a_max}: {fast}, {medium}, {slow}"
-        );
-        assert!(
-            fast > 1.05,
-            "a_max {a_max}: a 0.1 s ramp overshoots, {fast}"
         );
     }
 }

@@ -2,17 +2,20 @@
 //!
 //! [`brake_along`] keeps the *path* of a trajectory `q(u)` and slows down the progress along it:
 //! `p(t) = q(u(t))` with `u̇ = λ(t)` falling from 1 to 0, so `v = q′λ` and `a = q″λ² + q′λ̇`. The
-//! deceleration `−λ̇` is chosen at each instant so that `|q″|λ² + |q′||λ̇| ≤ 0.9·a_max` (with a floor
-//! that guarantees a stop when the trajectory itself is at the acceleration limit), ramped in and out
-//! so that acceleration is continuous at both ends. The result is sampled every 50 ms and
-//! represented exactly at those knots by quintic Hermite pieces (position, velocity and acceleration
-//! match), followed by a hold. Because the braking vehicle stays on a path that was checked clear of
-//! the static map, it stays clear of it; moving obstacles are another matter (it arrives later than
-//! planned), which is why the manager re-checks the fallback against the current forecasts and says
-//! whether it is clear.
+//! deceleration `−λ̇` is chosen at each instant so that `|q″λ² + q′λ̇| ≤ 0.9·a_max` (the path's
+//! own acceleration along `q′` counts with its sign; with a floor that guarantees a stop when the
+//! trajectory itself is at the acceleration limit), and the acceleration changes by at most
+//! `a_max` per 0.2 s: braking a trajectory that still accelerates first turns its acceleration
+//! round, as the vehicle must. The result is sampled every 50 ms and represented exactly at those
+//! knots by quintic Hermite pieces (position, velocity and acceleration match), followed by a
+//! hold. Because the braking vehicle stays on a path that was checked clear of the static map, it
+//! stays clear of it; moving obstacles are another matter (it arrives later than planned), which
+//! is why the manager re-checks the fallback against the current forecasts and says whether it is
+//! clear.
 //!
 //! [`brake_straight`] does the same along the current velocity direction, for when there is no
-//! trajectory to follow.
+//! trajectory to follow; the vehicle's acceleration across that direction ramps out within the
+//! same jerk limit.
 
 use trust_core::{Piece, PlanError, PolyTraj, State, Vec3, check_positive};
 
@@ -66,16 +69,37 @@ impl BrakePath for Along<'_> {
     }
 }
 
-/// A straight line through `p` along `v`, parameterized by time since `t0`.
+/// A line through `p` along `v`, parameterized by time since `t0`, bent at first by the part
+/// `a_normal` of the vehicle's acceleration across `v`, which ramps down to zero over `ramp_s`
+/// (`q″ = a_normal·(1 − s/ramp_s)`): a vehicle turning cannot stop turning at once. The part
+/// along `v` is the braking's initial `λ̇`.
 struct Straight {
     t0: f64,
     p: Vec3,
     v: Vec3,
+    a_normal: Vec3,
+    ramp_s: f64,
 }
 
 impl BrakePath for Straight {
     fn eval(&self, u: f64) -> [Vec3; 3] {
-        [self.p + self.v * (u - self.t0), self.v, Vec3::zeros()]
+        let s = (u - self.t0).max(0.0);
+        let r = self.ramp_s;
+        // f″ = 1 − s/r on [0, r], 0 after; f(0) = f′(0) = 0.
+        let (f, df, ddf) = if s < r {
+            (
+                s * s / 2.0 - s * s * s / (6.0 * r),
+                s - s * s / (2.0 * r),
+                1.0 - s / r,
+            )
+        } else {
+            (r * r / 3.0 + r / 2.0 * (s - r), r / 2.0, 0.0)
+        };
+        [
+            self.p + self.v * s + self.a_normal * f,
+            self.v + self.a_normal * df,
+            self.a_normal * ddf,
+        ]
     }
 }
 
@@ -96,7 +120,7 @@ pub fn brake_along(
     } else {
         traj.t_start()
     };
-    brake(&Along(traj), from, None, a_max, hold_s)
+    brake(&Along(traj), from, 0.0, a_max, hold_s)
 }
 
 /// Brakes along a straight line from `state` (its velocity direction) and then holds for `hold_s`
@@ -106,18 +130,56 @@ pub fn brake_along(
 /// As [`brake_along`], and for a non-finite state.
 pub fn brake_straight(state: &State, a_max: f64, hold_s: f64) -> Result<PolyTraj, PlanError> {
     state.validate("state")?;
+    check_positive("brake.a_max", a_max)?;
+    let speed2 = state.v.norm_squared();
+    let (a_along, a_normal) = if speed2 > 1e-12 {
+        let along = state.v * (state.a.dot(&state.v) / speed2);
+        (along, state.a - along)
+    } else {
+        (state.a, Vec3::zeros())
+    };
     let line = Straight {
         t0: state.t,
         p: state.p,
         v: state.v,
+        a_normal,
+        ramp_s: (a_normal.norm() / (a_max / RAMP_S)).max(1e-3),
     };
-    brake(&line, state.t, Some(state.a), a_max, hold_s)
+    // The acceleration along the line enters as λ̇ (a = v·λ̇ at λ = 1).
+    let lambda_dot = if speed2 > 1e-12 {
+        a_along.dot(&state.v) / speed2
+    } else {
+        0.0
+    };
+    brake(&line, state.t, lambda_dot, a_max, hold_s)
+}
+
+/// The braking tail of a trajectory that ends at `end` ([`crate::SafetyParams::braking_tail`],
+/// [`crate::SafetyParams::rest_hold_s`]): straight braking ([`brake_straight`]) from the end's
+/// position and velocity, then a hold of `hold_s` seconds. The end's acceleration is not
+/// counted: the tail is the model the backend's braking-tail penalty optimizes against
+/// (`trust_minco::PenaltyParams::braking_tail_delay_s`), which sees only the end's position and
+/// velocity — were the two to differ, candidates the optimizer cleared would be dropped by
+/// millimetres. Whatever the plan that follows does is checked when it is planned.
+///
+/// # Errors
+/// As [`brake_straight`].
+pub fn braking_tail(end: &State, a_max: f64, hold_s: f64) -> Result<PolyTraj, PlanError> {
+    brake_straight(
+        &State {
+            a: Vec3::zeros(),
+            ..*end
+        },
+        a_max,
+        hold_s,
+    )
 }
 
 /// Escape manoeuvres from `state` (beyond the paper): in each of `directions` (normalized; zero
 /// vectors skipped), a single quintic from `state` to rest `distance_m` away, then a hold of
 /// `hold_s` seconds. Its duration is the least of a geometric sequence (×1.25) whose speed and
-/// acceleration stay within `limits` (checked on a dense sampling), starting from the
+/// acceleration stay within `limits` and whose jerk stays below `a_max` per 0.2 s, the braking's
+/// own ramp (checked on a dense sampling), starting from the
 /// minimum-jerk rest-to-rest time of the distance. For the braking fallback: when a moving
 /// obstacle comes at a vehicle that brakes in place, moving out of its way is the only safe
 /// answer.
@@ -157,6 +219,7 @@ pub fn escape_maneuvers(
                 let t = state.t + duration * k as f64 / 64.0;
                 traj.velocity(t).norm() <= v_max * 1.001
                     && traj.acceleration(t).norm() <= a_max * 1.001
+                    && traj.jerk(t).norm() <= a_max / RAMP_S
             });
             if within {
                 out.push(traj);
@@ -166,6 +229,38 @@ pub fn escape_maneuvers(
         }
     }
     Ok(out)
+}
+
+/// From position `p`, velocity `v` and acceleration `a` at `t0`: the acceleration ramps down to
+/// zero within the jerk limit (`a_max` per [`RAMP_S`], with half as much again to spare), then
+/// the vehicle brakes along its velocity as [`brake_straight`] does and holds for `hold_s`.
+fn settle(
+    p: Vec3,
+    v: Vec3,
+    a: Vec3,
+    t0: f64,
+    a_max: f64,
+    hold_s: f64,
+) -> Result<PolyTraj, PlanError> {
+    // (At most 1.5 RAMP_S: a rejected plan braked along may accelerate beyond a_max.)
+    let ramp_s = (1.5 * a.norm() * RAMP_S / a_max).clamp(KNOT_S, 1.5 * RAMP_S);
+    // A linear ramp of the acceleration to zero: Δv = a·τ/2, Δp = v·τ + a·τ²/3.
+    let v1 = v + a * (0.5 * ramp_s);
+    let p1 = p + v * ramp_s + a * (ramp_s * ramp_s / 3.0);
+    let first = hermite_quintic([p, v, a], [p1, v1, Vec3::zeros()], ramp_s);
+    let line = Straight {
+        t0: t0 + ramp_s,
+        p: p1,
+        v: v1,
+        a_normal: Vec3::zeros(),
+        ramp_s: RAMP_S,
+    };
+    let rest = brake(&line, t0 + ramp_s, 0.0, a_max, hold_s)?;
+    let mut durations = vec![ramp_s];
+    durations.extend_from_slice(rest.durations());
+    let mut pieces = vec![first];
+    pieces.extend_from_slice(rest.pieces());
+    PolyTraj::new(t0, durations, pieces)
 }
 
 /// Fraction of `v_max` a dash ([`dash_maneuvers`]) cruises at.
@@ -260,14 +355,14 @@ pub fn dash_maneuvers(
 fn brake(
     path: &dyn BrakePath,
     t0: f64,
-    initial_accel: Option<Vec3>,
+    initial_lambda_dot: f64,
     a_max: f64,
     hold_s: f64,
 ) -> Result<PolyTraj, PlanError> {
     check_positive("brake.a_max", a_max)?;
     check_positive("brake.hold_s", hold_s)?;
     let target = TARGET_FRACTION * a_max;
-    let [p_start, v_start, a_start] = path.eval(t0);
+    let [p_start, v_start, a_path] = path.eval(t0);
     let v0 = v_start.norm().max(1e-3);
     // Floor of the deceleration rate of λ: stop within v0 / (a_max/10) even along a path at the
     // limit; the braking then asks for at most (0.9 + 0.1)·a_max (with a floor of a_max/4 it
@@ -276,33 +371,81 @@ fn brake(
     let beta_min = 0.1 * a_max / v0;
     let beta_max = target / v0;
     let ramp = beta_max / RAMP_S;
+    // The acceleration changes by at most a_max per RAMP_S: braking an accelerating trajectory
+    // swung the command from +0.9 to −0.9 a_max within 0.1 s (the path's own jerk and the
+    // ramp of λ̇ added up) and the quadrotor overshot a_max by 10 %.
+    let jerk_max = a_max / RAMP_S;
 
-    let mut knots: Vec<(f64, [Vec3; 3])> =
-        vec![(0.0, [p_start, v_start, initial_accel.unwrap_or(a_start)])];
-    let (mut u, mut lambda, mut lambda_dot) = (t0, 1.0f64, 0.0f64);
+    let mut accel = a_path + v_start * initial_lambda_dot;
+    if v_start.norm() < accel.norm() * RAMP_S {
+        // Nearly at rest, still accelerating: it would stop within a ramp, dropping its
+        // acceleration at once (a vehicle at 0.04 m/s decelerating at 2.9 m/s² was told to stop
+        // within 14 ms; its attitude swung and it reached 1.8 a_max). Settle instead.
+        return settle(p_start, v_start, accel, t0, a_max, hold_s);
+    }
+    let mut knots: Vec<(f64, [Vec3; 3])> = vec![(0.0, [p_start, v_start, accel])];
+    let (mut u, mut lambda, mut lambda_dot) = (t0, 1.0f64, initial_lambda_dot);
     let steps_per_knot = (KNOT_S / STEP_S).round() as usize;
     let max_steps = (MAX_BRAKE_S / STEP_S) as usize;
     let mut stopped = v_start.norm() < 1e-6;
     let mut step = 0;
     while !stopped && step < max_steps {
-        let [_, dq, ddq] = path.eval(u);
-        let speed = dq.norm().max(1e-9);
-        let beta = ((target - ddq.norm() * lambda * lambda) / speed).clamp(beta_min, beta_max);
-        // Slow enough to bring λ̇ back to 0 exactly when λ reaches 0 at the ramp rate.
-        let wanted = -beta.min((2.0 * ramp * lambda).sqrt());
-        lambda_dot += (wanted - lambda_dot).clamp(-ramp * STEP_S, ramp * STEP_S);
         u += lambda * STEP_S + 0.5 * lambda_dot * STEP_S * STEP_S;
         lambda = (lambda + lambda_dot * STEP_S).max(0.0);
+        let [_, dq, ddq] = path.eval(u);
+        let speed = dq.norm().max(1e-9);
+        // The largest deceleration rate with |q″λ² + q′λ̇| ≤ target: the path's own
+        // acceleration along q′ helps or hinders, the part across it only uses up the budget.
+        let tangent = dq / speed;
+        let a_along = ddq.dot(&tangent) * lambda * lambda;
+        let a_across = (ddq * (lambda * lambda) - tangent * a_along).norm();
+        let exact = (a_along + (target * target - a_across * a_across).max(0.0).sqrt()) / speed;
+        let beta = exact.max(beta_min);
+        // The rate of λ̇ is bounded by the ramp and, where the path is fast, by the jerk limit
+        // (q′λ̈ is the acceleration's change along the path).
+        let ramp_here = ramp.min(TARGET_FRACTION * jerk_max / speed);
+        // Slow enough to bring λ̇ back to 0 exactly when λ reaches 0 at that rate; on the way
+        // back λ̇ may change up to a quarter faster (within the jerk limit), so that it keeps to
+        // that curve (without the slack, where the path sped up, the curve outran λ̇ and the
+        // vehicle stopped dead from 0.2 a_max).
+        let wanted = -beta.min((2.0 * ramp_here * lambda).sqrt());
+        let mut next = lambda_dot
+            + (wanted - lambda_dot).clamp(-ramp_here * STEP_S, 1.25 * ramp_here * STEP_S);
+        // Keep |Δa| ≤ jerk_max·dt where λ̇ can: the λ̇ for which q″λ² + q′λ̇ stays that close
+        // to the last acceleration form an interval (a line through a ball). Never faster along
+        // the path than before or than the ramp asks: where the path's own acceleration falls,
+        // matching it means speeding up along the path — chased, that ran away to 3× the
+        // path's speed. Where no λ̇ matches (the path turns faster), the ramp alone.
+        let free = ddq * (lambda * lambda) - accel;
+        let (g2, cg) = (dq.norm_squared(), free.dot(&dq));
+        let radius = jerk_max * STEP_S;
+        let disc = cg * cg - g2 * (free.norm_squared() - radius * radius);
+        if g2 > 1e-12 && disc >= 0.0 {
+            let half = disc.sqrt();
+            next = next
+                .clamp((-cg - half) / g2, (-cg + half) / g2)
+                .min(lambda_dot.max(next));
+        }
+        lambda_dot = next;
+        accel = ddq * (lambda * lambda) + dq * lambda_dot;
         step += 1;
-        if lambda <= 1e-4 {
+        if lambda <= 1e-6 {
             stopped = true;
         }
         if stopped || step % steps_per_knot == 0 {
-            let [q, dq, ddq] = path.eval(u);
+            let q = path.eval(u)[0];
+            // The stop replaces a knot less than half a spacing before it: a 1 ms last piece
+            // from 0.02 a_max to rest is a jerk of 20 a_max/s.
+            if stopped
+                && knots.len() > 1
+                && step as f64 * STEP_S - knots[knots.len() - 1].0 < 0.5 * KNOT_S
+            {
+                knots.pop();
+            }
             let state = if stopped {
                 [q, Vec3::zeros(), Vec3::zeros()]
             } else {
-                [q, dq * lambda, ddq * (lambda * lambda) + dq * lambda_dot]
+                [q, dq * lambda, accel]
             };
             knots.push((step as f64 * STEP_S, state));
         }
@@ -429,6 +572,151 @@ mod tests {
         let end = b.position(b.t_end());
         assert!(end.y > 3.0 && end.y < 8.0, "{end:?}");
         assert!(b.velocity(b.t_end()).norm() < 1e-9);
+    }
+
+    /// Largest jerk norm over `[t0, t1]`, 2 ms apart.
+    fn max_jerk_between(traj: &PolyTraj, t0: f64, t1: f64) -> f64 {
+        let n = ((t1 - t0) / 2e-3).ceil() as usize;
+        (0..=n)
+            .map(|k| traj.jerk(t0 + (t1 - t0) * k as f64 / n as f64).norm())
+            .fold(0.0, f64::max)
+    }
+
+    /// A dash: from rest to 9 m/s along +x in 1.2 s (a quintic, 14 m/s² at its peak), then
+    /// straight on.
+    fn dash() -> PolyTraj {
+        let start = [Vec3::zeros(), Vec3::zeros(), Vec3::zeros()];
+        let end = [
+            Vec3::new(5.4, 0.0, 0.0),
+            Vec3::new(9.0, 0.0, 0.0),
+            Vec3::zeros(),
+        ];
+        let on = [
+            Vec3::new(14.4, 0.0, 0.0),
+            Vec3::new(9.0, 0.0, 0.0),
+            Vec3::zeros(),
+        ];
+        PolyTraj::new(
+            0.0,
+            vec![1.2, 1.0],
+            vec![
+                hermite_quintic(start, end, 1.2),
+                hermite_quintic(end, on, 1.0),
+            ],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn braking_an_accelerating_trajectory_turns_the_acceleration_round_within_the_jerk_limit() {
+        // Regression: braking a dash while it still accelerated swung the command from +0.9 to
+        // −0.9 a_max within 0.1 s and the quadrotor overshot a_max by 10 %.
+        let a_max = 15.0;
+        let traj = dash();
+        for from in [0.3, 0.5, 0.6, 0.8, 1.0] {
+            let b = brake_along(&traj, from, a_max, 0.5).unwrap();
+            let stop = b.t_end() - 0.5;
+            let jerk = max_jerk_between(&b, from, stop);
+            let (_, a) = b.max_speed_and_acceleration(64);
+            // The knots follow the profile's jerk limit exactly; the quintics between them
+            // overshoot it by up to 60 % (the old braking: 140 a_max/s and more).
+            assert!(jerk <= 2.0 * a_max / RAMP_S, "from {from}: jerk {jerk}");
+            assert!(a <= a_max, "from {from}: accel {a}");
+            assert!(b.velocity(b.t_end()).norm() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn straight_braking_from_a_turn_keeps_the_acceleration_continuous() {
+        let a_max = 3.0;
+        let s = State {
+            t: 1.0,
+            p: Vec3::zeros(),
+            v: Vec3::new(1.0, 0.0, 0.0),
+            a: Vec3::new(2.0, 1.6, 0.0),
+        };
+        let b = brake_straight(&s, a_max, 0.5).unwrap();
+        assert_relative_eq!(b.acceleration(1.0), s.a, epsilon = 1e-9);
+        assert_relative_eq!(b.velocity(1.0), s.v, epsilon = 1e-9);
+        let stop = b.t_end() - 0.5;
+        let jerk = max_jerk_between(&b, 1.0, stop);
+        let (_, a) = b.max_speed_and_acceleration(64);
+        assert!(jerk <= 2.0 * a_max / RAMP_S, "jerk {jerk}");
+        assert!(a <= a_max * 1.001, "accel {a}");
+        assert!(b.velocity(b.t_end()).norm() < 1e-9);
+    }
+
+    #[test]
+    fn braking_never_runs_ahead_of_the_path() {
+        // Regression: keeping the acceleration continuous along a path whose own acceleration
+        // fell meant speeding up along it; chased every step, the braking ran away to 3× the
+        // path's speed (a room with people: the vehicle reached 1.8 m/s at v_max 1 m/s).
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let a_max = 2.7;
+        let mut v3 = |scale: f64| {
+            Vec3::new(
+                rng.random_range(-scale..scale),
+                rng.random_range(-scale..scale),
+                rng.random_range(-scale..scale) * 0.2,
+            )
+        };
+        for _ in 0..200 {
+            let start = [Vec3::zeros(), v3(0.7), v3(1.5)];
+            let end = [v3(1.5), v3(0.7), v3(1.5)];
+            let traj =
+                PolyTraj::new(0.0, vec![1.0], vec![hermite_quintic(start, end, 1.0)]).unwrap();
+            let fastest = (0..=200)
+                .map(|k| traj.velocity(k as f64 / 200.0).norm())
+                .fold(0.0, f64::max);
+            for from in [0.0, 0.3, 0.6] {
+                let b = brake_along(&traj, from, a_max, 0.5).unwrap();
+                let (v, _) = b.max_speed_and_acceleration(64);
+                let reach = fastest + a_max * RAMP_S;
+                assert!(
+                    v <= reach,
+                    "from {from}: {v} m/s on a path of at most {fastest}"
+                );
+                assert!(b.velocity(b.t_end()).norm() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn braking_nearly_at_rest_settles_within_the_jerk_limit() {
+        // Regression: 0.04 m/s while decelerating at 2.9 m/s² was a 14 ms stop.
+        let a_max = 2.7;
+        let s = State {
+            t: 2.3,
+            p: Vec3::new(1.0, 2.0, 1.0),
+            v: Vec3::new(0.04, 0.0, 0.0),
+            a: Vec3::new(-2.6, 0.6, 0.0),
+        };
+        let b = brake_straight(&s, a_max, 0.5).unwrap();
+        assert_relative_eq!(b.acceleration(2.3), s.a, epsilon = 1e-9);
+        let stop = b.t_end() - 0.5;
+        // (Within the limit at the knots; the quintics between overshoot it by up to 60 %.)
+        assert!(max_jerk_between(&b, 2.3, stop) <= 2.0 * a_max / RAMP_S);
+        let (_, a) = b.max_speed_and_acceleration(64);
+        assert!(a <= a_max * 1.001, "{a}");
+        assert!(b.velocity(b.t_end()).norm() < 1e-12);
+        // Along a trajectory that turns round there, the same.
+        let turn = PolyTraj::new(
+            2.3,
+            vec![1.0],
+            vec![hermite_quintic(
+                [s.p, s.v, s.a],
+                [
+                    s.p + Vec3::new(-1.0, 0.3, 0.0),
+                    Vec3::new(-1.0, 0.3, 0.0),
+                    Vec3::zeros(),
+                ],
+                1.0,
+            )],
+        )
+        .unwrap();
+        let b = brake_along(&turn, 2.3, a_max, 0.5).unwrap();
+        assert!(max_jerk_between(&b, 2.3, b.t_end() - 0.5) <= 2.0 * a_max / RAMP_S);
     }
 
     #[test]

@@ -89,7 +89,9 @@ mod report;
 pub mod routing;
 pub mod safety;
 
-pub use brake::{brake_along, brake_straight, dash_maneuvers, escape_maneuvers, hermite_quintic};
+pub use brake::{
+    brake_along, brake_straight, braking_tail, dash_maneuvers, escape_maneuvers, hermite_quintic,
+};
 pub use manager::{Branch, MainDecision, Manager, choose_main};
 pub use params::{ManagerParams, ReanchorParams, SafetyParams};
 pub use progress::{ProgressMonitor, ProgressParams, StallRule};

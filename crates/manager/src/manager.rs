@@ -6,8 +6,8 @@ use rand::SeedableRng;
 use rayon::prelude::*;
 use trust_core::{
     Forecast, GuidePath, HomotopyChecker, InitialGuess, Limits, PathFrontend, PathQuery, PlanError,
-    PolyTraj, RankingWeights, Rng, Scene, Solution, State, TrajRequest, TrajectoryBackend, Vec3,
-    check_finite, check_finite_vec, straight_end,
+    PolyTraj, RankingWeights, Rng, Scene, Solution, State, StaticMap, TrajRequest,
+    TrajectoryBackend, Vec3, check_finite, check_finite_vec, straight_end,
 };
 
 use crate::ManagerParams;
@@ -20,7 +20,7 @@ use crate::report::{
 use crate::safety::{
     SafetyVerdict, assess_trajectory, check_trajectory, forecasts_near, window_bounds,
 };
-use trust_route::GlobalRoute;
+use trust_route::{GlobalRoute, RoutePoint};
 
 use crate::routing::{RouteReason, Router, plan_route};
 
@@ -297,8 +297,9 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
 
     /// Where this cycle's branches aim from `from`: the route's local goal
     /// ([`Manager::set_route`]), or `goal` without a route, near the route's end, or when the
-    /// route cannot be queried.
-    fn aim(&self, from: &Vec3, goal: &Vec3) -> Vec3 {
+    /// route cannot be queried. While `stalled`, the farthest route point before it that is in
+    /// sight from `from` ([`trust_route::GlobalRoute::last_in_sight`]).
+    fn aim(&self, from: &Vec3, goal: &Vec3, stalled: bool, map: &StaticMap) -> Vec3 {
         let Some(route) = &self.route else {
             return *goal;
         };
@@ -306,20 +307,29 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let Ok(s0) = route.progress(from) else {
             return *goal;
         };
-        match route.local_goal_from(s0, horizon_m) {
-            Ok(local) => {
-                // A sharp corner before the local goal is aimed at first (a shaft entrance: the
-                // pieces of a trajectory aimed beyond it cut through the slab). The vehicle is at
-                // the corner once within its clearance of it; then the aim moves on.
-                let at_corner = s0 + route.clearance_m().max(self.params.goal_reached_m);
-                match route.first_sharp_turn(at_corner, local.s, SHARP_TURN_RAD) {
-                    Some(corner) => corner.point,
-                    None if route.length() - local.s > 1e-9 => local.point,
-                    None => *goal,
-                }
-            }
-            Err(_) => *goal,
+        let Ok(local) = route.local_goal_from(s0, horizon_m) else {
+            return *goal;
+        };
+        // A sharp corner before the local goal is aimed at first (a shaft entrance: the pieces
+        // of a trajectory aimed beyond it cut through the slab). The vehicle is at the corner
+        // once within its clearance of it; then the aim moves on.
+        let at_corner = s0 + route.clearance_m().max(self.params.goal_reached_m);
+        let target = match route.first_sharp_turn(at_corner, local.s, SHARP_TURN_RAD) {
+            Some(corner) => corner,
+            None if route.length() - local.s > 1e-9 => local,
+            None => RoutePoint {
+                s: route.length(),
+                point: *goal,
+            },
+        };
+        if !stalled {
+            return target.point;
         }
+        // Stalled: a gentler corner can hide the aim too. An 18 m/s vehicle at rest 62 m before
+        // a building corner turning by 29° aimed 10 m past it along the face, every trajectory
+        // cut the building, and it hovered 15–60 s (holdout, a 900 m trip).
+        let sight = 0.5 * self.params.safety.static_clearance_m;
+        route.last_in_sight(map, from, s0, target, sight).point
     }
 
     /// The route from `from`'s projection on it to the aim ([`Manager::aim`]) as a guide path
@@ -400,7 +410,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         // Algorithm 1, lines 5–8: FwdMarch of the main branch and BwdReplan of the sub-branches,
         // in parallel with FwdExplore.
         let warm = self.warm_branches();
-        let aim = self.aim(&cycle.start.p, goal);
+        let aim = self.aim(&cycle.start.p, goal, cycle.stalled, scene.map);
         let (explored, resolved) = self.solve_in_parallel(&cycle, &aim, scene, &warm, &mut spans);
         if let Some(error) = explored.frontend_error {
             cycle.events.push(Event::FrontendFailed { error });

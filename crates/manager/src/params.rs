@@ -308,7 +308,7 @@ pub struct SafetyParams {
     /// A branch is infeasible if its speed or acceleration exceeds the limits by more than this
     /// fraction. Default 0.1 (the backends' soft penalties overshoot by well under 1 %).
     pub limit_tolerance: f64,
-    /// Also check the straight braking manoeuvre ([`crate::brake_straight`], at 0.9·`a_max`) that
+    /// Also check the straight braking manoeuvre ([`crate::braking_tail`], at 0.9·`a_max`) that
     /// follows a trajectory ending in motion: the vehicle must be able to stop safely after the plan ends. Default `true`
     /// (beyond the paper: UTF-MINCO's free terminal velocity otherwise lets a branch end at full
     /// speed in front of an obstacle).

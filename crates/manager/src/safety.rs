@@ -10,7 +10,7 @@
 //! not only at the samples (up to the `min_step_s` floor near contact, where it samples densely).
 //!
 //! A trajectory that ends moving is also checked for what comes after it: braking straight along
-//! its final velocity ([`crate::brake_straight`], at 0.9·`a_max`) must stay clear ([`SafetyParams::braking_tail`]). A free-terminal
+//! its final velocity ([`crate::braking_tail`], at 0.9·`a_max`) must stay clear ([`SafetyParams::braking_tail`]). A free-terminal
 //! trajectory can otherwise end at full speed just in front of an obstacle, and a vehicle whose
 //! replanning then fails has nowhere to go.
 
@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 use trust_core::{Aabb, Forecast, Limits, Piece, PolyTraj, Scene, State, Vec3, bernstein_points};
 
 use crate::SafetyParams;
-use crate::brake::brake_straight;
+use crate::brake::braking_tail;
 
 /// What the clearance was violated against.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -66,7 +66,7 @@ pub struct SafetyVerdict {
     /// Speed or acceleration above the limits by more than the tolerance.
     pub over_limits: bool,
     /// The trajectory itself was clear but what follows its end would not be: stopping
-    /// (straight braking, [`crate::brake_straight`], at 0.9·`a_max`;
+    /// (straight braking, [`crate::braking_tail`], at 0.9·`a_max`;
     /// [`SafetyParams::braking_tail`]) or then staying at rest for
     /// [`SafetyParams::rest_hold_s`].
     pub braking_tail_violated: bool,
@@ -238,7 +238,7 @@ fn check(
             return verdict;
         }
         if (verdict.violation.is_none() || full)
-            && let Ok(tail) = brake_straight(&rest, limits.a_max, params.min_step_s)
+            && let Ok(tail) = braking_tail(&rest, limits.a_max, params.min_step_s)
         {
             let t = check_window(
                 &tail,
@@ -266,7 +266,7 @@ fn check(
     if params.rest_hold_s > 0.0
         && end_speed <= REST_SPEED_FRACTION * limits.v_max
         && (verdict.violation.is_none() || full)
-        && let Ok(hold) = brake_straight(&rest, limits.a_max, params.rest_hold_s)
+        && let Ok(hold) = braking_tail(&rest, limits.a_max, params.rest_hold_s)
     {
         let held: Vec<Forecast> = scene
             .forecasts

@@ -1,9 +1,9 @@
 //! The backend's braking-tail penalty models the manoeuvre the safety check requires to be clear
-//! (`brake_straight`); if the two drift apart, the optimizer clears a tail the check does not
+//! (`braking_tail`); if the two drift apart, the optimizer clears a tail the check does not
 //! accept (or the reverse), and candidates are dropped by millimetres.
 
 use trust_core::{State, Vec3};
-use trust_manager::brake_straight;
+use trust_manager::braking_tail;
 use trust_minco::PenaltyParams;
 
 /// Distance travelled by the penalty's model at `t` after the end: coasting for the delay, then
@@ -30,7 +30,7 @@ fn the_backends_braking_tail_model_matches_the_braking_manoeuvre() {
                 v: Vec3::new(v, 0.0, 0.0),
                 a: Vec3::new(a, 0.0, 0.0),
             };
-            let brake = brake_straight(&start, a_max, 0.5).expect("brake");
+            let brake = braking_tail(&start, a_max, 0.5).expect("brake");
             let mut worst: f64 = 0.0;
             let mut t = 0.0;
             while t <= brake.t_end() {

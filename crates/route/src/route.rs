@@ -319,6 +319,71 @@ impl GlobalRoute {
         })
     }
 
+    /// The farthest point of the route from arc length `from_s` up to `to` that a straight line
+    /// from `position` reaches clear of `map` at `clearance_m`: the route's vertices in order
+    /// while each is in sight, then a bisection (12 halvings) on the route between the last one
+    /// in sight and the next. `to` itself when it is in sight, or when not even the route's point
+    /// at `from_s` is (the vehicle is off its route: nothing better to aim at). For a vehicle that
+    /// stalls in front of a route corner: an aim beyond the corner puts the building between the
+    /// vehicle and its aim, and every trajectory pulled straight at it cuts the corner.
+    pub fn last_in_sight(
+        &self,
+        map: &StaticMap,
+        position: &Vec3,
+        from_s: f64,
+        to: RoutePoint,
+        clearance_m: f64,
+    ) -> RoutePoint {
+        let seen = |p: &Vec3| map.segment_clear(position, p, clearance_m);
+        if seen(&to.point) {
+            return to;
+        }
+        let s0 = if from_s.is_nan() {
+            0.0
+        } else {
+            from_s.clamp(0.0, self.length())
+        };
+        let mut lo = RoutePoint {
+            s: s0,
+            point: self.point_at(s0),
+        };
+        if !seen(&lo.point) {
+            return to;
+        }
+        let mut hi = to;
+        for i in 1..self.points.len() {
+            if self.cum[i] <= s0 {
+                continue;
+            }
+            if self.cum[i] >= to.s {
+                break;
+            }
+            let vertex = RoutePoint {
+                s: self.cum[i],
+                point: self.points[i],
+            };
+            if seen(&vertex.point) {
+                lo = vertex;
+            } else {
+                hi = vertex;
+                break;
+            }
+        }
+        for _ in 0..12 {
+            let s = 0.5 * (lo.s + hi.s);
+            let mid = RoutePoint {
+                s,
+                point: self.point_at(s),
+            };
+            if seen(&mid.point) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    }
+
     /// The first segment, from arc length `from_s` on, that is no longer clear at `clearance_m`
     /// on `map` (e.g. a re-check after the map was updated, to decide a re-route), or `None`.
     /// Only the part of each segment after `from_s` is checked, so a vehicle that has passed a

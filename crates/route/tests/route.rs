@@ -321,6 +321,43 @@ fn a_route_reports_a_new_obstacle_only_ahead_of_the_vehicle() {
     assert!(!r.is_blocked(&later, 0.45, 25.0).unwrap());
 }
 
+#[test]
+fn the_aim_in_sight_stops_at_the_corner_a_building_hides_the_rest_behind() {
+    // Holdout: an 18 m/s vehicle 62 m before a building corner where its route turns by 29°
+    // aimed 10 m past the corner along the face, with the building in the way.
+    let map = StaticMap::from_shapes(
+        bounds([200.0, 160.0, 70.0]),
+        vec![aabox([60.0, 52.0, 0.0], [92.0, 108.0, 36.0])],
+    )
+    .unwrap();
+    let start = Vec3::new(5.0, 80.0, 15.0);
+    let corner = Vec3::new(60.0, 49.0, 15.0);
+    let route = GlobalRoute::from_points(vec![start, corner, Vec3::new(93.0, 49.0, 15.0)]).unwrap();
+    let local = route.local_goal(&start, 72.0).unwrap();
+    assert!(
+        local.s > (corner - start).norm(),
+        "the local goal is past the corner"
+    );
+    assert!(
+        !map.segment_clear(&start, &local.point, 0.2),
+        "and hidden by the building"
+    );
+    let seen = route.last_in_sight(&map, &start, 0.0, local, 0.2);
+    assert!(map.segment_clear(&start, &seen.point, 0.2));
+    // At the corner or a little past it (the face is in sight up to the building's edge).
+    assert!(
+        seen.s >= (corner - start).norm() - 1e-9 && seen.s < local.s,
+        "{seen:?}"
+    );
+    assert!((seen.point - route.point_at(seen.s)).norm() < 1e-9);
+    // An aim in sight is kept; an aim from off the route (the projection hidden) too.
+    let near = route.local_goal(&start, 40.0).unwrap();
+    assert_eq!(route.last_in_sight(&map, &start, 0.0, near, 0.2), near);
+    let inside = Vec3::new(70.0, 80.0, 15.0);
+    let far = route.local_goal(&inside, 72.0).unwrap();
+    assert_eq!(route.last_in_sight(&map, &inside, 0.0, far, 0.2), far);
+}
+
 /// A random map of full-height pillars and boxes in a `size` world, start and goal kept free.
 fn random_map(seed: u64, size: [f64; 3], count: usize, r: f64) -> (StaticMap, Vec3, Vec3) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);

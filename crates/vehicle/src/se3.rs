@@ -87,8 +87,11 @@ pub struct Se3Gains {
     /// force minus gravity), scaled down to it keeping the direction: the vehicle's acceleration
     /// limit, as a flight stack enforces it (our addition). A jerky reference otherwise makes the
     /// feedback push the vehicle beyond its limit while the attitude catches up (up to 1.2
-    /// `a_max` in the rooms with people). Default `None` (no cap); the closed loop
-    /// (`trust-flight`) sets it to the scenario's `a_max` when a scenario leaves it out.
+    /// `a_max` in the rooms with people). The thrust along the actual body axis is capped too,
+    /// so that an attitude lagging the command does not carry the vehicle past it (within
+    /// `asin(cap/g)` of tilt; measured in `crates/flight/tests/accel_headroom.rs`). Default
+    /// `None` (no cap); the closed loop (`trust-flight`) sets it to the scenario's `a_max` when a
+    /// scenario leaves it out.
     #[serde(default)]
     pub max_accel_m_s2: Option<f64>,
 }
@@ -170,7 +173,16 @@ impl Se3Controller {
         let force = accel + Vec3::z() * self.gravity_m_s2;
         let desired = desired_frame(&force, &r.j, r.yaw, &rot);
 
-        let thrust = self.mass_kg * force.dot(&rot.column(2));
+        let mut thrust = self.mass_kg * force.dot(&rot.column(2));
+        if let Some(cap) = k.max_accel_m_s2 {
+            thrust = self.mass_kg
+                * specific_thrust_within(
+                    thrust / self.mass_kg,
+                    rot[(2, 2)],
+                    self.gravity_m_s2,
+                    cap,
+                );
+        }
         // R_dᵀ R; its transpose is Rᵀ R_d.
         let rd_t_r = desired.rotation.transpose() * rot;
         let e_r = 0.5 * vee(&(rd_t_r - rd_t_r.transpose()));
@@ -276,6 +288,26 @@ pub fn flat_attitude(
 
 /// `v` scaled down to norm `max` if it is longer; a finite `v` whose norm overflows keeps its
 /// direction, a non-finite `v` stays non-finite.
+/// The specific thrust `τ` (m/s²) nearest `wanted` for which the body's acceleration
+/// `τ·b₃ − g·e₃` has a norm of at most `cap`, with `cos_tilt = b₃·e₃`: `|τb₃ − ge₃|² = τ² −
+/// 2gτ·cos_tilt + g²`, so `τ` must lie within `g·cos_tilt ± √(cap² − g²·sin²tilt)`; tilted beyond
+/// `asin(cap/g)` no thrust does, and the one with the least acceleration, `g·cos_tilt`, is taken.
+///
+/// The commanded acceleration is capped before the attitude is chosen, but while the attitude
+/// lags a quick swing of the command (braking, dodging) the thrust along the actual body axis
+/// accelerates the vehicle beyond it: 3° more tilt at 3 m/s² is 3.5 m/s² (1.065 `a_max` in the
+/// suite's penetration flight). Capping the thrust closes that gap.
+fn specific_thrust_within(wanted: f64, cos_tilt: f64, g: f64, cap: f64) -> f64 {
+    let sin2 = (1.0 - cos_tilt * cos_tilt).max(0.0);
+    let disc = cap * cap - g * g * sin2;
+    let mid = g * cos_tilt;
+    if disc < 0.0 {
+        return mid.max(0.0);
+    }
+    let half = disc.sqrt();
+    wanted.clamp((mid - half).max(0.0), (mid + half).max(0.0))
+}
+
 fn clamp_norm(v: Vec3, max: f64) -> Vec3 {
     let n = v.norm();
     if n <= max {
@@ -419,5 +451,32 @@ mod tests {
                 .to_string()
                 .contains("max_feedback_m_s2")
         );
+    }
+    #[test]
+    fn the_thrust_cap_keeps_the_bodys_acceleration_within_the_cap() {
+        let g = 9.81;
+        let cap = 3.0;
+        let accel = |tau: f64, tilt: f64| {
+            let b3 = Vec3::new(tilt.sin(), 0.0, tilt.cos());
+            (b3 * tau - Vec3::z() * g).norm()
+        };
+        for tilt_deg in [0.0_f64, 5.0, 10.0, 15.0, 17.0] {
+            let tilt = tilt_deg.to_radians();
+            for wanted in [0.0, 5.0, 9.0, 9.81, 11.0, 13.0, 20.0] {
+                let tau = specific_thrust_within(wanted, tilt.cos(), g, cap);
+                assert!(
+                    accel(tau, tilt) <= cap + 1e-9,
+                    "tilt {tilt_deg}°, {wanted}: {tau}"
+                );
+                if accel(wanted, tilt) <= cap {
+                    assert!((tau - wanted).abs() < 1e-12, "an allowed thrust is kept");
+                }
+            }
+        }
+        // Tilted beyond asin(cap/g) = 17.8°: the least acceleration, g·sin(tilt).
+        let tilt = 20.0_f64.to_radians();
+        let tau = specific_thrust_within(12.0, tilt.cos(), g, cap);
+        assert!((tau - g * tilt.cos()).abs() < 1e-12);
+        assert!((accel(tau, tilt) - g * tilt.sin()).abs() < 1e-9);
     }
 }
