@@ -570,7 +570,7 @@ mod tests {
     #[test]
     fn a_stop_that_an_obstacle_reaches_soon_after_the_end_is_unsafe() {
         // At rest at the origin for 2 s; a ball walking at it reaches it at t = 2.25 s, within
-        // the default 1 s rest hold and after the trajectory's end.
+        // the default 0.5 s rest hold and after the trajectory's end.
         let m = map(vec![]);
         let ball = Forecast::new(
             ObstacleShape::Sphere,
