@@ -56,7 +56,7 @@ mod forecast;
 pub mod pdc;
 mod walls;
 
-pub use ekf::{CvEkf, EkfParams, MAX_ACCEL_PSD, MAX_SIGMA_SCALE};
+pub use ekf::{CHI2_3_95, CvEkf, EkfParams, MAX_ACCEL_PSD, MAX_MANOEUVRE_GATE, MAX_SIGMA_SCALE};
 pub use error::PredictError;
 pub use forecast::{Forecast, ObstacleShape};
 pub use pdc::{CLEAR_TOLERANCE, Pdc, frame_along, round_cone_sdf};

@@ -2,8 +2,8 @@
 //! f64, each named after the bug.
 
 use trust_predict::{
-    Aabb, CvEkf, EkfParams, Forecast, MAX_ACCEL_PSD, MAX_SIGMA_SCALE, ObstacleShape, Pdc,
-    PredictError, Vec3, convex, round_cone_sdf,
+    Aabb, CvEkf, EkfParams, Forecast, MAX_ACCEL_PSD, MAX_MANOEUVRE_GATE, MAX_SIGMA_SCALE,
+    ObstacleShape, Pdc, PredictError, Vec3, convex, round_cone_sdf,
 };
 
 #[test]
@@ -173,7 +173,10 @@ fn ekf_at_the_edges_of_its_accepted_params_forecasts_or_names_its_params() {
     for meas_std in corners(1e-9, 1e6) {
         for accel_psd in corners(0.0, MAX_ACCEL_PSD) {
             for init_vel_std in corners(1e-9, 1e4) {
-                for sigma_scale in corners(0.0, MAX_SIGMA_SCALE) {
+                for (sigma_scale, manoeuvre_gate) in corners(0.0, MAX_SIGMA_SCALE)
+                    .into_iter()
+                    .zip([1e-9, MAX_MANOEUVRE_GATE])
+                {
                     let params = EkfParams {
                         meas_std,
                         accel_psd,
@@ -181,6 +184,7 @@ fn ekf_at_the_edges_of_its_accepted_params_forecasts_or_names_its_params() {
                         sigma_scale,
                         mu_min: 1e4,
                         inflate_by_position_std: true,
+                        manoeuvre_gate,
                     };
                     let mut ekf = CvEkf::new(0.0, Vec3::zeros(), params).unwrap();
                     for k in 1..=10 {
