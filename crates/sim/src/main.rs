@@ -554,7 +554,7 @@ fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
     }
     let o = &summary.outcome;
     println!(
-        "{}: {}{} at t = {:.2} s; path {:.1} m; min clearance static {:.2} m, moving {:.2} m; \
+        "{}: {}{} at t = {:.2} s; path {:.1} m; min clearance static {}, moving {}; \
          max speed {:.2} m/s, max accel {:.2} m/s²",
         planner.label,
         o.status.as_str(),
@@ -564,8 +564,8 @@ fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
             .unwrap_or_default(),
         o.t,
         o.path_length_m,
-        o.min_clearance_static_m,
-        o.min_clearance_dynamic_m,
+        clearance_text(o.min_clearance_static_m),
+        clearance_text(o.min_clearance_dynamic_m),
         o.max_speed,
         o.max_accel
     );
@@ -584,4 +584,14 @@ fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
         write_replay_files(&log_path, out, &trust_replay::ReplayParams::default())?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// A minimum clearance for the console: "none met" when there was nothing of that kind to meet
+/// (the outcome's `trust_flight::NO_OBSTACLE_CLEARANCE_M` sentinel), else metres.
+fn clearance_text(m: f64) -> String {
+    if m >= trust_flight::NO_OBSTACLE_CLEARANCE_M {
+        "– (none met)".to_string()
+    } else {
+        format!("{m:.2} m")
+    }
 }
