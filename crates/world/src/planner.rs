@@ -501,6 +501,9 @@ pub struct ManagerOverrides {
     /// Replaces `ManagerParams::progress` (fields not given take their defaults).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub progress: Option<ProgressParams>,
+    /// Replaces `ManagerParams::wall_images`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wall_images: Option<bool>,
 }
 
 impl ManagerOverrides {
@@ -552,6 +555,9 @@ impl ManagerOverrides {
         }
         if let Some(v) = self.progress {
             p.progress = v;
+        }
+        if let Some(v) = self.wall_images {
+            p.wall_images = v;
         }
         if let Some(v) = self.cycle_budget_ms {
             p.cycle_budget_ms = v;
@@ -620,6 +626,9 @@ pub struct SafetyOverrides {
     /// Replaces `SafetyParams::braking_tail`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub braking_tail: Option<bool>,
+    /// Replaces `SafetyParams::rest_hold_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rest_hold_s: Option<f64>,
 }
 
 impl SafetyOverrides {
@@ -642,6 +651,9 @@ impl SafetyOverrides {
         }
         if let Some(v) = self.braking_tail {
             p.braking_tail = v;
+        }
+        if let Some(v) = self.rest_hold_s {
+            p.rest_hold_s = v;
         }
     }
 }
@@ -1073,11 +1085,13 @@ mod tests {
     #[test]
     fn manager_overrides_merge_onto_the_preset() {
         let spec: PlannerSpec =
-            toml::from_str("name = \"baseline1\"\n[manager]\nhorizon_s = 3.0\n[manager.safety]\nmax_step_s = 0.02\n")
+            toml::from_str("name = \"baseline1\"\n[manager]\nhorizon_s = 3.0\nwall_images = false\n[manager.safety]\nmax_step_s = 0.02\nrest_hold_s = 1.5\n")
                 .unwrap();
         let r = spec.resolve();
         assert_eq!(r.manager.max_branches, 1);
         assert_eq!(r.manager.horizon_s, 3.0);
+        assert!(!r.manager.wall_images);
+        assert_eq!(r.manager.safety.rest_hold_s, 1.5);
         assert_eq!(r.manager.safety.max_step_s, 0.02);
         assert_eq!(r.manager.safety.min_step_s, 1e-3);
         assert_eq!(r.label, "baseline1[manager]");
