@@ -86,17 +86,23 @@ pub struct SuiteRow {
     pub fallbacks: usize,
     /// The run log, relative to the output folder.
     pub log: String,
+    /// For a collision with a moving obstacle: how long the planner's forecasts had the obstacle
+    /// where it hit (s; `trust_runlog::Outcome::forecast_warning_s`); empty otherwise.
+    pub forecast_warning_s: Option<f64>,
+    /// The vehicle's `v_max` (m/s).
+    pub v_max: f64,
 }
 
 impl SuiteRow {
     const COLUMNS: &'static str = "class,planner,seed,status,with,flight_time_s,distance_m,\
                                    ideal_time_s,path_length_m,min_clearance_static_m,\
-                                   min_clearance_dynamic_m,max_accel,a_max,fallbacks,log";
+                                   min_clearance_dynamic_m,max_accel,a_max,fallbacks,log,\
+                                   forecast_warning_s,v_max";
 
     fn to_line(&self) -> String {
         let clean = |s: &str| s.replace([',', '\n', '\r', '"'], ";");
         format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             clean(&self.class),
             clean(&self.planner),
             self.seed,
@@ -112,6 +118,9 @@ impl SuiteRow {
             self.a_max,
             self.fallbacks,
             clean(&self.log),
+            self.forecast_warning_s
+                .map_or(String::new(), |w| w.to_string()),
+            self.v_max,
         )
     }
 }
@@ -300,7 +309,7 @@ pub fn run_suite(
     write_text(&out.join("runs.csv"), &csv)?;
     let summary = summarize(&rows);
     write_json(&out.join("summary.json"), &summary)?;
-    write_text(&out.join("report.md"), &report(config, &summary))?;
+    write_text(&out.join("report.md"), &report(config, &summary, &rows))?;
     if !options.no_plots {
         outcome_chart(&summary)
             .write(out, "outcomes")
@@ -366,6 +375,8 @@ fn fly_one(class: &str, s: &Scenario, out: &Path) -> Result<SuiteRow, Experiment
         a_max: limits.a_max,
         fallbacks: sm.fallback_count,
         log: rel,
+        forecast_warning_s: o.forecast_warning_s,
+        v_max: limits.v_max,
     })
 }
 
@@ -416,7 +427,7 @@ pub fn summarize(rows: &[SuiteRow]) -> Vec<ClassSummary> {
 }
 
 /// `report.md`: the totals, then one table per class.
-fn report(config: &SuiteConfig, summary: &[ClassSummary]) -> String {
+fn report(config: &SuiteConfig, summary: &[ClassSummary], rows: &[SuiteRow]) -> String {
     let opt = |x: Option<f64>, d: usize| x.map_or("–".to_string(), |v| format!("{v:.d$}"));
     let mut s = String::from("# Scenario suite\n\n");
     s.push_str(&format!(
@@ -477,6 +488,31 @@ fn report(config: &SuiteConfig, summary: &[ClassSummary]) -> String {
             s.push('\n');
         }
     }
+    let collisions: Vec<&SuiteRow> = rows.iter().filter(|r| r.status == "collided").collect();
+    if !collisions.is_empty() {
+        s.push_str(
+            "## Collisions
+
+For a moving obstacle, how long before contact every forecast the \
+             planner got (with its wall images) had the obstacle where it hit — 0 s: it outran \
+             its forecast — beside the time to stop from `v_max` (`v_max / a_max`).\n\n\
+             | class | planner | seed | t (s) | with | in its forecasts for (s) | stop from v_max (s) |\n\
+             |---|---|---|---|---|---|---|\n",
+        );
+        for r in collisions {
+            s.push_str(&format!(
+                "| {} | {} | {} | {:.2} | {} | {} | {:.2} |\n",
+                r.class,
+                r.planner,
+                r.seed,
+                r.flight_time_s,
+                r.with,
+                opt(r.forecast_warning_s, 2),
+                r.v_max / r.a_max,
+            ));
+        }
+        s.push('\n');
+    }
     s
 }
 
@@ -523,7 +559,11 @@ mod tests {
             planner: "trust".into(),
             seed: 0,
             status: status.into(),
-            with: String::new(),
+            with: if status == "collided" {
+                "obstacle:0".into()
+            } else {
+                String::new()
+            },
             flight_time_s: t,
             distance_m: 10.0,
             ideal_time_s: 5.0,
@@ -534,6 +574,8 @@ mod tests {
             a_max: 3.0,
             fallbacks: 0,
             log: String::new(),
+            forecast_warning_s: (status == "collided").then_some(1.25),
+            v_max: 1.0,
         }
     }
 
@@ -562,8 +604,13 @@ mod tests {
                 time_limit_s: None,
             },
             &s,
+            &rows,
         );
         assert!(md.contains("## a\n") && md.contains("## b\n"), "{md}");
+        assert!(
+            md.contains("| a | trust | 0 | 3.00 | obstacle:0 | 1.25 | 0.33 |"),
+            "{md}"
+        );
         assert!(
             md.contains("4 flights — 2 arrived, 1 collided, 1 timed out"),
             "{md}"

@@ -99,6 +99,7 @@ fn log() -> RunLog {
             with: None,
             reason: None,
             cycle_count: 0,
+            forecast_warning_s: None,
         },
     }
 }

@@ -395,12 +395,28 @@ pub fn fly(
     let mut ended: Option<(Status, Option<String>, Option<String>)> = None;
     let mut next_progress = options.progress_every_s.unwrap_or(f64::INFINITY);
     let mut next_plan_snapshot = 0.0;
+    // The forecasts given to the planner over the last two horizons, by obstacle id, newest
+    // last: a collision's outcome says how long they had the obstacle where it hit.
+    let mut given: std::collections::VecDeque<(f64, Vec<(usize, Forecast)>)> =
+        std::collections::VecDeque::new();
+    let remember_s = 2.0 * planner.manager.horizon_s;
     let mut step = 0u64;
     let mut t = 0.0;
     while ended.is_none() {
         // Plan.
         if step.is_multiple_of(replan_steps) {
             let forecasts = sensing.forecasts(t)?;
+            given.push_back((
+                t,
+                sensing
+                    .tracked_ids()
+                    .into_iter()
+                    .zip(forecasts.iter().copied())
+                    .collect(),
+            ));
+            while given.front().is_some_and(|(tk, _)| *tk < t - remember_s) {
+                given.pop_front();
+            }
             let scene = Scene::new(world.planner_map(), &forecasts, t)?;
             let measured = vehicle.state().kinematic();
             let cycle_start = Instant::now();
@@ -496,6 +512,21 @@ pub fn fly(
         tally,
     } = log;
     let (status, with, reason) = ended.unwrap_or((Status::Invalid, None, None));
+    let forecast_warning_s = with
+        .as_deref()
+        .and_then(|w| w.strip_prefix("obstacle:"))
+        .and_then(|id| id.parse::<usize>().ok())
+        .and_then(|id| {
+            let centre = traffic.positions().get(id).copied()?;
+            Some(forecast_warning(
+                &given,
+                id,
+                &centre,
+                t,
+                radius,
+                world.planner_map().bounds(),
+            ))
+        });
     let outcome = Outcome {
         status,
         t,
@@ -508,6 +539,7 @@ pub fn fly(
         with,
         reason,
         cycle_count: record.cycles.len(),
+        forecast_warning_s,
     };
     if let Some(mut w) = writer {
         w.write(&Record::Outcome(outcome.clone()))?;
@@ -657,6 +689,36 @@ fn branch_samples(manager: &AnyManager) -> Vec<BranchSamples> {
 
 /// The cycle's forecasts as the log records them; `ids[i]` is the obstacle of `forecasts[i]`
 /// (`trust_world::sensing::Sensing::tracked_ids`).
+/// How long before `t_contact` the forecasts of obstacle `id` in `given` (time, forecasts by
+/// id; oldest first) have all had its true centre `centre` at contact within their uncertainty
+/// (`inflation − vehicle radius`), counting their wall images ([`Outcome::forecast_warning_s`]).
+fn forecast_warning(
+    given: &std::collections::VecDeque<(f64, Vec<(usize, Forecast)>)>,
+    id: usize,
+    centre: &Vec3,
+    t_contact: f64,
+    vehicle_radius: f64,
+    walls: &trust_predict::Aabb,
+) -> f64 {
+    let holds = |f: &Forecast| {
+        let within = |g: &Forecast| {
+            (centre - g.center(t_contact)).norm() <= g.inflation(t_contact) - vehicle_radius
+        };
+        within(f)
+            || trust_predict::wall_images(f, walls, f.t0, t_contact)
+                .iter()
+                .any(within)
+    };
+    let mut since = t_contact;
+    for (tk, forecasts) in given.iter().rev() {
+        match forecasts.iter().find(|(i, _)| *i == id) {
+            Some((_, f)) if holds(f) => since = *tk,
+            _ => break,
+        }
+    }
+    t_contact - since
+}
+
 fn forecast_records(ids: &[usize], forecasts: &[Forecast]) -> Vec<ForecastRecord> {
     ids.iter()
         .zip(forecasts)
@@ -697,4 +759,109 @@ fn dropped(report: &StepReport) -> Dropped {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::VecDeque;
+    use trust_predict::Aabb;
+
+    /// A ball (radius 0.2 m, `r_safe` 0.3 m for a 0.1 m vehicle, growth 0.5 m/s) forecast at
+    /// every 0.1 s from `t0 = 0` on, walking +x at 1 m/s from x = 1 (forecast velocity `v`).
+    fn given(v: f64, until: f64) -> VecDeque<(f64, Vec<(usize, Forecast)>)> {
+        (0..=(until * 10.0).round() as usize)
+            .map(|k| {
+                let t = k as f64 * 0.1;
+                let f = Forecast::new(
+                    ObstacleShape::Sphere,
+                    Vec3::new(1.0 + t, 5.0, 5.0),
+                    Vec3::new(v, 0.0, 0.0),
+                    t,
+                    0.2,
+                    0.3,
+                    0.5,
+                )
+                .unwrap();
+                (t, vec![(3, f)])
+            })
+            .collect()
+    }
+
+    fn walls() -> Aabb {
+        Aabb::new(Vec3::zeros(), Vec3::new(100.0, 10.0, 10.0)).unwrap()
+    }
+
+    #[test]
+    fn a_forecast_that_held_gives_the_whole_history_as_warning() {
+        // The ball walks as forecast: at contact (t = 2, x = 3) every forecast had it.
+        let w = forecast_warning(
+            &given(1.0, 2.0),
+            3,
+            &Vec3::new(3.0, 5.0, 5.0),
+            2.0,
+            0.1,
+            &walls(),
+        );
+        assert!((w - 2.0).abs() < 1e-9, "{w}");
+    }
+
+    #[test]
+    fn an_obstacle_outside_its_last_forecast_gives_no_warning() {
+        // Forecast standing still, true ball 2 m away from the last forecast's centre.
+        let w = forecast_warning(
+            &given(0.0, 2.0),
+            3,
+            &Vec3::new(5.0, 5.0, 5.0),
+            2.0,
+            0.1,
+            &walls(),
+        );
+        assert_eq!(w, 0.0);
+        // Another obstacle's id: no forecast of it, no warning.
+        let w = forecast_warning(
+            &given(1.0, 2.0),
+            4,
+            &Vec3::new(3.0, 5.0, 5.0),
+            2.0,
+            0.1,
+            &walls(),
+        );
+        assert_eq!(w, 0.0);
+    }
+
+    #[test]
+    fn the_warning_counts_only_the_forecasts_that_had_it() {
+        // Forecasts standing still: the one issued at t_k misses the ball at contact by
+        // 2 − t_k against an uncertainty 0.2 + 0.5·(2 − t_k), so only those from t_k = 1.6 on
+        // have it.
+        let w = forecast_warning(
+            &given(0.0, 2.0),
+            3,
+            &Vec3::new(3.0, 5.0, 5.0),
+            2.0,
+            0.1,
+            &walls(),
+        );
+        assert!((w - 0.4).abs() < 1e-9, "{w}");
+    }
+
+    #[test]
+    fn a_forecast_reflected_at_a_wall_counts_by_its_image() {
+        // The last forecast (t = 1.5, at x = 2.5) says the ball keeps walking +x; the true ball
+        // turns at the wall x = 4 (its centre at 3.8) and is 2.5 s later where only the mirror
+        // image of the forecast is.
+        let walls = Aabb::new(Vec3::zeros(), Vec3::new(4.0, 10.0, 10.0)).unwrap();
+        let mut g = given(1.0, 1.5);
+        g.retain(|(t, _)| *t >= 1.5);
+        let t_c = 4.0;
+        let straight = 2.5 + (t_c - 1.5);
+        let reflected = 2.0 * (4.0 - 0.2) - straight;
+        let w = forecast_warning(&g, 3, &Vec3::new(reflected, 5.0, 5.0), t_c, 0.1, &walls);
+        assert!((w - 2.5).abs() < 1e-9, "{w}");
+        // Without the walls in the way, the same point is far outside the forecast.
+        let open = Aabb::new(Vec3::zeros(), Vec3::new(100.0, 10.0, 10.0)).unwrap();
+        let w = forecast_warning(&g, 3, &Vec3::new(reflected, 5.0, 5.0), t_c, 0.1, &open);
+        assert_eq!(w, 0.0);
+    }
 }

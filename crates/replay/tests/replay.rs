@@ -177,6 +177,7 @@ fn write_log(path: &Path, t_end: f64, with_branches: bool) {
         with: None,
         reason: None,
         cycle_count: steps / 5,
+        forecast_warning_s: None,
     }))
     .unwrap();
     w.finish().unwrap();

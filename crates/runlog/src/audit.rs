@@ -464,6 +464,7 @@ mod tests {
             with: with.map(str::to_string),
             reason: None,
             cycle_count: 0,
+            forecast_warning_s: None,
         };
         let corner = 0.3f64.hypot(0.3) - 0.3;
         let log = RunLog {

@@ -366,6 +366,14 @@ pub struct Outcome {
     /// Added: planning cycles run.
     #[serde(default)]
     pub cycle_count: usize,
+    /// Added, only for a collision with a moving obstacle: how long before contact the forecasts
+    /// the planner was given (with their mirror images at the map's walls) already had the
+    /// obstacle where it was at contact (s) — every forecast of that obstacle issued since then
+    /// had its true centre within the forecast's uncertainty (`r_safe` less the vehicle radius,
+    /// plus the growth). 0 when even the last forecast before contact missed it: the obstacle
+    /// outran its forecast. Compare with the time the vehicle needs to stop (`v/a_max`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub forecast_warning_s: Option<f64>,
 }
 
 /// One line of a run log.
@@ -742,6 +750,7 @@ mod tests {
             with: Some("static".into()),
             reason: None,
             cycle_count: 10,
+            forecast_warning_s: None,
         });
         let json = serde_json::to_value(outcome).unwrap();
         assert_eq!(json["status"], "collided");
@@ -888,6 +897,7 @@ mod tests {
             with: None,
             reason: None,
             cycle_count: 0,
+            forecast_warning_s: None,
         };
         w.write(&Record::Outcome(outcome.clone())).unwrap();
         w.finish().unwrap();

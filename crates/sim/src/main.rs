@@ -229,6 +229,29 @@ enum Model {
     Perfect,
 }
 
+/// `println!` that ends the program quietly when standard output is closed (`trust-sim … |
+/// head`) instead of panicking; any other write error ends it with a message and code 1.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        emit(format_args!($($arg)*))
+    };
+}
+
+fn emit(args: std::fmt::Arguments<'_>) {
+    use std::io::Write as _;
+    let mut stdout = std::io::stdout().lock();
+    if let Err(e) = stdout
+        .write_fmt(args)
+        .and_then(|()| stdout.write_all(b"\n"))
+    {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("error: writing to standard output: {e}");
+        std::process::exit(1);
+    }
+}
+
 fn main() -> ExitCode {
     match run_cli() {
         Ok(code) => code,
@@ -384,8 +407,8 @@ fn run_cli() -> Result<ExitCode> {
             let rows = run_suite(&config, &out, &options)?;
             let report = std::fs::read_to_string(out.join("report.md"))
                 .with_context(|| format!("reading {}", out.join("report.md").display()))?;
-            println!("{report}");
-            println!("wrote {} ({} flights)", out.display(), rows.len());
+            out!("{report}");
+            out!("wrote {} ({} flights)", out.display(), rows.len());
             let bad = rows
                 .iter()
                 .filter(|r| r.status == "collided" || r.status == "invalid")
@@ -407,8 +430,8 @@ fn run_cli() -> Result<ExitCode> {
                 s = s.with_seed(seed);
             }
             let summary = trust_experiments::e3::run_e3(&s, &out)?;
-            println!("{}", trust_experiments::e3::report_md(&summary));
-            println!("wrote {}", out.display());
+            out!("{}", trust_experiments::e3::report_md(&summary));
+            out!("wrote {}", out.display());
             Ok(ExitCode::SUCCESS)
         }
         Cmd::AblateMerge {
@@ -423,10 +446,10 @@ fn run_cli() -> Result<ExitCode> {
             let mut bad = 0;
             for path in &scenarios {
                 match trust_world::load_checked(path) {
-                    Ok(_) => println!("{}: ok", path.display()),
+                    Ok(_) => out!("{}: ok", path.display()),
                     Err(e) => {
                         bad += 1;
-                        println!("{e}");
+                        out!("{e}");
                     }
                 }
             }
@@ -443,7 +466,7 @@ fn run_cli() -> Result<ExitCode> {
                 let dir = path.parent().unwrap_or(Path::new("."));
                 let a = audit(&log, dir).map_err(anyhow::Error::msg)?;
                 if a.passed() {
-                    println!(
+                    out!(
                         "{}: ok ({}, {} states)",
                         path.display(),
                         log.outcome.status.as_str(),
@@ -451,11 +474,13 @@ fn run_cli() -> Result<ExitCode> {
                     );
                 } else {
                     bad += 1;
-                    println!("{}: {} disagreement(s)", path.display(), a.findings.len());
+                    out!("{}: {} disagreement(s)", path.display(), a.findings.len());
                     for f in &a.findings {
-                        println!(
+                        out!(
                             "  {}: logged {}, states say {}",
-                            f.field, f.logged, f.recomputed
+                            f.field,
+                            f.logged,
+                            f.recomputed
                         );
                     }
                 }
@@ -469,7 +494,7 @@ fn run_cli() -> Result<ExitCode> {
         Cmd::Export { log, mcap } => {
             let summary = trust_export::export_file(&log, &mcap)?;
             let total: u64 = summary.message_counts.values().sum();
-            println!(
+            out!(
                 "wrote {} ({total} messages on {} topics)",
                 mcap.display(),
                 summary.message_counts.len()
@@ -484,8 +509,8 @@ fn print_study(out: &Path, flights: usize) -> Result<ExitCode> {
         .with_context(|| format!("reading {}", out.join("report.md").display()))?;
     // The table and the targets: everything up to "## Reading it".
     let head = report.split("## Reading it").next().unwrap_or(&report);
-    println!("{}", head.trim_end());
-    println!("\n{flights} flight(s); wrote {}", out.display());
+    out!("{}", head.trim_end());
+    out!("\n{flights} flight(s); wrote {}", out.display());
     Ok(ExitCode::SUCCESS)
 }
 
@@ -510,7 +535,7 @@ struct RunFlags {
 
 fn write_replay_files(log: &Path, dir: &Path, params: &trust_replay::ReplayParams) -> Result<()> {
     let files = trust_replay::write_replay(log, dir, params)?;
-    println!(
+    out!(
         "replay: {} ({:.0} kB), {} ({} frames, {}×{} px)",
         files.html.display(),
         files.html_bytes as f64 / 1e3,
@@ -553,14 +578,17 @@ fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
         write_flight_plots(out, &h, &flight.record, world.static_points())?;
     }
     let o = &summary.outcome;
-    println!(
+    out!(
         "{}: {}{} at t = {:.2} s; path {:.1} m; min clearance static {}, moving {}; \
          max speed {:.2} m/s, max accel {:.2} m/s²",
         planner.label,
         o.status.as_str(),
         o.with
             .as_ref()
-            .map(|w| format!(" with {w}"))
+            .map(|w| match o.forecast_warning_s {
+                Some(s) => format!(" with {w} (in its forecasts for {s:.2} s before)"),
+                None => format!(" with {w}"),
+            })
             .unwrap_or_default(),
         o.t,
         o.path_length_m,
@@ -569,7 +597,7 @@ fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
         o.max_speed,
         o.max_accel
     );
-    println!(
+    out!(
         "{} cycles: median {:.2} ms, p99 {:.2} ms; {:.3} ms solve per trajectory; \
          {} fallbacks; {:.1}× real time",
         summary.cycle_count,
@@ -579,7 +607,7 @@ fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
         summary.fallback_count,
         summary.real_time_factor
     );
-    println!("wrote {}", out.display());
+    out!("wrote {}", out.display());
     if flags.replay {
         write_replay_files(&log_path, out, &trust_replay::ReplayParams::default())?;
     }
