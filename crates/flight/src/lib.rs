@@ -792,41 +792,25 @@ mod tests {
         Aabb::new(Vec3::zeros(), Vec3::new(100.0, 10.0, 10.0)).unwrap()
     }
 
+    /// The warning for obstacle `id` truly at `(x, 5, 5)` at contact time 2 s, far from walls.
+    fn warning(given: &VecDeque<(f64, Vec<(usize, Forecast)>)>, id: usize, x: f64) -> f64 {
+        forecast_warning(given, id, &Vec3::new(x, 5.0, 5.0), 2.0, 0.1, &walls())
+    }
+
     #[test]
     fn a_forecast_that_held_gives_the_whole_history_as_warning() {
         // The ball walks as forecast: at contact (t = 2, x = 3) every forecast had it.
-        let w = forecast_warning(
-            &given(1.0, 2.0),
-            3,
-            &Vec3::new(3.0, 5.0, 5.0),
-            2.0,
-            0.1,
-            &walls(),
-        );
+        let w = warning(&given(1.0, 2.0), 3, 3.0);
         assert!((w - 2.0).abs() < 1e-9, "{w}");
     }
 
     #[test]
     fn an_obstacle_outside_its_last_forecast_gives_no_warning() {
         // Forecast standing still, true ball 2 m away from the last forecast's centre.
-        let w = forecast_warning(
-            &given(0.0, 2.0),
-            3,
-            &Vec3::new(5.0, 5.0, 5.0),
-            2.0,
-            0.1,
-            &walls(),
-        );
+        let w = warning(&given(0.0, 2.0), 3, 5.0);
         assert_eq!(w, 0.0);
         // Another obstacle's id: no forecast of it, no warning.
-        let w = forecast_warning(
-            &given(1.0, 2.0),
-            4,
-            &Vec3::new(3.0, 5.0, 5.0),
-            2.0,
-            0.1,
-            &walls(),
-        );
+        let w = warning(&given(1.0, 2.0), 4, 3.0);
         assert_eq!(w, 0.0);
     }
 
@@ -835,14 +819,7 @@ mod tests {
         // Forecasts standing still: the one issued at t_k misses the ball at contact by
         // 2 − t_k against an uncertainty 0.2 + 0.5·(2 − t_k), so only those from t_k = 1.6 on
         // have it.
-        let w = forecast_warning(
-            &given(0.0, 2.0),
-            3,
-            &Vec3::new(3.0, 5.0, 5.0),
-            2.0,
-            0.1,
-            &walls(),
-        );
+        let w = warning(&given(0.0, 2.0), 3, 3.0);
         assert!((w - 0.4).abs() < 1e-9, "{w}");
     }
 
