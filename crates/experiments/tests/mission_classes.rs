@@ -76,7 +76,9 @@ fn a_wall_ahead_the_vehicle_leaves_the_start_and_arrives() {
 
 #[test]
 fn a_stalled_flight_says_so_then_progresses_and_arrives() {
-    let (f, events) = fly_audited(&suite("room_penetration").with_seed(1), "stall");
+    // Seed 106 stalls behind the people (seed 1 did until the forecasts' growth stopped after
+    // a quarter of the horizon; it now flies through without stalling).
+    let (f, events) = fly_audited(&suite("room_penetration").with_seed(106), "stall");
     let o = &f.summary.outcome;
     assert_eq!(o.status, Status::Arrived, "{o:?}");
     let stalled = events.iter().position(|e| e == "stalled");

@@ -392,18 +392,27 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     ) -> Result<StepReport, PlanError> {
         let mut spans = Spans::start();
         check_step_input(now, measured, goal, scene)?;
-        let with_images;
-        let imaged: Vec<Forecast>;
-        let scene = if self.params.wall_images {
-            imaged = forecasts_with_wall_images(scene, now, now + 2.0 * self.params.horizon_s);
-            with_images = Scene {
-                forecasts: &imaged,
-                ..*scene
-            };
-            &with_images
-        } else {
-            scene
+        // The forecasts the cycle plans against: their growth stopped after
+        // `forecast_growth_s`, and their mirror images at the walls.
+        let growth_s = self.params.forecast_growth();
+        let mut seen: Vec<Forecast> = scene
+            .forecasts
+            .iter()
+            .map(|f| f.with_growth_for(growth_s))
+            .collect();
+        if self.params.wall_images {
+            seen = with_wall_images(
+                seen,
+                scene.map.bounds(),
+                now,
+                now + 2.0 * self.params.horizon_s,
+            );
+        }
+        let planned = Scene {
+            forecasts: &seen,
+            ..*scene
         };
+        let scene = &planned;
         let mut cycle = self.begin_cycle(now, measured, goal, spans.started);
         self.update_route(&mut cycle, measured, scene, &mut spans);
 
@@ -1101,15 +1110,20 @@ fn max_jerk(traj: &PolyTraj) -> f64 {
     worst
 }
 
-/// The scene's forecasts followed by their mirror images at the map bounds' walls over
-/// `[from, until]` ([`trust_predict::wall_images`]).
-fn forecasts_with_wall_images(scene: &Scene<'_>, from: f64, until: f64) -> Vec<Forecast> {
-    let walls = scene.map.bounds();
-    let mut all = scene.forecasts.to_vec();
-    for f in scene.forecasts {
-        all.extend(trust_predict::wall_images(f, walls, from, until));
-    }
-    all
+/// `forecasts` followed by their mirror images at the `walls` over `[from, until]`
+/// ([`trust_predict::wall_images`]).
+fn with_wall_images(
+    mut forecasts: Vec<Forecast>,
+    walls: &trust_predict::Aabb,
+    from: f64,
+    until: f64,
+) -> Vec<Forecast> {
+    let images: Vec<Forecast> = forecasts
+        .iter()
+        .flat_map(|f| trust_predict::wall_images(f, walls, from, until))
+        .collect();
+    forecasts.extend(images);
+    forecasts
 }
 
 /// Checks the inputs of [`Manager::step`].

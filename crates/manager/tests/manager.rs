@@ -591,6 +591,54 @@ fn an_obstacle_turning_at_a_wall_is_expected_back() {
     assert!(!plan_kept(true));
 }
 
+/// A slow walker beside the line whose forecast grows fast: grown for the whole horizon it
+/// reaches the line by the time the vehicle passes and the plan is dropped; with the growth
+/// stopped after a quarter of the horizon (the default) the plan passes. The paper's model is
+/// `forecast_growth_s = ∞`.
+#[test]
+fn forecast_growth_stops_after_a_quarter_of_the_horizon() {
+    let map = open_air();
+    let walker = [Forecast::new(
+        ObstacleShape::Sphere,
+        Vec3::new(30.0, 6.0, 5.0),
+        Vec3::zeros(),
+        0.0,
+        1.0,
+        0.3,
+        2.0,
+    )
+    .unwrap()];
+    let scene = Scene::new(&map, &walker, 0.0).unwrap();
+    let goal = Vec3::new(95.0, 0.0, 5.0);
+    let plan_kept = |forecast_growth_s: Option<f64>| {
+        let mut m = Manager::new(
+            StraightLine,
+            Blind,
+            Tvd::default(),
+            Limits::default(),
+            reproducible(ManagerParams {
+                forecast_growth_s,
+                ..ManagerParams::single_branch()
+            }),
+        )
+        .unwrap();
+        let r = m.step(0.0, &cruising(8.0), &goal, &scene).unwrap();
+        r.main.is_some()
+    };
+    assert_eq!(ManagerParams::default().forecast_growth(), 1.0);
+    assert!(plan_kept(None));
+    assert!(!plan_kept(Some(f64::INFINITY)));
+    let bad = ManagerParams {
+        forecast_growth_s: Some(0.0),
+        ..ManagerParams::default()
+    };
+    let Err(e) = Manager::new(StraightLine, Blind, Tvd::default(), Limits::default(), bad) else {
+        panic!("forecast_growth_s = 0 accepted");
+    };
+    let e = e.to_string();
+    assert!(e.contains("manager.forecast_growth_s"), "{e}");
+}
+
 /// A ball rolling at a vehicle at rest, twice as fast as the vehicle can fly, its forecast growing
 /// fast: the fallback steps out of its path rather than fleeing along it (judged against
 /// forecasts that grow for ever, every option collided and fleeing, colliding latest, won).

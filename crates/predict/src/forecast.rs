@@ -42,6 +42,9 @@ pub enum ObstacleShape {
 ///   but the inflation is clamped at its `t0` value (`r_safe`) — an uncertainty never shrinks below
 ///   its value at the observation. Consequently `radius_rate(t) = 0` for `t < t0` and `mu` for
 ///   `t ≥ t0` (the right derivative at `t0`).
+/// * Beyond the paper, the growth may stop `growth_s` seconds after `t0`
+///   ([`Forecast::with_growth_for`]): `radius(t) = r_o + r_safe + mu·min(t − t0, growth_s)`, and
+///   `radius_rate` is 0 from then on. [`Forecast::new`] grows for ever (`growth_s = ∞`).
 /// * The fields are public for serde and for reading; build forecasts with [`Forecast::new`] (or
 ///   call [`Forecast::validate`] after deserializing or editing one). The query methods assume a
 ///   valid forecast and finite query arguments; non-finite arguments propagate per IEEE 754.
@@ -62,6 +65,18 @@ pub struct Forecast {
     pub r_safe: f64,
     /// Uncertainty growth rate `mu_o` (m/s); `≥ 0`.
     pub mu: f64,
+    /// How long after `t0` the uncertainty grows (s); `> 0`, `∞` (the default, and the paper's
+    /// model) for ever. Absent from serialized forecasts that grow for ever.
+    #[serde(default = "forever", skip_serializing_if = "is_forever")]
+    pub growth_s: f64,
+}
+
+fn forever() -> f64 {
+    f64::INFINITY
+}
+
+fn is_forever(s: &f64) -> bool {
+    *s == f64::INFINITY
 }
 
 impl Forecast {
@@ -87,6 +102,7 @@ impl Forecast {
             r_o,
             r_safe,
             mu,
+            growth_s: f64::INFINITY,
         };
         f.validate()?;
         Ok(f)
@@ -118,6 +134,13 @@ impl Forecast {
         check_positive("forecast.r_o", self.r_o, Quantity::Length)?;
         check_non_negative("forecast.r_safe", self.r_safe, Quantity::Length)?;
         check_non_negative("forecast.mu", self.mu, Quantity::Rate)?;
+        if self.growth_s.is_nan() || self.growth_s <= 0.0 {
+            return Err(PredictError::OutOfRange {
+                field: "forecast.growth_s".into(),
+                value: self.growth_s,
+                expected: "> 0 s (∞: grows for ever)",
+            });
+        }
         if let ObstacleShape::Cylinder { half_height } = self.shape {
             check_positive("forecast.shape.half_height", half_height, Quantity::Length)?;
         }
@@ -144,16 +167,28 @@ impl Forecast {
     #[inline]
     pub fn growth_held_after(&self, duration: f64) -> Forecast {
         Forecast {
-            r_safe: self.r_safe + self.mu * duration.max(0.0),
+            r_safe: self.r_safe + self.mu * duration.clamp(0.0, self.growth_s),
             mu: 0.0,
             ..*self
         }
     }
 
-    /// Inflation added to the base shape at time `t`: `r_safe + mu·max(t − t0, 0)`.
+    /// This forecast with its growth stopping `seconds` after `t0` (or sooner if it already
+    /// did): the radius grows as before up to then and stays. For a replanning planner that
+    /// judges a whole horizon against forecasts it revises every cycle (the manager's
+    /// `forecast_growth_s`). `seconds` must be `> 0` ([`Forecast::validate`]).
+    #[inline]
+    pub fn with_growth_for(&self, seconds: f64) -> Forecast {
+        Forecast {
+            growth_s: self.growth_s.min(seconds),
+            ..*self
+        }
+    }
+
+    /// Inflation added to the base shape at time `t`: `r_safe + mu·clamp(t − t0, 0, growth_s)`.
     #[inline]
     pub fn inflation(&self, t: f64) -> f64 {
-        self.r_safe + self.mu * (t - self.t0).max(0.0)
+        self.r_safe + self.mu * (t - self.t0).clamp(0.0, self.growth_s)
     }
 
     /// Avoidance radius `r_o + r_safe + mu·max(t − t0, 0)` (sphere radius or cylinder radius).
@@ -162,11 +197,15 @@ impl Forecast {
         self.r_o + self.inflation(t)
     }
 
-    /// `d radius/dt`: `mu` for `t ≥ t0`, `0` before (the radius is clamped there). The inflated
-    /// cylinder half-height grows at the same rate.
+    /// `d radius/dt`: `mu` for `t0 ≤ t < t0 + growth_s`, `0` before and after (the radius is
+    /// clamped there). The inflated cylinder half-height grows at the same rate.
     #[inline]
     pub fn radius_rate(&self, t: f64) -> f64 {
-        if t >= self.t0 { self.mu } else { 0.0 }
+        if t >= self.t0 && t - self.t0 < self.growth_s {
+            self.mu
+        } else {
+            0.0
+        }
     }
 
     /// Half of the vertical extent of the inflated obstacle at `t`: the radius for a sphere,
@@ -283,6 +322,43 @@ impl Forecast {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn growth_that_stops_holds_the_radius_and_its_rate() {
+        let f = Forecast::sphere(Vec3::zeros(), Vec3::x(), 1.0, 0.5, 0.2, 0.4)
+            .unwrap()
+            .with_growth_for(1.5);
+        assert_relative_eq!(f.radius(0.0), 0.7); // before t0: clamped
+        assert_relative_eq!(f.radius(2.0), 0.7 + 0.4);
+        assert_relative_eq!(f.radius(2.5), 0.7 + 0.6);
+        assert_relative_eq!(f.radius(9.0), 0.7 + 0.6);
+        assert_eq!(f.radius_rate(2.0), 0.4);
+        assert_eq!(f.radius_rate(2.5), 0.0);
+        assert_eq!(f.radius_rate(9.0), 0.0);
+        // A shorter cap wins, a longer one does not lengthen it.
+        assert_eq!(f.with_growth_for(1.0).growth_s, 1.0);
+        assert_eq!(f.with_growth_for(3.0).growth_s, 1.5);
+        // Held after 4 s: the growth stopped at 1.5 s.
+        assert_relative_eq!(f.growth_held_after(4.0).radius(1.0), 0.7 + 0.6);
+        // The default grows for ever.
+        let g = Forecast::sphere(Vec3::zeros(), Vec3::x(), 1.0, 0.5, 0.2, 0.4).unwrap();
+        assert_relative_eq!(g.radius(9.0), 0.7 + 3.2);
+        let bad = Forecast { growth_s: 0.0, ..g };
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(e.contains("forecast.growth_s"), "{e}");
+        let nan = Forecast {
+            growth_s: f64::NAN,
+            ..g
+        };
+        assert!(nan.validate().is_err());
+        // Serialized without the field when it grows for ever, with it otherwise.
+        let json = serde_json::to_string(&g).unwrap();
+        assert!(!json.contains("growth_s"), "{json}");
+        assert_eq!(serde_json::from_str::<Forecast>(&json).unwrap(), g);
+        let json = serde_json::to_string(&f).unwrap();
+        assert_eq!(serde_json::from_str::<Forecast>(&json).unwrap(), f);
+    }
+
     use super::*;
     use approx::assert_relative_eq;
     use proptest::prelude::*;

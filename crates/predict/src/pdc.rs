@@ -153,11 +153,18 @@ impl Pdc {
     #[inline]
     pub(crate) fn between(forecast: &Forecast, t_a: f64, t_b: f64) -> Self {
         let (a, b) = (forecast.center(t_a), forecast.center(t_b));
-        let (ra, rb) = (forecast.radius(t_a), forecast.radius(t_b));
-        let (ha, hb) = (
+        let (mut ra, rb) = (forecast.radius(t_a), forecast.radius(t_b));
+        let (mut ha, hb) = (
             forecast.vertical_half_extent(t_a),
             forecast.vertical_half_extent(t_b),
         );
+        // Growth that stops inside the window: the slices after the stop are as large as the
+        // end, so a cone growing linearly from the start would cut them; the window's largest
+        // shape all along contains them (conservative).
+        let stop = forecast.t0 + forecast.growth_s;
+        if t_a < stop && stop < t_b {
+            (ra, ha) = (rb, hb);
+        }
         let (ext_a, ext_b) = (Vec3::new(ra, ra, ha), Vec3::new(rb, rb, hb));
         Pdc {
             forecast: *forecast,

@@ -214,6 +214,7 @@ mod tests {
             r_o: 0.5,
             r_safe: 0.0,
             mu: 0.0,
+            growth_s: f64::INFINITY,
         }
     }
 

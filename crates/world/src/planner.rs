@@ -504,6 +504,9 @@ pub struct ManagerOverrides {
     /// Replaces `ManagerParams::wall_images`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub wall_images: Option<bool>,
+    /// Replaces `ManagerParams::forecast_growth_s` (`inf`: the paper's growth for ever).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub forecast_growth_s: Option<f64>,
 }
 
 impl ManagerOverrides {
@@ -558,6 +561,9 @@ impl ManagerOverrides {
         }
         if let Some(v) = self.wall_images {
             p.wall_images = v;
+        }
+        if let Some(v) = self.forecast_growth_s {
+            p.forecast_growth_s = Some(v);
         }
         if let Some(v) = self.cycle_budget_ms {
             p.cycle_budget_ms = v;
@@ -1085,12 +1091,13 @@ mod tests {
     #[test]
     fn manager_overrides_merge_onto_the_preset() {
         let spec: PlannerSpec =
-            toml::from_str("name = \"baseline1\"\n[manager]\nhorizon_s = 3.0\nwall_images = false\n[manager.safety]\nmax_step_s = 0.02\nrest_hold_s = 1.5\n")
+            toml::from_str("name = \"baseline1\"\n[manager]\nhorizon_s = 3.0\nwall_images = false\nforecast_growth_s = inf\n[manager.safety]\nmax_step_s = 0.02\nrest_hold_s = 1.5\n")
                 .unwrap();
         let r = spec.resolve();
         assert_eq!(r.manager.max_branches, 1);
         assert_eq!(r.manager.horizon_s, 3.0);
         assert!(!r.manager.wall_images);
+        assert_eq!(r.manager.forecast_growth(), f64::INFINITY);
         assert_eq!(r.manager.safety.rest_hold_s, 1.5);
         assert_eq!(r.manager.safety.max_step_s, 0.02);
         assert_eq!(r.manager.safety.min_step_s, 1e-3);

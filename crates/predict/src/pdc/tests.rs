@@ -628,3 +628,18 @@ proptest! {
         prop_assert!((fd - g).norm() < 1e-4, "{fd:?} vs {g:?}");
     }
 }
+
+/// Growth that stops inside the window: every slice stays inside the cone (a cone growing
+/// linearly between the end radii would cut the slices just after the stop).
+#[test]
+fn a_cone_whose_growth_stops_inside_the_window_contains_every_slice() {
+    let f = Forecast::sphere(Vec3::zeros(), Vec3::new(2.0, 0.0, 0.0), 0.0, 0.5, 0.1, 1.0)
+        .unwrap()
+        .with_growth_for(0.5);
+    let pdc = Pdc::over_window(&f, 0.0, 2.0).unwrap();
+    for k in 0..=40 {
+        let t = 2.0 * k as f64 / 40.0;
+        let side = f.center(t) + Vec3::new(0.0, f.radius(t) - 1e-9, 0.0);
+        assert!(pdc.contains(&side), "slice at t = {t} leaks");
+    }
+}
