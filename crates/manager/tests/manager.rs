@@ -558,8 +558,7 @@ fn braking_fallback_when_every_branch_collides() {
 /// (`ManagerParams::wall_images`, the default) the plan is dropped; without, it is kept.
 #[test]
 fn an_obstacle_turning_at_a_wall_is_expected_back() {
-    let map = open_air();
-    let walker = [Forecast::new(
+    let walker = Forecast::new(
         ObstacleShape::Sphere,
         Vec3::new(29.0, 7.0, 5.0),
         Vec3::new(0.0, 4.0, 0.0),
@@ -568,27 +567,39 @@ fn an_obstacle_turning_at_a_wall_is_expected_back() {
         0.3,
         0.0,
     )
-    .unwrap()];
-    let scene = Scene::new(&map, &walker, 0.0).unwrap();
-    let goal = Vec3::new(95.0, 0.0, 5.0);
+    .unwrap();
     let plan_kept = |wall_images: bool| {
-        let mut m = Manager::new(
-            StraightLine,
-            Blind,
-            Tvd::default(),
-            Limits::default(),
-            reproducible(ManagerParams {
+        straight_plan_kept(
+            ManagerParams {
                 wall_images,
                 ..ManagerParams::single_branch()
-            }),
+            },
+            walker,
         )
-        .unwrap();
-        let r = m.step(0.0, &cruising(8.0), &goal, &scene).unwrap();
-        r.main.is_some()
     };
     assert!(ManagerParams::default().wall_images);
     assert!(plan_kept(false));
     assert!(!plan_kept(true));
+}
+
+/// Whether a single-branch manager cruising at 8 m/s along y = 0 toward x = 95 past `obstacle`
+/// (open air) keeps the straight branch in its first cycle.
+fn straight_plan_kept(params: ManagerParams, obstacle: Forecast) -> bool {
+    let map = open_air();
+    let forecasts = [obstacle];
+    let scene = Scene::new(&map, &forecasts, 0.0).unwrap();
+    let mut m = Manager::new(
+        StraightLine,
+        Blind,
+        Tvd::default(),
+        Limits::default(),
+        reproducible(params),
+    )
+    .unwrap();
+    let r = m
+        .step(0.0, &cruising(8.0), &Vec3::new(95.0, 0.0, 5.0), &scene)
+        .unwrap();
+    r.main.is_some()
 }
 
 /// A slow walker beside the line whose forecast grows fast: grown for the whole horizon it
@@ -597,8 +608,7 @@ fn an_obstacle_turning_at_a_wall_is_expected_back() {
 /// `forecast_growth_s = ∞`.
 #[test]
 fn forecast_growth_stops_after_a_quarter_of_the_horizon() {
-    let map = open_air();
-    let walker = [Forecast::new(
+    let walker = Forecast::new(
         ObstacleShape::Sphere,
         Vec3::new(30.0, 6.0, 5.0),
         Vec3::zeros(),
@@ -607,23 +617,15 @@ fn forecast_growth_stops_after_a_quarter_of_the_horizon() {
         0.3,
         2.0,
     )
-    .unwrap()];
-    let scene = Scene::new(&map, &walker, 0.0).unwrap();
-    let goal = Vec3::new(95.0, 0.0, 5.0);
+    .unwrap();
     let plan_kept = |forecast_growth_s: Option<f64>| {
-        let mut m = Manager::new(
-            StraightLine,
-            Blind,
-            Tvd::default(),
-            Limits::default(),
-            reproducible(ManagerParams {
+        straight_plan_kept(
+            ManagerParams {
                 forecast_growth_s,
                 ..ManagerParams::single_branch()
-            }),
+            },
+            walker,
         )
-        .unwrap();
-        let r = m.step(0.0, &cruising(8.0), &goal, &scene).unwrap();
-        r.main.is_some()
     };
     assert_eq!(ManagerParams::default().forecast_growth(), 1.0);
     assert!(plan_kept(None));
