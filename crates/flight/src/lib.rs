@@ -395,11 +395,12 @@ pub fn fly(
     let mut ended: Option<(Status, Option<String>, Option<String>)> = None;
     let mut next_progress = options.progress_every_s.unwrap_or(f64::INFINITY);
     let mut next_plan_snapshot = 0.0;
-    // The forecasts given to the planner over the last two horizons, by obstacle id, newest
-    // last: a collision's outcome says how long they had the obstacle where it hit.
-    let mut given: std::collections::VecDeque<(f64, Vec<(usize, Forecast)>)> =
-        std::collections::VecDeque::new();
+    // The forecasts the planner planned against (growth stopped as its manager stops it) over
+    // the last two horizons, by obstacle id, newest last: a collision's outcome says how long
+    // they had the obstacle where it hit.
+    let mut given = ForecastHistory::new();
     let remember_s = 2.0 * planner.manager.horizon_s;
+    let growth_s = planner.manager.forecast_growth();
     let mut step = 0u64;
     let mut t = 0.0;
     while ended.is_none() {
@@ -411,7 +412,7 @@ pub fn fly(
                 sensing
                     .tracked_ids()
                     .into_iter()
-                    .zip(forecasts.iter().copied())
+                    .zip(forecasts.iter().map(|f| f.with_growth_for(growth_s)))
                     .collect(),
             ));
             while given.front().is_some_and(|(tk, _)| *tk < t - remember_s) {
@@ -689,11 +690,14 @@ fn branch_samples(manager: &AnyManager) -> Vec<BranchSamples> {
 
 /// The cycle's forecasts as the log records them; `ids[i]` is the obstacle of `forecasts[i]`
 /// (`trust_world::sensing::Sensing::tracked_ids`).
+/// Forecasts by cycle: (cycle time, forecasts by obstacle id), oldest first.
+type ForecastHistory = std::collections::VecDeque<(f64, Vec<(usize, Forecast)>)>;
+
 /// How long before `t_contact` the forecasts of obstacle `id` in `given` (time, forecasts by
 /// id; oldest first) have all had its true centre `centre` at contact within their uncertainty
 /// (`inflation − vehicle radius`), counting their wall images ([`Outcome::forecast_warning_s`]).
 fn forecast_warning(
-    given: &std::collections::VecDeque<(f64, Vec<(usize, Forecast)>)>,
+    given: &ForecastHistory,
     id: usize,
     centre: &Vec3,
     t_contact: f64,
@@ -764,12 +768,11 @@ fn dropped(report: &StepReport) -> Dropped {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::VecDeque;
     use trust_predict::Aabb;
 
     /// A ball (radius 0.2 m, `r_safe` 0.3 m for a 0.1 m vehicle, growth 0.5 m/s) forecast at
     /// every 0.1 s from `t0 = 0` on, walking +x at 1 m/s from x = 1 (forecast velocity `v`).
-    fn given(v: f64, until: f64) -> VecDeque<(f64, Vec<(usize, Forecast)>)> {
+    fn given(v: f64, until: f64) -> ForecastHistory {
         (0..=(until * 10.0).round() as usize)
             .map(|k| {
                 let t = k as f64 * 0.1;
@@ -793,7 +796,7 @@ mod tests {
     }
 
     /// The warning for obstacle `id` truly at `(x, 5, 5)` at contact time 2 s, far from walls.
-    fn warning(given: &VecDeque<(f64, Vec<(usize, Forecast)>)>, id: usize, x: f64) -> f64 {
+    fn warning(given: &ForecastHistory, id: usize, x: f64) -> f64 {
         forecast_warning(given, id, &Vec3::new(x, 5.0, 5.0), 2.0, 0.1, &walls())
     }
 

@@ -367,7 +367,8 @@ pub struct Outcome {
     #[serde(default)]
     pub cycle_count: usize,
     /// Added, only for a collision with a moving obstacle: how long before contact the forecasts
-    /// the planner was given (with their mirror images at the map's walls) already had the
+    /// the planner planned against (its growth stop applied, with their mirror images at the
+    /// map's walls) already had the
     /// obstacle where it was at contact (s) — every forecast of that obstacle issued since then
     /// had its true centre within the forecast's uncertainty (`r_safe` less the vehicle radius,
     /// plus the growth). 0 when even the last forecast before contact missed it: the obstacle
