@@ -87,7 +87,7 @@ fn the_same_seed_gives_a_byte_identical_log() {
         "two runs with seed 7 wrote different logs"
     );
     // The branches are logged main first, sampled from their start to their end; the forecasts
-    // name header obstacles.
+    // name header obstacles and carry the growth stop the manager planned with.
     let log = RunLog::read(&dir.join("run0.jsonl")).unwrap();
     assert!(!log.cycles.is_empty());
     for c in &log.cycles {
@@ -107,6 +107,7 @@ fn the_same_seed_gives_a_byte_identical_log() {
         }
         for f in c.forecasts.as_ref().expect("forecasts logged") {
             assert!(f.id < log.header.obstacles.len() && f.r0 > 0.0 && f.t0 <= c.t + 1e-9);
+            assert_eq!(f.growth_s, Some(planner.manager.forecast_growth()));
         }
     }
     // Another seed flies another trial.

@@ -455,8 +455,11 @@ pub fn fly(
                         cycle_record(&report, manager.route(), effective, options.zero_timing);
                     if options.log_branches {
                         record.branch_samples = Some(branch_samples(&manager));
-                        record.forecasts =
-                            Some(forecast_records(&sensing.tracked_ids(), &forecasts));
+                        record.forecasts = Some(forecast_records(
+                            &sensing.tracked_ids(),
+                            &forecasts,
+                            growth_s,
+                        ));
                     }
                     log.cycle(record)?;
                 }
@@ -723,7 +726,9 @@ fn forecast_warning(
     t_contact - since
 }
 
-fn forecast_records(ids: &[usize], forecasts: &[Forecast]) -> Vec<ForecastRecord> {
+/// The cycle's forecasts as logged: as sensed, with the growth stop the manager applies to them
+/// before planning (`growth_s`, absent when they grow for ever).
+fn forecast_records(ids: &[usize], forecasts: &[Forecast], growth_s: f64) -> Vec<ForecastRecord> {
     ids.iter()
         .zip(forecasts)
         .map(|(&id, f)| ForecastRecord {
@@ -739,6 +744,7 @@ fn forecast_records(ids: &[usize], forecasts: &[Forecast]) -> Vec<ForecastRecord
                     half_height: f.vertical_half_extent(f.t0),
                 },
             },
+            growth_s: growth_s.is_finite().then_some(growth_s),
         })
         .collect()
 }

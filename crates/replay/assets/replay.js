@@ -184,12 +184,14 @@
       if (info.shape === 'cylinder') { return { r: info.radius, hh: info.half_height || 0 }; }
       return { r: info.radius };
     }
-    // f = [id, x, y, z, vx, vy, vz, t0, r0, mu, half_height (0: sphere)]
+    // f = [id, x, y, z, vx, vy, vz, t0, r0, mu, half_height (0: sphere),
+    //      growth_s (null: grows for ever)]
     function forecastAt(f, t) {
       var dt = Math.max(0, t - f[7]);
       var c = [f[1] + f[4] * dt, f[2] + f[5] * dt, f[3] + f[6] * dt];
-      var s = { r: f[8] + f[9] * dt };
-      if (f[10] > 0) { s.hh = f[10] + f[9] * dt; }
+      var grown = f[9] * (f[11] == null ? dt : Math.min(dt, f[11]));
+      var s = { r: f[8] + grown };
+      if (f[10] > 0) { s.hh = f[10] + grown; }
       return { c: c, s: s };
     }
     function latestRoute(ci) {

@@ -131,17 +131,7 @@ fn forecast_is_near(
     branches: Option<&[BranchSamples]>,
     near: f64,
 ) -> bool {
-    let at = |t: f64| {
-        let dt = (t - f.t0).max(0.0);
-        (
-            [
-                f.p0[0] + f.v0[0] * dt,
-                f.p0[1] + f.v0[1] * dt,
-                f.p0[2] + f.v0[2] * dt,
-            ],
-            f.r0 + f.mu * dt,
-        )
-    };
+    let at = |t: f64| (f.centre_at(t), f.radius_at(t));
     let dist = |a: &[f64; 3], b: &[f64; 3]| {
         ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
     };
@@ -157,15 +147,27 @@ fn forecast_is_near(
     })
 }
 
-/// A forecast as the page reads it: `[id, x, y, z, vx, vy, vz, t0, r0, mu, half_height]`
-/// (`half_height` 0 for a sphere).
+/// A forecast as the page reads it:
+/// `[id, x, y, z, vx, vy, vz, t0, r0, mu, half_height, growth_s]` (`half_height` 0 for a sphere,
+/// `growth_s` `null` when the radius grows for ever).
 fn compact_forecast(f: &ForecastRecord) -> Value {
     let hh = match f.shape {
         ForecastShape::Sphere => 0.0,
         ForecastShape::Cylinder { half_height } => half_height,
     };
     json!([
-        f.id, f.p0[0], f.p0[1], f.p0[2], f.v0[0], f.v0[1], f.v0[2], f.t0, f.r0, f.mu, hh
+        f.id,
+        f.p0[0],
+        f.p0[1],
+        f.p0[2],
+        f.v0[0],
+        f.v0[1],
+        f.v0[2],
+        f.t0,
+        f.r0,
+        f.mu,
+        hh,
+        f.growth_s.map_or(Value::Null, num)
     ])
 }
 

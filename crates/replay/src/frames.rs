@@ -205,15 +205,7 @@ pub fn write_top_view_gif(
             .and_then(|c| c.forecasts.as_ref())
             .map(|fs| {
                 fs.iter()
-                    .map(|f| {
-                        let dt = (s.t - f.t0).max(0.0);
-                        let c = [
-                            f.p0[0] + f.v0[0] * dt,
-                            f.p0[1] + f.v0[1] * dt,
-                            f.p0[2] + f.v0[2] * dt,
-                        ];
-                        (xy(&c), f.r0 + f.mu * dt)
-                    })
+                    .map(|f| (xy(&f.centre_at(s.t)), f.radius_at(s.t)))
                     .collect()
             })
             .unwrap_or_default();

@@ -266,8 +266,9 @@ pub enum ForecastShape {
     },
 }
 
-/// A forecast of one moving obstacle as the planner received it (added, issue 20): centre
-/// `p0 + v0·(t − t0)`, radius `r0 + mu·(t − t0)` for `t ≥ t0`.
+/// A forecast of one moving obstacle as the planner planned against it (added, issue 20): centre
+/// `p0 + v0·(t − t0)`, radius `r0 + mu·min(t − t0, growth_s)` for `t ≥ t0` (see
+/// [`ForecastRecord::centre_at`] and [`ForecastRecord::radius_at`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ForecastRecord {
@@ -285,6 +286,35 @@ pub struct ForecastRecord {
     pub mu: f64,
     /// Base shape.
     pub shape: ForecastShape,
+    /// How long the radius grows (s) after `t0` (added, issue 19): the planner stops the growth
+    /// after `trust_manager::ManagerParams::forecast_growth_s`. Absent: it grows for ever (logs
+    /// written before the field, or `forecast_growth_s = inf`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub growth_s: Option<f64>,
+}
+
+impl ForecastRecord {
+    /// Predicted centre at time `t` (the centre at `t0` for `t < t0`).
+    pub fn centre_at(&self, t: f64) -> [f64; 3] {
+        let dt = (t - self.t0).max(0.0);
+        [
+            self.p0[0] + self.v0[0] * dt,
+            self.p0[1] + self.v0[1] * dt,
+            self.p0[2] + self.v0[2] * dt,
+        ]
+    }
+
+    /// How much the radius (and a cylinder's half-height) has grown by time `t` (m):
+    /// `mu·clamp(t − t0, 0, growth_s)`.
+    pub fn growth_at(&self, t: f64) -> f64 {
+        let dt = (t - self.t0).max(0.0);
+        self.mu * self.growth_s.map_or(dt, |g| dt.min(g))
+    }
+
+    /// Avoidance radius at time `t` (m): `r0 +` [`ForecastRecord::growth_at`].
+    pub fn radius_at(&self, t: f64) -> f64 {
+        self.r0 + self.growth_at(t)
+    }
 }
 
 /// Trajectories the safety check dropped in one cycle, by cause of the first violation.
@@ -822,6 +852,7 @@ mod tests {
                 r0: 0.6,
                 mu: 0.3,
                 shape: ForecastShape::Cylinder { half_height: 1.7 },
+                growth_s: Some(1.0),
             },
             ForecastRecord {
                 id: 2,
@@ -831,6 +862,7 @@ mod tests {
                 r0: 0.5,
                 mu: 0.0,
                 shape: ForecastShape::Sphere,
+                growth_s: None,
             },
         ]);
         let on = serde_json::to_string(&Record::Cycle(c.clone())).unwrap();
@@ -843,6 +875,8 @@ mod tests {
             1.7
         );
         assert_eq!(json["forecasts"][1]["shape"], "sphere");
+        assert_eq!(json["forecasts"][0]["growth_s"], 1.0);
+        assert!(json["forecasts"][1].get("growth_s").is_none());
         // A non-finite sample is refused.
         let dir = std::env::temp_dir().join(format!("trust-runlog-nf-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
@@ -851,6 +885,22 @@ mod tests {
         let e = w.write(&Record::Cycle(c)).unwrap_err().to_string();
         assert!(e.contains("sample 0 of branch 1"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_forecast_grows_until_its_growth_stop_and_without_one_for_ever() {
+        let old =
+            r#"{"id":1,"p0":[0,0,1],"v0":[1,0,0],"t0":2.0,"r0":0.5,"mu":0.25,"shape":"sphere"}"#;
+        let mut f: ForecastRecord = serde_json::from_str(old).unwrap();
+        assert_eq!(f.growth_s, None);
+        assert_eq!(f.radius_at(1.0), 0.5);
+        assert_eq!(f.radius_at(6.0), 1.5);
+        assert_eq!(f.centre_at(3.5), [1.5, 0.0, 1.0]);
+        assert_eq!(f.centre_at(1.0), [0.0, 0.0, 1.0]);
+        f.growth_s = Some(1.0);
+        assert_eq!(f.radius_at(2.5), 0.625);
+        assert_eq!(f.radius_at(6.0), 0.75);
+        assert_eq!(f.growth_at(6.0), 0.25);
     }
 
     #[test]
