@@ -89,9 +89,15 @@ pub struct Se3Gains {
     /// feedback push the vehicle beyond its limit while the attitude catches up (up to 1.2
     /// `a_max` in the rooms with people). The thrust along the actual body axis is capped too,
     /// so that an attitude lagging the command does not carry the vehicle past it (within
-    /// `asin(cap/g)` of tilt; measured in `crates/flight/tests/accel_headroom.rs`). Default
-    /// `None` (no cap); the closed loop (`trust-flight`) sets it to the scenario's `a_max` when a
-    /// scenario leaves it out.
+    /// `asin(cap/g)` of tilt). Tilted further, no thrust keeps the acceleration within the cap,
+    /// so the cap leaves room for the attitude's overshoot: a body swinging its thrust towards
+    /// the command at `ȧ` (m/s³) overshoots by about `ȧ·lead`, with `lead` the peak of the
+    /// attitude loop's response to a released rate (`exp(−ζ/√(1−ζ²)·atan(√(1−ζ²)/ζ))/ω_n`,
+    /// 20 ms with the default gains), and the command is held within `cap − ȧ·lead` (at least
+    /// half the cap). Without that room a swing to the cap within 0.2 s peaked at 1.12–1.15 times
+    /// the cap below 2 m/s²; with it every swing stays within 1.02 (measured in
+    /// `crates/flight/tests/accel_headroom.rs`). Default `None` (no cap); the closed loop
+    /// (`trust-flight`) sets it to the scenario's `a_max` when a scenario leaves it out.
     #[serde(default)]
     pub max_accel_m_s2: Option<f64>,
 }
@@ -134,6 +140,8 @@ impl Se3Gains {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Se3Controller {
     gains: Se3Gains,
+    /// How far (s of its swing rate) the attitude overshoots a command that stops turning.
+    lead_s: f64,
     mass_kg: f64,
     inertia_kg_m2: Vec3,
     gravity_m_s2: f64,
@@ -144,8 +152,10 @@ impl Se3Controller {
     pub fn new(gains: Se3Gains, model: &QuadrotorParams) -> Result<Self, VehicleError> {
         gains.validate()?;
         model.validate()?;
+        let lead_s = overshoot_per_rate(gains.k_r, gains.k_omega);
         Ok(Se3Controller {
             gains,
+            lead_s,
             mass_kg: model.mass_kg,
             inertia_kg_m2: model.inertia_kg_m2,
             gravity_m_s2: model.gravity_m_s2,
@@ -166,12 +176,29 @@ impl Se3Controller {
         let e_v = state.v - r.v;
         let correction = clamp_norm(e_x * (k.k_x / k.k_v), k.max_approach_speed_m_s);
         let feedback = clamp_norm(-(e_v + correction) * k.k_v, k.max_feedback_m_s2);
-        let accel = match k.max_accel_m_s2 {
-            Some(cap) => clamp_norm(feedback + r.a, cap),
-            None => feedback + r.a,
+        let wanted = feedback + r.a;
+        // The commanded acceleration and its rate (the reference's jerk, the feed-forward of the
+        // body rate). Clamped to the cap, the command only turns: the jerk's radial part would
+        // rotate the desired attitude past the capped tilt, so it is projected out.
+        let (accel, accel_rate) = match k.max_accel_m_s2 {
+            Some(cap) => {
+                let n = wanted.norm();
+                let u = direction(&wanted).unwrap_or_else(Vec3::zeros);
+                // The body still turning towards the command carries the attitude past it by
+                // about `lead_s` times the rate at which it swings the thrust: leave that room.
+                let b3_rate = rot * state.body_rate.cross(&Vec3::z());
+                let swing = u.dot(&b3_rate) * (r.a + Vec3::z() * self.gravity_m_s2).norm();
+                let room = (cap - swing.max(0.0) * self.lead_s).max(0.5 * cap);
+                if n > room {
+                    (u * room, (r.j - u * u.dot(&r.j)) * (room / n))
+                } else {
+                    (wanted, r.j)
+                }
+            }
+            None => (wanted, r.j),
         };
         let force = accel + Vec3::z() * self.gravity_m_s2;
-        let desired = desired_frame(&force, &r.j, r.yaw, &rot);
+        let desired = desired_frame(&force, &accel_rate, r.yaw, &rot);
 
         let mut thrust = self.mass_kg * force.dot(&rot.column(2));
         if let Some(cap) = k.max_accel_m_s2 {
@@ -286,8 +313,26 @@ pub fn flat_attitude(
     Some((q, frame.body_rate))
 }
 
-/// `v` scaled down to norm `max` if it is longer; a finite `v` whose norm overflows keeps its
-/// direction, a non-finite `v` stays non-finite.
+/// The peak (s) of the attitude error `e` of `ë + k_ω ė + k_R e = 0` released at `e = 0` with
+/// rate 1: with `ω_n = √k_R`, `ζ = k_ω/(2ω_n)`, `exp(−ζ/√(1−ζ²)·atan(√(1−ζ²)/ζ))/ω_n`
+/// underdamped, `e⁻¹/ω_n` critically damped, `(e^{−aω_n t*} − e^{−bω_n t*})/(2sω_n)` overdamped
+/// (`s = √(ζ²−1)`, `a, b = ζ ∓ s`, at `t* = ln(b/a)/((b − a)ω_n)`).
+fn overshoot_per_rate(k_r: f64, k_omega: f64) -> f64 {
+    let wn = k_r.sqrt();
+    let zeta = k_omega / (2.0 * wn);
+    if (zeta - 1.0).abs() < 1e-9 {
+        (-1.0f64).exp() / wn
+    } else if zeta < 1.0 {
+        let s = (1.0 - zeta * zeta).sqrt();
+        (-(zeta / s) * (s / zeta).atan()).exp() / wn
+    } else {
+        let s = (zeta * zeta - 1.0).sqrt();
+        let (a, b) = (zeta - s, zeta + s);
+        let t = (b / a).ln() / ((b - a) * wn);
+        ((-a * wn * t).exp() - (-b * wn * t).exp()) / (2.0 * s * wn)
+    }
+}
+
 /// The specific thrust `τ` (m/s²) nearest `wanted` for which the body's acceleration
 /// `τ·b₃ − g·e₃` has a norm of at most `cap`, with `cos_tilt = b₃·e₃`: `|τb₃ − ge₃|² = τ² −
 /// 2gτ·cos_tilt + g²`, so `τ` must lie within `g·cos_tilt ± √(cap² − g²·sin²tilt)`; tilted beyond
@@ -296,7 +341,8 @@ pub fn flat_attitude(
 /// The commanded acceleration is capped before the attitude is chosen, but while the attitude
 /// lags a quick swing of the command (braking, dodging) the thrust along the actual body axis
 /// accelerates the vehicle beyond it: 3° more tilt at 3 m/s² is 3.5 m/s² (1.065 `a_max` in the
-/// suite's penetration flight). Capping the thrust closes that gap.
+/// suite's penetration flight). Capping the thrust closes that gap while the tilt is within
+/// `asin(cap/g)`; the room the command leaves for the attitude's overshoot keeps it there.
 fn specific_thrust_within(wanted: f64, cos_tilt: f64, g: f64, cap: f64) -> f64 {
     let sin2 = (1.0 - cos_tilt * cos_tilt).max(0.0);
     let disc = cap * cap - g * g * sin2;
@@ -308,6 +354,8 @@ fn specific_thrust_within(wanted: f64, cos_tilt: f64, g: f64, cap: f64) -> f64 {
     wanted.clamp((mid - half).max(0.0), (mid + half).max(0.0))
 }
 
+/// `v` scaled down to norm `max` if it is longer; a finite `v` whose norm overflows keeps its
+/// direction, a non-finite `v` stays non-finite.
 fn clamp_norm(v: Vec3, max: f64) -> Vec3 {
     let n = v.norm();
     if n <= max {
@@ -452,6 +500,33 @@ mod tests {
                 .contains("max_feedback_m_s2")
         );
     }
+    #[test]
+    fn the_lead_is_the_attitude_loops_overshoot_per_released_rate() {
+        // ë + k_ω ė + k_R e = 0 from e = 0, ė = 1: the peak of e, by explicit integration.
+        for (k_r, k_omega) in [
+            (400.0, 36.0),
+            (400.0, 20.0),
+            (100.0, 20.0),
+            (400.0, 60.0),
+            (400.0, 40.0),
+        ] {
+            let gains = Se3Gains {
+                k_r,
+                k_omega,
+                ..Se3Gains::default()
+            };
+            let c = Se3Controller::new(gains, &QuadrotorParams::default()).unwrap();
+            let (mut e, mut de, mut peak) = (0.0f64, 1.0f64, 0.0f64);
+            let dt = 1e-6;
+            for _ in 0..1_000_000 {
+                de += (-k_omega * de - k_r * e) * dt;
+                e += de * dt;
+                peak = peak.max(e);
+            }
+            assert_relative_eq!(c.lead_s, peak, max_relative = 1e-3);
+        }
+    }
+
     #[test]
     fn the_thrust_cap_keeps_the_bodys_acceleration_within_the_cap() {
         let g = 9.81;
