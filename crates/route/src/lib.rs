@@ -37,7 +37,9 @@
 //!    without a line-of-sight query per edge.
 //!    The search runs **coarse to fine** ([`RouteParams::coarse_factor`]): first on cells 4 times
 //!    larger (a coarse free cell is farther from the obstacles, so its route is as safe), then on
-//!    the fine grid only when the coarse one finds nothing.
+//!    the fine grid when the coarse one finds nothing — or, for a fine grid of at most
+//!    [`RouteParams::refine_max_cells`] cells (a room), always, keeping the shorter route: the
+//!    coarse grid closes passages narrower than about `2(c + 4h·√3/2)`.
 //! 3. **Shortcut.** From each kept vertex the route jumps to the farthest following vertex that
 //!    a straight segment reaches with clearance `c` (checked with `segment_clear`), which
 //!    removes the grid's 45° staircase; a shortcut is only taken when clear at `c`, so it never

@@ -56,6 +56,16 @@ pub struct RouteParams {
     /// 4 × 4 m shaft, the search fills the whole space below the slab) the first cycle took 3.3 s,
     /// now 18 ms, 15 ms of it the route (`route_ms` of `trust-sim run scenarios/suite/shaft_climb.toml`).
     pub coarse_factor: f64,
+    /// After a coarse route is found, a fine grid (at `h₀`) of at most this many cells is
+    /// searched too, and the shorter of the two routes is kept. The coarse grid closes passages
+    /// narrower than about `2(c + coarse_factor·h₀·√3/2)` (1.8 m for a 0.22 m vehicle): in a
+    /// 12 × 10 × 3 m store with 2.4 m aisles the coarse route went round the shelves, 11.7 m for
+    /// 9.3 m, and the flight took 3.4 × d/v_max. Small grids are cheap to search (every room of
+    /// the suite, the variants and two holdout sets: ≤ 2 ms), large ones are not (a 40 × 40 m
+    /// shaft: 0.6 s instead of 8 ms), hence the cap. Range `[0, 100 000 000]` (`max_cells` applies too), 0 never refines;
+    /// default 1 000 000 (13 MB at most; the slowest fine search measured under it, a
+    /// Crazyflie-scale U-trap, 99 ms).
+    pub refine_max_cells: usize,
     /// Replace the grid path by the greedy line-of-sight shortcut (each kept segment checked with
     /// `StaticMap::segment_clear` at the inflated clearance). Default true.
     pub shortcut: bool,
@@ -80,6 +90,7 @@ impl Default for RouteParams {
             heuristic_weight: DEFAULT_HEURISTIC_WEIGHT,
             snap_radius_factor: 4.0,
             coarse_factor: 4.0,
+            refine_max_cells: 1_000_000,
             shortcut: true,
         }
     }
@@ -125,6 +136,13 @@ impl RouteParams {
                     expected: format!("an integer in [1, {MAX_COUNT}]"),
                 });
             }
+        }
+        if self.refine_max_cells > MAX_COUNT {
+            return Err(RouteError::InvalidParam {
+                field: "route.refine_max_cells".to_owned(),
+                value: self.refine_max_cells as f64,
+                expected: format!("an integer in [0, {MAX_COUNT}]"),
+            });
         }
         Ok(())
     }

@@ -443,8 +443,10 @@ impl RoutePlanner {
             clearance,
         };
         // Coarse to fine: a coarse grid's free cells are farther from the obstacles (the node
-        // clearance grows with the cell), so a coarse route is as safe as a fine one; only when
-        // the coarse grid finds none (a passage too narrow for it) does the fine grid search.
+        // clearance grows with the cell), so a coarse route is as safe as a fine one; when the
+        // coarse grid finds none (a passage too narrow for it) the fine grid searches, and when
+        // the fine grid is small it searches anyway for a shorter route through the passages
+        // the coarse one closed (`refine_max_cells`).
         let mut expanded_before = 0;
         if p.coarse_factor > 1.0 {
             // The coarse grid coarsens to fit the cell cap like the fine one: a world too large
@@ -452,7 +454,7 @@ impl RoutePlanner {
             // is still routed, on the coarse grid.
             let coarse = h0 * p.coarse_factor;
             match self.grid_route(map, &ends, coarse, coarse * p.max_coarsening, deadline) {
-                Ok(route) => return Ok(route),
+                Ok(route) => return Ok(self.refined(map, &ends, h0, route, deadline)),
                 Err(RouteError::Unreachable { expanded, .. }) => expanded_before = expanded,
                 Err(RouteError::NoFreeCell { .. } | RouteError::TooManyCells { .. }) => {}
                 Err(e) => return Err(e),
@@ -461,6 +463,36 @@ impl RoutePlanner {
         let mut route = self.grid_route(map, &ends, h0, h0 * p.max_coarsening, deadline)?;
         route.add_expanded(expanded_before);
         Ok(route)
+    }
+
+    /// `coarse`, or the route on the fine grid of cells `h0` when that grid has at most
+    /// `refine_max_cells` cells and its route is shorter. The coarse route is kept whenever
+    /// the fine search fails (a cap, the deadline): it is valid, only longer.
+    fn refined(
+        &self,
+        map: &StaticMap,
+        ends: &Ends,
+        h0: f64,
+        coarse: GlobalRoute,
+        deadline: Option<Instant>,
+    ) -> GlobalRoute {
+        let p = &self.params;
+        let cap = p.refine_max_cells.min(p.max_cells);
+        if Grid::new(map.bounds(), h0, cap, h0).is_err() {
+            return coarse;
+        }
+        match self.grid_route(map, ends, h0, h0, deadline) {
+            Ok(mut fine) if fine.length() < coarse.length() => {
+                fine.add_expanded(coarse.expanded_count());
+                fine
+            }
+            Ok(fine) => {
+                let mut coarse = coarse;
+                coarse.add_expanded(fine.expanded_count());
+                coarse
+            }
+            Err(_) => coarse,
+        }
     }
 
     /// A* on a grid of cells of size `h` (coarsened up to `h_max` to fit `max_cells`) between

@@ -57,12 +57,12 @@ pub struct Blocked {
 }
 
 impl GlobalRoute {
-    /// Builds a route from its points (at least one; the planner guarantees it).
-    /// Adds `n` to the expansion count (cells a coarser search expanded before this one).
+    /// Adds `n` to the expansion count (cells another search expanded besides this one).
     pub(crate) fn add_expanded(&mut self, n: usize) {
         self.expanded_count += n;
     }
 
+    /// Builds a route from its points (at least one; the planner guarantees it).
     pub(crate) fn new(
         points: Vec<Vec3>,
         clearance_m: f64,

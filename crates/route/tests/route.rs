@@ -491,3 +491,57 @@ fn a_world_too_large_for_the_fine_grid_is_routed_on_the_coarse_one() {
     assert_clear(&map, &route);
     assert!(route.points().iter().any(|p| p.y < 15.0 || p.y > 45.0));
 }
+
+/// A 12 × 10 × 3 m store with three staggered full-height shelving rows 2.4 m apart (holdout
+/// finding: the coarse grid closed the aisles and its route went round the rows).
+fn store() -> StaticMap {
+    StaticMap::from_shapes(
+        bounds([12.0, 10.0, 3.0]),
+        vec![
+            aabox([3.5, 2.0, 0.0], [4.1, 7.0, 3.0]),
+            aabox([6.5, 3.0, 0.0], [7.1, 8.0, 3.0]),
+            aabox([9.5, 2.0, 0.0], [10.1, 7.0, 3.0]),
+            Cylinder::new(Vec3::new(2.0, 8.0, 1.5), 0.15, 1.5)
+                .unwrap()
+                .into(),
+            Cylinder::new(Vec3::new(8.3, 1.4, 1.5), 0.15, 1.5)
+                .unwrap()
+                .into(),
+        ],
+    )
+    .unwrap()
+}
+
+#[test]
+fn a_small_world_is_refined_on_the_fine_grid_through_passages_the_coarse_one_closes() {
+    let map = store();
+    let (s, g) = (Vec3::new(7.87, 6.69, 1.15), Vec3::new(1.15, 1.46, 2.05));
+    let refined = planner().plan(&map, &s, &g, 0.22).unwrap();
+    let coarse_only = RoutePlanner::new(RouteParams {
+        refine_max_cells: 0,
+        ..RouteParams::default()
+    })
+    .unwrap()
+    .plan(&map, &s, &g, 0.22)
+    .unwrap();
+    assert_clear(&map, &refined);
+    assert_clear(&map, &coarse_only);
+    // Down the aisle between the second and third rows, then past the first row's end: 10.6 m
+    // at the clearance; round the rows' far ends: 15.6 m.
+    assert!(
+        refined.length() < 11.5 && coarse_only.length() > 14.0,
+        "refined {} m, coarse only {} m",
+        refined.length(),
+        coarse_only.length()
+    );
+    assert!(refined.expanded_count() > coarse_only.expanded_count());
+    // A refinement cap below the fine grid's size keeps the coarse route.
+    let capped = RoutePlanner::new(RouteParams {
+        refine_max_cells: 10_000,
+        ..RouteParams::default()
+    })
+    .unwrap()
+    .plan(&map, &s, &g, 0.22)
+    .unwrap();
+    assert_eq!(capped.points(), coarse_only.points());
+}
