@@ -401,12 +401,23 @@ pub fn fly(
     let mut given = ForecastHistory::new();
     let remember_s = 2.0 * planner.manager.horizon_s;
     let growth_s = planner.manager.forecast_growth();
+    let regions = obstacle_walls(world);
     let mut step = 0u64;
     let mut t = 0.0;
     while ended.is_none() {
         // Plan.
         if step.is_multiple_of(replan_steps) {
-            let forecasts = sensing.forecasts(t)?;
+            // Each forecast knows the box its obstacle stays inside when that is not the map
+            // (a scenario's obstacle region, where the traffic turns it back).
+            let forecasts: Vec<Forecast> = sensing
+                .forecasts(t)?
+                .into_iter()
+                .zip(sensing.tracked_ids())
+                .map(|(f, id)| match regions.get(id).copied().flatten() {
+                    Some(region) => f.with_walls(region),
+                    None => f,
+                })
+                .collect();
             given.push_back((
                 t,
                 sensing
@@ -691,8 +702,17 @@ fn branch_samples(manager: &AnyManager) -> Vec<BranchSamples> {
         .collect()
 }
 
-/// The cycle's forecasts as the log records them; `ids[i]` is the obstacle of `forecasts[i]`
-/// (`trust_world::sensing::Sensing::tracked_ids`).
+/// By obstacle, the box it is known to stay inside when that is not the map: the region of a
+/// moving obstacle that the traffic turns back at its walls ([`Forecast::walls`]). `None` for
+/// an obstacle whose region is the world and for scripted ones (a script does not reflect).
+fn obstacle_walls(world: &World) -> Vec<Option<trust_predict::Aabb>> {
+    world
+        .obstacles()
+        .iter()
+        .map(|o| (!o.motion.is_scripted() && o.region != *world.bounds()).then_some(o.region))
+        .collect()
+}
+
 /// Forecasts by cycle: (cycle time, forecasts by obstacle id), oldest first.
 type ForecastHistory = std::collections::VecDeque<(f64, Vec<(usize, Forecast)>)>;
 
@@ -712,7 +732,7 @@ fn forecast_warning(
             (centre - g.center(t_contact)).norm() <= g.inflation(t_contact) - vehicle_radius
         };
         within(f)
-            || trust_predict::wall_images(f, walls, f.t0, t_contact)
+            || trust_predict::wall_images(f, f.walls.as_ref().unwrap_or(walls), f.t0, t_contact)
                 .iter()
                 .any(within)
     };
@@ -799,6 +819,24 @@ mod tests {
 
     fn walls() -> Aabb {
         Aabb::new(Vec3::zeros(), Vec3::new(100.0, 10.0, 10.0)).unwrap()
+    }
+
+    #[test]
+    fn forecasts_know_the_region_their_obstacle_turns_back_in() {
+        let text = "name = \"regions\"\n[world]\nbounds = { min = [0, 0, 0], max = [60, 20, 10] }\n\
+            [mission]\nstart = [2, 10, 5]\ngoal = [58, 10, 5]\n\
+            [[random_obstacles]]\ncount = 2\nspeed_m_s = [0.5, 1.0]\nregion = { min = [8, 0, 0], max = [52, 20, 10] }\n\
+            [[random_obstacles]]\ncount = 1\nspeed_m_s = [0.5, 1.0]\n\
+            [[obstacles]]\nshape = \"sphere\"\nradius_m = 0.5\nposition = [30, 5, 5]\nvelocity = [0, 1, 0]\n";
+        let s =
+            trust_world::scenario::Scenario::from_toml_str(text, std::path::Path::new("r.toml"))
+                .unwrap();
+        let world = World::build(&s).unwrap();
+        let walls = obstacle_walls(&world);
+        let region = Aabb::new(Vec3::new(8.0, 0.0, 0.0), Vec3::new(52.0, 20.0, 10.0)).unwrap();
+        assert_eq!(walls.len(), 4);
+        assert_eq!(walls.iter().filter(|w| **w == Some(region)).count(), 2);
+        assert_eq!(walls.iter().filter(|w| w.is_none()).count(), 2);
     }
 
     /// The warning for obstacle `id` truly at `(x, 5, 5)` at contact time 2 s, far from walls.

@@ -1110,17 +1110,20 @@ fn max_jerk(traj: &PolyTraj) -> f64 {
     worst
 }
 
-/// `forecasts` followed by their mirror images at the `walls` over `[from, until]`
-/// ([`trust_predict::wall_images`]).
+/// `forecasts` followed by their mirror images over `[from, until]`
+/// ([`trust_predict::wall_images`]) at the walls of the box each obstacle is known to stay
+/// inside ([`Forecast::walls`]), or else at the map's `bounds`.
 fn with_wall_images(
     mut forecasts: Vec<Forecast>,
-    walls: &trust_predict::Aabb,
+    bounds: &trust_predict::Aabb,
     from: f64,
     until: f64,
 ) -> Vec<Forecast> {
     let images: Vec<Forecast> = forecasts
         .iter()
-        .flat_map(|f| trust_predict::wall_images(f, walls, from, until))
+        .flat_map(|f| {
+            trust_predict::wall_images(f, f.walls.as_ref().unwrap_or(bounds), from, until)
+        })
         .collect();
     forecasts.extend(images);
     forecasts

@@ -582,6 +582,35 @@ fn an_obstacle_turning_at_a_wall_is_expected_back() {
     assert!(!plan_kept(true));
 }
 
+/// An obstacle known to stay inside a region (`Forecast::walls`, a scenario's obstacle
+/// region) turns at the region's wall y = 5 in open air, 5 m inside the map's wall: walking at
+/// 5/3 m/s from y = 3 it turns at y = 4 (t = 0.6 s) and is back on the blind plan's line at
+/// x = 29 when the vehicle gets there (t = 3 s); its constant-velocity forecast is at y = 8. The
+/// manager mirrors it at its region's walls, not only at the map's.
+#[test]
+fn an_obstacle_turning_at_its_region_wall_is_expected_back() {
+    let walker = Forecast::new(
+        ObstacleShape::Sphere,
+        Vec3::new(29.0, 3.0, 5.0),
+        Vec3::new(0.0, 5.0 / 3.0, 0.0),
+        0.0,
+        1.0,
+        0.3,
+        0.0,
+    )
+    .unwrap();
+    let region = Aabb::new(Vec3::new(20.0, -10.0, 0.0), Vec3::new(40.0, 5.0, 10.0)).unwrap();
+    let params = ManagerParams::single_branch;
+    assert!(straight_plan_kept(params(), walker));
+    assert!(!straight_plan_kept(params(), walker.with_walls(region)));
+    // Without wall images the region is not used either.
+    let no_images = ManagerParams {
+        wall_images: false,
+        ..params()
+    };
+    assert!(straight_plan_kept(no_images, walker.with_walls(region)));
+}
+
 /// Whether a single-branch manager cruising at 8 m/s along y = 0 toward x = 95 past `obstacle`
 /// (open air) keeps the straight branch in its first cycle.
 fn straight_plan_kept(params: ManagerParams, obstacle: Forecast) -> bool {

@@ -69,6 +69,12 @@ pub struct Forecast {
     /// model) for ever. Absent from serialized forecasts that grow for ever.
     #[serde(default = "forever", skip_serializing_if = "is_forever")]
     pub growth_s: f64,
+    /// The box the obstacle is known to stay inside, turning at its walls (beyond the paper): a
+    /// prior the world gives, as the map's bounds are for every obstacle. The manager mirrors
+    /// the forecast at these walls ([`crate::wall_images`]) instead of the map's. `None` (the
+    /// default, absent when serialized): only the map's bounds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub walls: Option<Aabb>,
 }
 
 fn forever() -> f64 {
@@ -103,6 +109,7 @@ impl Forecast {
             r_safe,
             mu,
             growth_s: f64::INFINITY,
+            walls: None,
         };
         f.validate()?;
         Ok(f)
@@ -181,6 +188,15 @@ impl Forecast {
     pub fn with_growth_for(&self, seconds: f64) -> Forecast {
         Forecast {
             growth_s: self.growth_s.min(seconds),
+            ..*self
+        }
+    }
+
+    /// This forecast with the box the obstacle stays inside ([`Forecast::walls`]).
+    #[inline]
+    pub fn with_walls(&self, walls: Aabb) -> Forecast {
+        Forecast {
+            walls: Some(walls),
             ..*self
         }
     }
@@ -357,6 +373,23 @@ mod tests {
         assert_eq!(serde_json::from_str::<Forecast>(&json).unwrap(), g);
         let json = serde_json::to_string(&f).unwrap();
         assert_eq!(serde_json::from_str::<Forecast>(&json).unwrap(), f);
+    }
+
+    #[test]
+    fn the_walls_an_obstacle_stays_inside_are_optional_and_round_trip() {
+        let f = Forecast::sphere(Vec3::zeros(), Vec3::x(), 1.0, 0.5, 0.2, 0.4).unwrap();
+        assert_eq!(f.walls, None);
+        let json = serde_json::to_string(&f).unwrap();
+        assert!(!json.contains("walls"), "{json}");
+        let region = Aabb::new(Vec3::new(-5.0, -5.0, 0.0), Vec3::new(5.0, 5.0, 3.0)).unwrap();
+        let w = f.with_walls(region);
+        assert_eq!(w.walls, Some(region));
+        assert_eq!(w.radius(3.0), f.radius(3.0));
+        let json = serde_json::to_string(&w).unwrap();
+        assert_eq!(serde_json::from_str::<Forecast>(&json).unwrap(), w);
+        // The images at the walls keep them.
+        let images = crate::wall_images(&w, &region, 1.0, 10.0);
+        assert!(!images.is_empty() && images.iter().all(|i| i.walls == Some(region)));
     }
 
     use super::*;

@@ -215,6 +215,7 @@ mod tests {
             r_safe: 0.0,
             mu: 0.0,
             growth_s: f64::INFINITY,
+            walls: None,
         }
     }
 

@@ -102,6 +102,7 @@ fn tvd_equivalent_rejects_a_forecast_with_negative_r_safe() {
         r_safe: -1.0,
         mu: 0.0,
         growth_s: f64::INFINITY,
+        walls: None,
     }];
     let scene = Scene {
         map: &map,
