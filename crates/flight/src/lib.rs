@@ -24,7 +24,10 @@
 //! # Changelog
 //!
 //! - Issue 19: cycle records carry the route the manager planned (`route`, `route_ms`) and a
-//!   fallback's shortfall (`fallback_shortfall_m`).
+//!   fallback's shortfall (`fallback_shortfall_m`). The forecasts the manager gets carry their
+//!   obstacle's region when it is not the world (`trust_predict::Forecast::walls`: the traffic
+//!   turns the obstacle back at its walls), and the logged forecasts the growth stop
+//!   (`ForecastRecord::growth_s`).
 //! - Moved out of `trust-sim` (issue 17): `trust_sim::run::{fly, header, RunOptions, RunSummary,
 //!   Flight, FlightRecord}` are at this crate's root.
 //! - `trust_sim::error::SimError` is split by stage; this crate's errors are [`FlightError`]s
