@@ -412,20 +412,20 @@ pub fn fly(
         if step.is_multiple_of(replan_steps) {
             // Each forecast knows the box its obstacle stays inside when that is not the map
             // (a scenario's obstacle region, where the traffic turns it back).
+            let ids = sensing.tracked_ids();
             let forecasts: Vec<Forecast> = sensing
                 .forecasts(t)?
                 .into_iter()
-                .zip(sensing.tracked_ids())
-                .map(|(f, id)| match regions.get(id).copied().flatten() {
+                .zip(&ids)
+                .map(|(f, &id)| match regions.get(id).copied().flatten() {
                     Some(region) => f.with_walls(region),
                     None => f,
                 })
                 .collect();
             given.push_back((
                 t,
-                sensing
-                    .tracked_ids()
-                    .into_iter()
+                ids.iter()
+                    .copied()
                     .zip(forecasts.iter().map(|f| f.with_growth_for(growth_s)))
                     .collect(),
             ));
@@ -469,11 +469,7 @@ pub fn fly(
                         cycle_record(&report, manager.route(), effective, options.zero_timing);
                     if options.log_branches {
                         record.branch_samples = Some(branch_samples(&manager));
-                        record.forecasts = Some(forecast_records(
-                            &sensing.tracked_ids(),
-                            &forecasts,
-                            growth_s,
-                        ));
+                        record.forecasts = Some(forecast_records(&ids, &forecasts, growth_s));
                     }
                     log.cycle(record)?;
                 }
