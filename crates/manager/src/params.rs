@@ -33,7 +33,9 @@ pub struct ManagerParams {
     /// adds the mirror images of every forecast at the bounds' walls over twice the horizon
     /// ([`trust_predict::wall_images`]), so a person walking at a room's wall is expected back
     /// along the reflected line (beyond the paper). A constant-velocity forecast walks them through
-    /// the wall, and a vehicle crossing behind them meets them on their way back. Default `true`.
+    /// the wall, and a vehicle crossing behind them meets them on their way back. A forecast
+    /// that knows the box its obstacle stays inside ([`trust_predict::Forecast::walls`], e.g. a
+    /// scenario's obstacle region) is mirrored at that box's walls instead. Default `true`.
     pub wall_images: bool,
     /// How long each forecast's uncertainty grows before it stops (s, beyond the paper;
     /// [`trust_predict::Forecast::with_growth_for`]); `None`: a quarter of the horizon (1 s at
