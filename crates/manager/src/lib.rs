@@ -66,7 +66,7 @@
 //! - Issue 19 (beyond the paper): [`Manager::set_router`] gives the manager a [`Router`]; it plans
 //!   its global route on the first cycle toward a goal and after a stall (events `Rerouted`,
 //!   `RouteFailed`; [`CycleTiming::route_ms`]) and aims at the route's local goal or a sharp corner
-//!   before it. The fallback also weighs rejected trajectories flown as they are (`evade`) and
+//!   before it that hides the route beyond (else the farthest route point in sight past it). The fallback also weighs rejected trajectories flown as they are (`evade`) and
 //!   [`escape_maneuvers`] (`escape`), and reports `FallbackReport::shortfall_m`.
 //! - `Manager::step` follows Algorithm 1 step by step (`fwd_march`, `bwd_replan`, `fwd_explore`,
 //!   the safety pass, `add_new_branch` with `pop_back`, the main-branch choice and the fallback);

@@ -121,6 +121,30 @@ struct Candidate {
 /// ([`trust_route::GlobalRoute::first_sharp_turn`]; beyond the paper).
 const SHARP_TURN_RAD: f64 = std::f64::consts::FRAC_PI_3;
 
+/// What a vehicle at `from` (arc length `s0` on `route`) aims at when the route turns sharply
+/// at `corner` before the aim `ahead`: the farthest route point up to `ahead` in sight at
+/// `clearance` when that lies more than `reach` past the corner, else the corner itself (the
+/// corner hides the route beyond it: a shaft's entrance).
+#[allow(clippy::too_many_arguments)]
+fn aim_past_corner(
+    route: &GlobalRoute,
+    map: &StaticMap,
+    from: &Vec3,
+    s0: f64,
+    corner: RoutePoint,
+    ahead: RoutePoint,
+    clearance: f64,
+    reach: f64,
+) -> RoutePoint {
+    let seen = route.last_in_sight(map, from, s0, ahead, clearance);
+    // `last_in_sight` returns `ahead` unseen when the vehicle is off its route.
+    if seen.s > corner.s + reach && map.segment_clear(from, &seen.point, clearance) {
+        seen
+    } else {
+        corner
+    }
+}
+
 /// Whether `v` failed by at most `margin` (m) of clearance, or only on the limits.
 fn narrowly_unsafe(v: &SafetyVerdict, margin: f64) -> bool {
     !v.safe
@@ -296,7 +320,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     }
 
     /// Where this cycle's branches aim from `from`: the route's local goal
-    /// ([`Manager::set_route`]), or `goal` without a route, near the route's end, or when the
+    /// ([`Manager::set_route`]), or a sharp corner before it that hides the route beyond
+    /// ([`aim_past_corner`]), or `goal` without a route, near the route's end, or when the
     /// route cannot be queried. While `stalled`, the farthest route point before it that is in
     /// sight from `from` ([`trust_route::GlobalRoute::last_in_sight`]).
     fn aim(&self, from: &Vec3, goal: &Vec3, stalled: bool, map: &StaticMap) -> Vec3 {
@@ -310,17 +335,33 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let Ok(local) = route.local_goal_from(s0, horizon_m) else {
             return *goal;
         };
-        // A sharp corner before the local goal is aimed at first (a shaft entrance: the pieces
-        // of a trajectory aimed beyond it cut through the slab). The vehicle is at the corner
-        // once within its clearance of it; then the aim moves on.
-        let at_corner = s0 + route.clearance_m().max(self.params.goal_reached_m);
-        let target = match route.first_sharp_turn(at_corner, local.s, SHARP_TURN_RAD) {
-            Some(corner) => corner,
-            None if route.length() - local.s > 1e-9 => local,
-            None => RoutePoint {
+        let ahead = if route.length() - local.s > 1e-9 {
+            local
+        } else {
+            RoutePoint {
                 s: route.length(),
                 point: *goal,
-            },
+            }
+        };
+        // A sharp corner before the local goal is aimed at first when it hides what lies
+        // beyond (a shaft entrance: the pieces of a trajectory aimed beyond it cut through the
+        // slab). The vehicle is at the corner once within its clearance of it; then the aim
+        // moves on. A corner that hides nothing — the route beyond it is in sight at the
+        // safety clearance — is not: aimed at, the plan ended at rest on it (a forest's route
+        // turning by 61° stopped the vehicle there, 10 m/s to 1.4 m/s).
+        let reach = route.clearance_m().max(self.params.goal_reached_m);
+        let target = match route.first_sharp_turn(s0 + reach, ahead.s, SHARP_TURN_RAD) {
+            Some(corner) => aim_past_corner(
+                route,
+                map,
+                from,
+                s0,
+                corner,
+                ahead,
+                self.params.safety.static_clearance_m,
+                reach,
+            ),
+            None => ahead,
         };
         if !stalled {
             return target.point;
@@ -1527,6 +1568,70 @@ mod tests {
         assert!(!narrowly_unsafe(&verdict(false, Some(-0.2)), 0.05));
         assert!(narrowly_unsafe(&verdict(false, None), 0.05), "limits only");
         assert!(!narrowly_unsafe(&verdict(false, Some(f64::NAN)), 0.05));
+    }
+
+    #[test]
+    fn a_sharp_corner_is_aimed_at_only_while_it_hides_the_route_beyond() {
+        use trust_core::Aabb;
+        use trust_geometry::{AaBox, Shape};
+        let v = Vec3::new;
+        let slab = |min: Vec3, max: Vec3| Shape::AaBox(AaBox { min, max });
+        let bounds = Aabb::new(v(-1.0, -5.0, 0.0), v(20.0, 15.0, 10.0)).unwrap();
+        // A route along x turning by 90° at (10, 0, 2) to +y; the vehicle at (4, 0, 2).
+        let route = GlobalRoute::from_points(vec![
+            v(0.0, 0.0, 2.0),
+            v(10.0, 0.0, 2.0),
+            v(10.0, 10.0, 2.0),
+        ])
+        .unwrap();
+        let corner = RoutePoint {
+            s: 10.0,
+            point: v(10.0, 0.0, 2.0),
+        };
+        let ahead = RoutePoint {
+            s: 16.0,
+            point: v(10.0, 6.0, 2.0),
+        };
+        let from = v(4.0, 0.0, 2.0);
+        let aim = |map: &StaticMap, s0: f64| {
+            aim_past_corner(&route, map, &from, s0, corner, ahead, 0.3, 0.3)
+        };
+        // Nothing hides the route beyond the corner: aim past it, at `ahead`.
+        let open = StaticMap::empty(bounds).unwrap();
+        assert_eq!(aim(&open, 4.0).point, ahead.point);
+        // The route turns round the end of a wall along its left: the corner first.
+        let wall = StaticMap::from_shapes(bounds, vec![slab(v(-1.0, 0.5, 0.0), v(9.5, 1.0, 10.0))])
+            .unwrap();
+        assert_eq!(aim(&wall, 4.0).point, corner.point);
+        // Off the route (its point at `s0` behind a wall, so `last_in_sight` gives up and
+        // returns `ahead`, which the wall hides from the vehicle): still the corner.
+        let off = wall
+            .clone()
+            .with_shapes(vec![slab(v(2.0, -5.0, 0.0), v(3.0, 0.4, 10.0))])
+            .unwrap();
+        assert_eq!(aim(&off, 0.5).point, corner.point);
+        // A shaft through a slab at z ∈ [4, 5] above the corner: the aim is what is in sight
+        // past the corner, up to the slab's hole, not the hidden shaft above it.
+        let shaft_route =
+            GlobalRoute::from_points(vec![v(0.0, 0.0, 2.0), v(10.0, 0.0, 2.0), v(10.0, 0.0, 9.0)])
+                .unwrap();
+        let shaft = StaticMap::from_shapes(
+            bounds,
+            vec![
+                slab(v(-1.0, -5.0, 4.0), v(9.0, 15.0, 5.0)),
+                slab(v(11.0, -5.0, 4.0), v(20.0, 15.0, 5.0)),
+                slab(v(9.0, -5.0, 4.0), v(11.0, -1.0, 5.0)),
+                slab(v(9.0, 1.0, 4.0), v(11.0, 15.0, 5.0)),
+            ],
+        )
+        .unwrap();
+        let up = RoutePoint {
+            s: 16.0,
+            point: v(10.0, 0.0, 8.0),
+        };
+        let a = aim_past_corner(&shaft_route, &shaft, &from, 4.0, corner, up, 0.3, 0.3);
+        assert!(a.s > corner.s && a.point.z < 4.5, "{a:?}");
+        assert!(shaft.segment_clear(&from, &a.point, 0.3));
     }
 
     #[test]
