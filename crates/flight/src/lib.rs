@@ -746,7 +746,8 @@ fn forecast_warning(
 }
 
 /// The cycle's forecasts as logged: as sensed, with the growth stop the manager applies to them
-/// before planning (`growth_s`, absent when they grow for ever).
+/// before planning (`growth_s`, absent when they grow for ever) and the region whose walls the
+/// manager mirrors them at (`walls`, absent at the world's bounds).
 fn forecast_records(ids: &[usize], forecasts: &[Forecast], growth_s: f64) -> Vec<ForecastRecord> {
     ids.iter()
         .zip(forecasts)
@@ -764,6 +765,7 @@ fn forecast_records(ids: &[usize], forecasts: &[Forecast], growth_s: f64) -> Vec
                 },
             },
             growth_s: growth_s.is_finite().then_some(growth_s),
+            walls: f.walls.as_ref().map(|w| [v3(&w.min), v3(&w.max)]),
         })
         .collect()
 }
@@ -836,6 +838,41 @@ mod tests {
         assert_eq!(walls.len(), 4);
         assert_eq!(walls.iter().filter(|w| **w == Some(region)).count(), 2);
         assert_eq!(walls.iter().filter(|w| w.is_none()).count(), 2);
+    }
+
+    #[test]
+    fn logged_forecasts_carry_their_region_and_growth_stop() {
+        let f = Forecast::new(
+            ObstacleShape::Sphere,
+            Vec3::new(1.0, 5.0, 5.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            0.0,
+            0.2,
+            0.3,
+            0.5,
+        )
+        .unwrap();
+        let region = Aabb::new(Vec3::new(2.0, 0.0, 0.0), Vec3::new(8.0, 6.0, 3.0)).unwrap();
+        let records = forecast_records(&[4, 7], &[f.with_walls(region), f], 1.0);
+        assert_eq!(records[0].id, 4);
+        assert_eq!(records[0].walls, Some([[2.0, 0.0, 0.0], [8.0, 6.0, 3.0]]));
+        assert_eq!(records[0].growth_s, Some(1.0));
+        assert_eq!(records[1].walls, None);
+        let grows = forecast_records(&[4], &[records_forecast()], f64::INFINITY);
+        assert_eq!(grows[0].growth_s, None);
+    }
+
+    fn records_forecast() -> Forecast {
+        Forecast::new(
+            ObstacleShape::Sphere,
+            Vec3::zeros(),
+            Vec3::zeros(),
+            0.0,
+            0.2,
+            0.3,
+            0.5,
+        )
+        .unwrap()
     }
 
     /// The warning for obstacle `id` truly at `(x, 5, 5)` at contact time 2 s, far from walls.

@@ -185,7 +185,8 @@
       return { r: info.radius };
     }
     // f = [id, x, y, z, vx, vy, vz, t0, r0, mu, half_height (0: sphere),
-    //      growth_s (null: grows for ever)]
+    //      growth_s (null: grows for ever), walls ([min, max] of the region the planner mirrors
+    //      the forecast in; null: the world's bounds)]
     function forecastAt(f, t) {
       var dt = Math.max(0, t - f[7]);
       var c = [f[1] + f[4] * dt, f[2] + f[5] * dt, f[3] + f[6] * dt];
@@ -238,6 +239,16 @@
       var cyc = ci >= 0 ? C[ci] : null;
       // forecasts: now (solid) and 1 s, 2 s ahead (fading), centre line from t0
       if (cyc && cyc.forecasts) {
+        var regions = {};
+        cyc.forecasts.forEach(function (f) {
+          if (!f[12]) { return; }
+          var key = JSON.stringify(f[12]);
+          if (regions[key]) { return; }
+          regions[key] = true;
+          g.setLineDash([6, 4]);
+          v.rect(g, f[12][0], f[12][1], null, COLORS.forecast, 1);
+          g.setLineDash([]);
+        });
         cyc.forecasts.forEach(function (f) {
           var now = forecastAt(f, t);
           [2, 1].forEach(function (ahead) {
@@ -339,7 +350,11 @@
     var legend = document.getElementById('legend');
     [['flown path', COLORS.path], ['vehicle', COLORS.vehicle], ['main branch', COLORS.main], ['other branches', COLORS.other],
       ['obstacles (truth)', COLORS.truthEdge], ['forecasts: now, +1 s, +2 s', COLORS.forecast], ['static obstacles', COLORS.static],
+      ['obstacle regions (forecasts mirrored at their walls)', COLORS.forecast],
       ['global route', COLORS.route], ['goal', COLORS.goal]].filter(function (e) {
+      if (e[0].indexOf('obstacle regions') === 0) {
+        return C.some(function (c) { return (c.forecasts || []).some(function (f) { return !!f[12]; }); });
+      }
       return e[0] !== 'global route' || H.route || C.some(function (c) { return !!c.route; });
     }).forEach(function (e) {
       var li = document.createElement('li'); li.textContent = e[0]; li.style.setProperty('--c', e[1]); legend.appendChild(li);

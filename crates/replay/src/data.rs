@@ -148,8 +148,9 @@ fn forecast_is_near(
 }
 
 /// A forecast as the page reads it:
-/// `[id, x, y, z, vx, vy, vz, t0, r0, mu, half_height, growth_s]` (`half_height` 0 for a sphere,
-/// `growth_s` `null` when the radius grows for ever).
+/// `[id, x, y, z, vx, vy, vz, t0, r0, mu, half_height, growth_s, walls]` (`half_height` 0 for a
+/// sphere, `growth_s` `null` when the radius grows for ever, `walls` `[min, max]` of the region
+/// the planner mirrors the forecast in, `null` at the world's bounds).
 fn compact_forecast(f: &ForecastRecord) -> Value {
     let hh = match f.shape {
         ForecastShape::Sphere => 0.0,
@@ -167,7 +168,11 @@ fn compact_forecast(f: &ForecastRecord) -> Value {
         f.r0,
         f.mu,
         hh,
-        f.growth_s.map_or(Value::Null, num)
+        f.growth_s.map_or(Value::Null, num),
+        f.walls.map_or(Value::Null, |[lo, hi]| json!([
+            [num(lo[0]), num(lo[1]), num(lo[2])],
+            [num(hi[0]), num(hi[1]), num(hi[2])]
+        ]))
     ])
 }
 

@@ -132,6 +132,11 @@ pub fn write_top_view_gif(
         .map(|c| serde_json::to_value(c).ok().and_then(|v| route_of(&v)))
         .collect();
     let has_route = header_route.is_some() || cycle_routes.iter().any(Option::is_some);
+    let has_regions = log.cycles.iter().any(|c| {
+        c.forecasts
+            .as_ref()
+            .is_some_and(|fs| fs.iter().any(|f| f.walls.is_some()))
+    });
     let states = &log.states;
     let times = frame_times(states[0].t, states[states.len() - 1].t, params);
     let truth_color = Color::rgb(204, 51, 17);
@@ -215,6 +220,46 @@ pub fn write_top_view_gif(
                 .alpha(0.9, 0.9)
                 .label("forecasts"),
         );
+        if has_regions {
+            // The regions whose walls the planner mirrors the forecasts at (one outline each;
+            // an empty entry keeps the legend, and so the frame size, the same in every frame).
+            let mut outlines: Vec<[[f64; 3]; 2]> = Vec::new();
+            for w in cycle
+                .and_then(|c| c.forecasts.as_ref())
+                .into_iter()
+                .flatten()
+                .filter_map(|f| f.walls)
+            {
+                if !outlines.contains(&w) {
+                    outlines.push(w);
+                }
+            }
+            if outlines.is_empty() {
+                view = view.polyline(
+                    Polyline::new(Vec::new())
+                        .color(forecast_color)
+                        .width_px(1)
+                        .dashed()
+                        .label("obstacle regions"),
+                );
+            }
+            for [lo, hi] in outlines {
+                let outline = vec![
+                    Point2::new(lo[0], lo[1]),
+                    Point2::new(hi[0], lo[1]),
+                    Point2::new(hi[0], hi[1]),
+                    Point2::new(lo[0], hi[1]),
+                    Point2::new(lo[0], lo[1]),
+                ];
+                view = view.polyline(
+                    Polyline::new(outline)
+                        .color(forecast_color)
+                        .width_px(1)
+                        .dashed()
+                        .label("obstacle regions"),
+                );
+            }
+        }
         let branches = cycle.and_then(|c| c.branch_samples.as_ref());
         let line = |b: &trust_runlog::BranchSamples| -> Vec<Point2<f64>> {
             b.samples.iter().map(|q| Point2::new(q[1], q[2])).collect()

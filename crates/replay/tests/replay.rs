@@ -150,6 +150,7 @@ fn write_log(path: &Path, t_end: f64, with_branches: bool) {
                             mu: 0.2,
                             shape: ForecastShape::Cylinder { half_height: 1.1 },
                             growth_s: Some(1.0),
+                            walls: Some([[2.0, 0.0, 0.0], [8.0, 8.0, 3.0]]),
                         },
                         ForecastRecord {
                             id: 1,
@@ -160,6 +161,7 @@ fn write_log(path: &Path, t_end: f64, with_branches: bool) {
                             mu: 0.2,
                             shape: ForecastShape::Sphere,
                             growth_s: None,
+                            walls: None,
                         },
                     ]
                 }),
@@ -232,12 +234,17 @@ fn the_page_is_self_contained_and_embeds_valid_json() {
         cycles[0]["branches"][0],
         serde_json::json!([[1.0, 5.0, 1.0], [5.0, 5.0, 1.0]])
     );
-    // [id, p0, v0, t0, r0, mu, half_height, growth_s]; obstacle 1 (4 m from the vehicle at
-    // t = 0) is near.
+    // [id, p0, v0, t0, r0, mu, half_height, growth_s, walls]; obstacle 1 (4 m from the vehicle
+    // at t = 0) is near.
     assert_eq!(cycles[0]["forecasts"][0][10], 1.1);
     assert_eq!(cycles[0]["forecasts"][0][11], 1.0);
+    assert_eq!(
+        cycles[0]["forecasts"][0][12],
+        serde_json::json!([[2.0, 0.0, 0.0], [8.0, 8.0, 3.0]])
+    );
     assert_eq!(cycles[0]["forecasts"][1][0], 1);
     assert!(cycles[0]["forecasts"][1][11].is_null());
+    assert!(cycles[0]["forecasts"][1][12].is_null());
     // Clearances recomputed from the states, both finite and positive at the start.
     assert!(data["states"]["clear"][0][0].as_f64().unwrap() > 0.0);
     assert!(data["states"]["clear"][0][1].as_f64().unwrap() > 0.0);

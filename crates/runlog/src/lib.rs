@@ -291,6 +291,12 @@ pub struct ForecastRecord {
     /// written before the field, or `forecast_growth_s = inf`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub growth_s: Option<f64>,
+    /// The region the obstacle's traffic turns it back in, `[min, max]` corners (added, issue
+    /// 19): the planner mirrors the forecast at these walls (`trust_predict::Forecast::walls`).
+    /// Absent: at the world's bounds (the obstacle has no region of its own, or logs written
+    /// before the field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub walls: Option<[[f64; 3]; 2]>,
 }
 
 impl ForecastRecord {
@@ -853,6 +859,7 @@ mod tests {
                 mu: 0.3,
                 shape: ForecastShape::Cylinder { half_height: 1.7 },
                 growth_s: Some(1.0),
+                walls: Some([[2.0, 0.0, 0.0], [8.0, 6.0, 3.0]]),
             },
             ForecastRecord {
                 id: 2,
@@ -863,6 +870,7 @@ mod tests {
                 mu: 0.0,
                 shape: ForecastShape::Sphere,
                 growth_s: None,
+                walls: None,
             },
         ]);
         let on = serde_json::to_string(&Record::Cycle(c.clone())).unwrap();
