@@ -842,37 +842,15 @@ mod tests {
 
     #[test]
     fn logged_forecasts_carry_their_region_and_growth_stop() {
-        let f = Forecast::new(
-            ObstacleShape::Sphere,
-            Vec3::new(1.0, 5.0, 5.0),
-            Vec3::new(1.0, 0.0, 0.0),
-            0.0,
-            0.2,
-            0.3,
-            0.5,
-        )
-        .unwrap();
+        let f = given(1.0, 0.0)[0].1[0].1;
         let region = Aabb::new(Vec3::new(2.0, 0.0, 0.0), Vec3::new(8.0, 6.0, 3.0)).unwrap();
         let records = forecast_records(&[4, 7], &[f.with_walls(region), f], 1.0);
         assert_eq!(records[0].id, 4);
         assert_eq!(records[0].walls, Some([[2.0, 0.0, 0.0], [8.0, 6.0, 3.0]]));
         assert_eq!(records[0].growth_s, Some(1.0));
         assert_eq!(records[1].walls, None);
-        let grows = forecast_records(&[4], &[records_forecast()], f64::INFINITY);
+        let grows = forecast_records(&[4], &[f], f64::INFINITY);
         assert_eq!(grows[0].growth_s, None);
-    }
-
-    fn records_forecast() -> Forecast {
-        Forecast::new(
-            ObstacleShape::Sphere,
-            Vec3::zeros(),
-            Vec3::zeros(),
-            0.0,
-            0.2,
-            0.3,
-            0.5,
-        )
-        .unwrap()
     }
 
     /// The warning for obstacle `id` truly at `(x, 5, 5)` at contact time 2 s, far from walls.
