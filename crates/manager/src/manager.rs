@@ -137,8 +137,10 @@ fn aim_past_corner(
     reach: f64,
 ) -> RoutePoint {
     let seen = route.last_in_sight(map, from, s0, ahead, clearance);
-    // `last_in_sight` returns `ahead` unseen when the vehicle is off its route.
-    if seen.s > corner.s + reach && map.segment_clear(from, &seen.point, clearance) {
+    // A point short of `ahead` was checked in sight; `ahead` itself may come back unseen when
+    // the vehicle is off its route.
+    let in_sight = seen.s < ahead.s || map.segment_clear(from, &seen.point, clearance);
+    if seen.s > corner.s + reach && in_sight {
         seen
     } else {
         corner

@@ -83,7 +83,8 @@ fn check(params: &GifParams) -> Result<(), ReplayError> {
 
 /// Writes the top view of `log`'s flight (read from a file in `log_dir`) as an animated GIF at
 /// `path`: per frame the static geometry, the flown path so far, the true obstacles, the
-/// forecasts of the latest cycle at their current radius, its branches (main thick, the others
+/// forecasts of the latest cycle at their current radius (and dashed the regions whose walls the
+/// planner mirrors them at, when the log has any), its branches (main thick, the others
 /// thin and dashed), start, goal and the vehicle; the title carries the time and the cycle's
 /// events. Frames are `params.frame_step_s` of simulated time apart (more for long flights, at
 /// most `params.max_frames`).
@@ -221,36 +222,36 @@ pub fn write_top_view_gif(
                 .label("forecasts"),
         );
         if has_regions {
-            // The regions whose walls the planner mirrors the forecasts at (one outline each;
-            // an empty entry keeps the legend, and so the frame size, the same in every frame).
-            let mut outlines: Vec<[[f64; 3]; 2]> = Vec::new();
+            // The regions whose walls the planner mirrors the forecasts at, one outline each;
+            // an empty outline when there is none keeps the legend, and so the frame size, the
+            // same in every frame.
+            let mut regions: Vec<[[f64; 3]; 2]> = Vec::new();
             for w in cycle
                 .and_then(|c| c.forecasts.as_ref())
                 .into_iter()
                 .flatten()
                 .filter_map(|f| f.walls)
             {
-                if !outlines.contains(&w) {
-                    outlines.push(w);
+                if !regions.contains(&w) {
+                    regions.push(w);
                 }
             }
+            let mut outlines: Vec<Vec<Point2<f64>>> = regions
+                .iter()
+                .map(|[lo, hi]| {
+                    vec![
+                        Point2::new(lo[0], lo[1]),
+                        Point2::new(hi[0], lo[1]),
+                        Point2::new(hi[0], hi[1]),
+                        Point2::new(lo[0], hi[1]),
+                        Point2::new(lo[0], lo[1]),
+                    ]
+                })
+                .collect();
             if outlines.is_empty() {
-                view = view.polyline(
-                    Polyline::new(Vec::new())
-                        .color(forecast_color)
-                        .width_px(1)
-                        .dashed()
-                        .label("obstacle regions"),
-                );
+                outlines.push(Vec::new());
             }
-            for [lo, hi] in outlines {
-                let outline = vec![
-                    Point2::new(lo[0], lo[1]),
-                    Point2::new(hi[0], lo[1]),
-                    Point2::new(hi[0], hi[1]),
-                    Point2::new(lo[0], hi[1]),
-                    Point2::new(lo[0], lo[1]),
-                ];
+            for outline in outlines {
                 view = view.polyline(
                     Polyline::new(outline)
                         .color(forecast_color)

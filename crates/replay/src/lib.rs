@@ -8,7 +8,7 @@
 //!   images fetched). It plays the flight in a top (x–y) and a side (x–z) view on 2-D canvases:
 //!   static shapes (and the thinned static point cloud when the log names one), the true moving
 //!   obstacles with their shapes, the forecasts the planner held (centre and growing radius, when
-//!   the log has them), the flown path, the branches of the current cycle with the main one
+//!   the log has them, and dashed the regions whose walls it mirrors them at), the flown path, the branches of the current cycle with the main one
 //!   highlighted, and the latest global route when the log carries one. Under the views: a
 //!   timeline with the cycles' events (switch, fallback, stalled, …), play/pause, a time slider,
 //!   a speed control, and the speed and clearance traces with a cursor. The page reads `#t=SECONDS`
