@@ -93,7 +93,7 @@ pub use brake::{
     brake_along, brake_straight, braking_tail, dash_maneuvers, escape_maneuvers, hermite_quintic,
 };
 pub use manager::{Branch, MainDecision, Manager, choose_main};
-pub use params::{ManagerParams, ReanchorParams, SafetyParams};
+pub use params::{GROWTH_FRACTION, ManagerParams, ReanchorParams, SafetyParams};
 pub use progress::{ProgressMonitor, ProgressParams, StallRule};
 pub use report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,

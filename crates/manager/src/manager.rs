@@ -1060,8 +1060,10 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         if let Ok(dashes) = dash_maneuvers(start, &directions, cruise_s, &self.limits, hold_s) {
             options.extend(dashes.into_iter().map(|t| ("dash", t)));
         }
-        // The options are judged against the forecasts grown for a quarter of the horizon and
-        // then held: the fallback is chosen again next cycle from new observations, and against
+        // The options are judged against the forecasts grown for at most a quarter of the
+        // horizon (the scene's forecasts already stop growing after `forecast_growth`, 0.25 s
+        // by default; this cap matters when that is longer, e.g. the paper's growth for ever)
+        // and then held: the fallback is chosen again next cycle from new observations, and against
         // an uncertainty growing without end every option collides at last, so the latest
         // collision won — fleeing along a person's path instead of stepping out of it.
         let grow_for = FALLBACK_GROWTH_FRACTION * self.params.horizon_s;

@@ -633,10 +633,10 @@ fn straight_plan_kept(params: ManagerParams, obstacle: Forecast) -> bool {
 
 /// A slow walker beside the line whose forecast grows fast: grown for the whole horizon it
 /// reaches the line by the time the vehicle passes and the plan is dropped; with the growth
-/// stopped after a quarter of the horizon (the default) the plan passes. The paper's model is
+/// stopped after a sixteenth of the horizon (the default) the plan passes. The paper's model is
 /// `forecast_growth_s = ∞`.
 #[test]
-fn forecast_growth_stops_after_a_quarter_of_the_horizon() {
+fn forecast_growth_stops_after_a_sixteenth_of_the_horizon() {
     let walker = Forecast::new(
         ObstacleShape::Sphere,
         Vec3::new(30.0, 6.0, 5.0),
@@ -656,7 +656,7 @@ fn forecast_growth_stops_after_a_quarter_of_the_horizon() {
             walker,
         )
     };
-    assert_eq!(ManagerParams::default().forecast_growth(), 1.0);
+    assert_eq!(ManagerParams::default().forecast_growth(), 0.25);
     assert!(plan_kept(None));
     assert!(!plan_kept(Some(f64::INFINITY)));
     let bad = ManagerParams {
