@@ -13,7 +13,7 @@
 //!    vehicle brushed a pillar (clearance −0.06 mm) or hovered short of the goal; now it arrives
 //!    with positive clearance, within 1.3 × distance / v_max, without exceeding a_max by 5 %.
 //!
-//! (Braking at a wall with the quadrotor model, is `crates/flight/tests/braking.rs`.)
+//! (Braking at a wall with the quadrotor model is `crates/flight/tests/braking.rs`.)
 
 use std::path::{Path, PathBuf};
 
