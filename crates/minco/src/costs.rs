@@ -41,5 +41,6 @@ pub use penalties::{BrakingTail, PenaltyIntegrals, PenaltyIntegrand, TAIL_RAMP_M
 pub use smooth::{SmoothedL1, smoothed_l1};
 pub use static_map::StaticObstacleTerm;
 pub use terminal::{
-    TerminalCost, final_approach_gain, smoothed_weighted_norm, terminal_velocity_weight, time_cost,
+    TerminalCost, final_approach_gain, rest_to_rest_quintic_time, smoothed_weighted_norm,
+    terminal_velocity_weight, time_cost,
 };

@@ -59,6 +59,33 @@ impl InitialTrajectory {
     pub fn pieces(&self) -> usize {
         self.waypoints.len() + 1
     }
+
+    /// Raises the duration of a guess from a guide path that starts at rest to at least the
+    /// minimum-jerk rest-to-rest time within the jerk limit `j_max`
+    /// ([`crate::costs::rest_to_rest_quintic_time`]); the waypoints keep their places (the
+    /// guess is slowed uniformly). A warm start, a moving start or no jerk limit
+    /// (`j_max = ∞`) leave it as it is.
+    ///
+    /// Why: the [`SpeedProfile`] knows no jerk limit. For a short guide (the last decimetres to
+    /// the goal) its duration asks for many times the jerk limit, and from there the solver
+    /// found it cheaper to shrink the move than to stretch the time: from rest 0.1 m before
+    /// the goal, a Crazyflie's plan moved 1 cm.
+    pub fn with_jerk_floor(
+        mut self,
+        guess: &InitialGuess<'_>,
+        start: &State,
+        limits: &Limits,
+        j_max: f64,
+    ) -> Self {
+        if let InitialGuess::Guide(path) = guess {
+            let at_rest = start.v.norm() <= 1e-3 * limits.v_max;
+            let floor = crate::costs::rest_to_rest_quintic_time(path.length(), limits.a_max, j_max);
+            if at_rest && floor.is_finite() && floor > self.total_duration {
+                self.total_duration = floor;
+            }
+        }
+        self
+    }
 }
 
 /// Three decimals for ordinary magnitudes, scientific notation otherwise (messages).

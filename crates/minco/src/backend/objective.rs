@@ -254,6 +254,10 @@ impl<'a> UtfMincoObjective<'a> {
                     params.weights.time,
                     params.weights.terminal,
                     limits.a_max,
+                    params
+                        .penalty
+                        .jerk_limit(limits.a_max)
+                        .unwrap_or(f64::INFINITY),
                     params.penalty.goal_settle_m,
                 ),
             ),

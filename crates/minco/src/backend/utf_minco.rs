@@ -57,7 +57,12 @@ impl TrajectoryBackend for UtfMinco {
         let started = Instant::now();
         validate_request(req, scene)?;
         let p = &self.params;
-        let init = initial_trajectory(&req.initial, &req.start, &req.limits, &p.pieces);
+        let j_max = p
+            .penalty
+            .jerk_limit(req.limits.a_max)
+            .unwrap_or(f64::INFINITY);
+        let init = initial_trajectory(&req.initial, &req.start, &req.limits, &p.pieces)
+            .with_jerk_floor(&req.initial, &req.start, &req.limits, j_max);
         init.check_duration(&req.initial, &req.limits)?;
         check_end_time(req, init.total_duration)?;
         let mut f =
