@@ -154,7 +154,11 @@
 //!
 //! - Issue 19: UTF-MINCO's terminal pull is raised near the goal by the final-approach gain
 //!   ([`costs::final_approach_gain`], `PenaltyParams::goal_settle_m` = 0.02 m) so the free terminal
-//!   settles within 2 cm of the goal at any `a_max`; the reported `H_s` is unchanged.
+//!   settles within 2 cm of the goal at any `a_max`; the reported `H_s` is unchanged. The gain
+//!   counts the jerk limit (`PenaltyParams::jerk_ramp_s`), and a guide's first guess from rest
+//!   takes at least the jerk-limited rest-to-rest time
+//!   (`InitialTrajectory::with_jerk_floor`): from rest just short of the goal the plan moves
+//!   onto it (it stayed put up to 0.1 m short at a Crazyflie's limits, 0.4 m at E4's).
 //! - `backend::guidance_radius(start, goal, horizon_s, &limits)` moved to
 //!   `trust_core::guidance_radius(start, goal, horizon_s, v_max)`, shared with DEV-PRM's goal
 //!   guidance surface; the Bernstein control points of the fused integration come from

@@ -107,13 +107,15 @@ pub struct PenaltyParams {
     /// design-of-Hs rises linearly from 0 (at `d_ε`) to 1 (on the goal).
     pub goal_radius_m: f64,
     /// Settling distance `d_s` (m) of the final approach: near the goal (weighted by `α`) the
-    /// terminal pull is raised so that the free terminal settles within `d_s` of the goal
-    /// instead of `c/(4 a_max)(λ_t/λ_s)²` short of it
+    /// terminal pull is raised so that the free terminal settles within `d_s` of the goal, and
+    /// a vehicle at rest farther than `d_s` from it moves onto it, instead of stopping where
+    /// the time of the last rest-to-rest move outweighs the pull
     /// ([`crate::costs::final_approach_gain`]; UTF-MINCO only). Ours, beyond the paper: 0.02 m,
     /// under half the manager's 0.05 m "reaches the goal" threshold
     /// (`trust_manager::ManagerParams::goal_reached_m`) and far below every goal tolerance, at
-    /// any scale — the gain it implies scales with `a_max` (3.1 at E4's 15 m/s², 6.9 at a
-    /// Crazyflie's 3 m/s² with `λ_t = λ_s`). Accepted: `[1e-6, 1e6]` m.
+    /// any scale — the gain it implies scales with the limits (with `λ_t = λ_s` and the
+    /// presets' jerk limit `a_max/0.3 s`: 14.9 at E4's planning 13.5 m/s², 25.5 at 2.7 m/s²;
+    /// without a jerk limit 4.6 and 10.3). Accepted: `[1e-6, 1e6]` m.
     pub goal_settle_m: f64,
     /// Diagonal of `K_f^p`, the terminal position weights of eq. design-of-Hs.
     pub terminal_position_gains: Vec3,
