@@ -714,6 +714,58 @@ fn the_fallback_steps_out_of_a_faster_obstacles_path() {
     );
 }
 
+/// Issue 19 (a holdout room: a person pacing across it faster than the vehicle; 6 of 60
+/// flights collided): a vehicle in a faster obstacle's lane whose forecast's margins leave no
+/// way out of it in time. Every option touches the forecast, and "collides latest" fled along
+/// the lane, where the obstacle catches up; the fallback now steps out of the obstacle's likely
+/// path (its forecast without growth or margins), and says that it is not clear of the forecast.
+#[test]
+fn with_no_way_clear_of_the_forecasts_the_fallback_steps_out_of_the_likely_path() {
+    let map = open_air();
+    let limits = Limits {
+        v_max: 1.0,
+        a_max: 3.0,
+    };
+    let mut m = Manager::new(
+        StraightLine,
+        Blind,
+        Tvd::default(),
+        limits,
+        reproducible(ManagerParams::single_branch()),
+    )
+    .unwrap();
+    // 0.3 m of body and 1.5 m of margin, coming at 1.5 m/s from 3 m away: every way out
+    // touches the forecast, and fleeing straight ahead of it does so last.
+    let person = [Forecast::new(
+        ObstacleShape::Sphere,
+        Vec3::new(47.0, 0.0, 5.0),
+        Vec3::new(1.5, 0.0, 0.0),
+        0.0,
+        0.3,
+        1.5,
+        0.6,
+    )
+    .unwrap()];
+    let scene = Scene::new(&map, &person, 0.0).unwrap();
+    let start = State::at_rest(0.0, Vec3::new(50.0, 0.0, 5.0));
+    let r = m
+        .step(0.0, &start, &Vec3::new(95.0, 0.0, 5.0), &scene)
+        .unwrap();
+    let fallback = r.fallback.expect("every branch collides");
+    assert!(!fallback.collision_free, "{fallback:?}");
+    let plan = m.plan().unwrap();
+    // Out of the person's likely path (0.3 m of body) for as long as the plan lasts.
+    let aside = (0..=100)
+        .map(|k| {
+            let t = plan.t_start() + (plan.t_end() - plan.t_start()) * f64::from(k) / 100.0;
+            let p = plan.position(t);
+            let centre = person[0].center(t);
+            (p - centre).norm() - 0.3
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!(aside > 0.0, "{} came within {aside:.3} m", fallback.along);
+}
+
 /// A frontend that never finds a path.
 struct Nothing;
 

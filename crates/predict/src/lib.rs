@@ -56,7 +56,10 @@ mod forecast;
 pub mod pdc;
 mod walls;
 
-pub use ekf::{CHI2_3_95, CvEkf, EkfParams, MAX_ACCEL_PSD, MAX_MANOEUVRE_GATE, MAX_SIGMA_SCALE};
+pub use ekf::{
+    CHI2_3_95, CvEkf, EkfParams, LAG_NOISE_THRESHOLD, LAG_WARMUP_S, MAX_ACCEL_PSD,
+    MAX_MANOEUVRE_GATE, MAX_SIGMA_SCALE,
+};
 pub use error::PredictError;
 pub use forecast::{Forecast, ObstacleShape};
 pub use pdc::{CLEAR_TOLERANCE, Pdc, frame_along, round_cone_sdf};

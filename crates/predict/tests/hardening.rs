@@ -166,6 +166,23 @@ fn ekf_params_errors_carry_each_fields_own_unit() {
 }
 
 #[test]
+fn ekf_lag_compensation_smoothing_is_checked_by_name() {
+    for bad in [-0.1, f64::NAN, f64::INFINITY, 2e7] {
+        let e = EkfParams {
+            accel_smoothing_s: bad,
+            ..EkfParams::default()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("ekf.accel_smoothing_s") && e.contains(" s"),
+            "{bad}: {e}"
+        );
+    }
+}
+
+#[test]
 fn ekf_at_the_edges_of_its_accepted_params_forecasts_or_names_its_params() {
     // Every accepted corner: the filter runs, and a forecast either succeeds or names the EKF
     // parameters that drove the growth rate / margin out of the policy (never another field).
@@ -177,27 +194,30 @@ fn ekf_at_the_edges_of_its_accepted_params_forecasts_or_names_its_params() {
                     .into_iter()
                     .zip([1e-9, MAX_MANOEUVRE_GATE])
                 {
-                    let params = EkfParams {
-                        meas_std,
-                        accel_psd,
-                        init_vel_std,
-                        sigma_scale,
-                        mu_min: 1e4,
-                        inflate_by_position_std: true,
-                        manoeuvre_gate,
-                    };
-                    let mut ekf = CvEkf::new(0.0, Vec3::zeros(), params).unwrap();
-                    for k in 1..=10 {
-                        let t = f64::from(k) * 1e6;
-                        ekf.step(t, (k % 3 != 0).then(|| Vec3::new(1.0, 2.0, 3.0)))
-                            .unwrap();
-                    }
-                    assert!(ekf.covariance().iter().all(|x| x.is_finite()));
-                    match ekf.forecast(ObstacleShape::Sphere, 0.5, 0.1) {
-                        Ok(f) => assert!(f.validate().is_ok()),
-                        Err(e) => {
-                            let msg = e.to_string();
-                            assert!(msg.contains("ekf."), "{msg}");
+                    for accel_smoothing_s in [0.0, 1e-9, 0.5, 1e7] {
+                        let params = EkfParams {
+                            meas_std,
+                            accel_psd,
+                            init_vel_std,
+                            sigma_scale,
+                            mu_min: 1e4,
+                            inflate_by_position_std: true,
+                            manoeuvre_gate,
+                            accel_smoothing_s,
+                        };
+                        let mut ekf = CvEkf::new(0.0, Vec3::zeros(), params).unwrap();
+                        for k in 1..=10 {
+                            let t = f64::from(k) * 1e6;
+                            ekf.step(t, (k % 3 != 0).then(|| Vec3::new(1.0, 2.0, 3.0)))
+                                .unwrap();
+                        }
+                        assert!(ekf.covariance().iter().all(|x| x.is_finite()));
+                        match ekf.forecast(ObstacleShape::Sphere, 0.5, 0.1) {
+                            Ok(f) => assert!(f.validate().is_ok()),
+                            Err(e) => {
+                                let msg = e.to_string();
+                                assert!(msg.contains("ekf."), "{msg}");
+                            }
                         }
                     }
                 }
