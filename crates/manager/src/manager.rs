@@ -1108,7 +1108,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let mut verdicts = Vec::with_capacity(options.len());
         for (i, (kind, traj)) in options.iter().enumerate() {
             let v = assess(traj, &judged);
-            verdicts.push(v.clone());
+            verdicts.push(v);
             if !admissible(kind, traj, &v) {
                 continue;
             }
@@ -1166,7 +1166,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                     });
                 if let Some((i, _)) = widest {
                     // Reported against the forecasts (its shortfall is theirs).
-                    best = Some((i, verdicts[i].clone()));
+                    best = Some((i, verdicts[i]));
                     break;
                 }
             }
