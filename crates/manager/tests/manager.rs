@@ -670,24 +670,29 @@ fn forecast_growth_stops_after_a_sixteenth_of_the_horizon() {
     assert!(e.contains("manager.forecast_growth_s"), "{e}");
 }
 
-/// A ball rolling at a vehicle at rest, twice as fast as the vehicle can fly, its forecast growing
-/// fast: the fallback steps out of its path rather than fleeing along it (judged against
-/// forecasts that grow for ever, every option collided and fleeing, colliding latest, won).
-#[test]
-fn the_fallback_steps_out_of_a_faster_obstacles_path() {
-    let map = open_air();
+/// A single-branch manager at a room's limits (1 m/s, 3 m/s²) with the [`Blind`] backend.
+fn blind_single_branch_at_room_limits() -> Manager<StraightLine, Blind, Tvd> {
     let limits = Limits {
         v_max: 1.0,
         a_max: 3.0,
     };
-    let mut m = Manager::new(
+    Manager::new(
         StraightLine,
         Blind,
         Tvd::default(),
         limits,
         reproducible(ManagerParams::single_branch()),
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// A ball rolling at a vehicle at rest, twice as fast as the vehicle can fly, its forecast growing
+/// fast: the fallback steps out of its path rather than fleeing along it (judged against
+/// forecasts that grow for ever, every option collided and fleeing, colliding latest, won).
+#[test]
+fn the_fallback_steps_out_of_a_faster_obstacles_path() {
+    let map = open_air();
+    let mut m = blind_single_branch_at_room_limits();
     let ball = [Forecast::new(
         ObstacleShape::Sphere,
         Vec3::new(46.0, 0.0, 5.0),
@@ -722,18 +727,7 @@ fn the_fallback_steps_out_of_a_faster_obstacles_path() {
 #[test]
 fn with_no_way_clear_of_the_forecasts_the_fallback_steps_out_of_the_likely_path() {
     let map = open_air();
-    let limits = Limits {
-        v_max: 1.0,
-        a_max: 3.0,
-    };
-    let mut m = Manager::new(
-        StraightLine,
-        Blind,
-        Tvd::default(),
-        limits,
-        reproducible(ManagerParams::single_branch()),
-    )
-    .unwrap();
+    let mut m = blind_single_branch_at_room_limits();
     // 0.3 m of body and 1.5 m of margin, coming at 1.5 m/s from 3 m away: every way out
     // touches the forecast, and fleeing straight ahead of it does so last.
     let person = [Forecast::new(

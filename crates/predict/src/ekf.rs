@@ -864,20 +864,7 @@ mod tests {
         };
         let (mut missed, mut issued, mut mu_sum, mut mu_count) = (0, 0, 0.0, 0);
         for seed in 0..100 {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let noise = Normal::new(0.0, 0.1).unwrap();
-            let mut z = |t: f64| {
-                truth(t)
-                    + Vec3::new(
-                        noise.sample(&mut rng),
-                        noise.sample(&mut rng),
-                        noise.sample(&mut rng),
-                    )
-            };
-            let mut ekf = CvEkf::new(-2.0, z(-2.0), params.clone()).unwrap();
-            for k in 1..=((2.0 + t_turn + 1.0) * rate) as usize {
-                let t = -2.0 + k as f64 / rate;
-                ekf.step(t, Some(z(t))).unwrap();
+            track_noisy(seed, &params, &truth, t_turn + 1.0, rate, |t, ekf| {
                 if (0.0..t_turn).contains(&t) {
                     mu_sum += ekf.uncertainty_rate();
                     mu_count += 1;
@@ -893,7 +880,7 @@ mod tests {
                         }
                     }
                 }
-            }
+            });
         }
         (missed as f64 / issued as f64, mu_sum / mu_count as f64)
     }
@@ -912,26 +899,41 @@ mod tests {
         assert!(mu_on < 1.1 * mu_off, "{mu_on} vs {mu_off}");
     }
 
+    /// Tracks `truth` from `t = -2` s to `until` with 0.1 m of noise at `rate` Hz (stream
+    /// `seed`), calling `visit` after each update.
+    fn track_noisy(
+        seed: u64,
+        params: &EkfParams,
+        truth: &impl Fn(f64) -> Vec3,
+        until: f64,
+        rate: f64,
+        mut visit: impl FnMut(f64, &CvEkf),
+    ) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let noise = Normal::new(0.0, 0.1).unwrap();
+        let mut z = |t: f64| {
+            truth(t)
+                + Vec3::new(
+                    noise.sample(&mut rng),
+                    noise.sample(&mut rng),
+                    noise.sample(&mut rng),
+                )
+        };
+        let mut ekf = CvEkf::new(-2.0, z(-2.0), params.clone()).unwrap();
+        for k in 1..=((2.0 + until) * rate).round() as usize {
+            let t = -2.0 + k as f64 / rate;
+            ekf.step(t, Some(z(t))).unwrap();
+            visit(t, &ekf);
+        }
+    }
+
     /// Mean distance between the forecast centre and the truth `tau` seconds ahead, over the
     /// forecasts issued at 20 Hz (0.1 m noise) while `t ∈ window`, 100 seeds; the track starts
     /// at `t = -2`.
     fn forecast_error(params: &EkfParams, truth: impl Fn(f64) -> Vec3, window: (f64, f64)) -> f64 {
         let (mut sum, mut count) = (0.0, 0);
         for seed in 0..100 {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let noise = Normal::new(0.0, 0.1).unwrap();
-            let mut z = |t: f64| {
-                truth(t)
-                    + Vec3::new(
-                        noise.sample(&mut rng),
-                        noise.sample(&mut rng),
-                        noise.sample(&mut rng),
-                    )
-            };
-            let mut ekf = CvEkf::new(-2.0, z(-2.0), params.clone()).unwrap();
-            for k in 1..=((2.0 + window.1) * 20.0).round() as usize {
-                let t = -2.0 + k as f64 / 20.0;
-                ekf.step(t, Some(z(t))).unwrap();
+            track_noisy(seed, params, &truth, window.1, 20.0, |t, ekf| {
                 if t >= window.0 {
                     let f = ekf.forecast(ObstacleShape::Sphere, 0.25, 0.0).unwrap();
                     for tau in [0.5, 1.0] {
@@ -939,7 +941,7 @@ mod tests {
                         count += 1;
                     }
                 }
-            }
+            });
         }
         sum / count as f64
     }
