@@ -296,7 +296,8 @@ impl LagCompensation {
     }
 
     /// The shifts `(Δp, Δv)` of the forecast's start; none until the estimate has been fed for
-    /// the smoothing time; `Δv` at most `max_dv` long.
+    /// the smoothing time; the acceleration used is scaled down so that `Δv` is at most
+    /// `max_dv` long (`Δp` with it).
     fn shifts(&self, smoothing_s: f64, max_dv: f64) -> (Vec3, Vec3) {
         if !(smoothing_s > 0.0 && self.fed_s >= smoothing_s) {
             return (Vec3::zeros(), Vec3::zeros());
@@ -304,19 +305,16 @@ impl LagCompensation {
         // Only what stands out of the estimate's noise (a soft threshold).
         let threshold = LAG_NOISE_THRESHOLD * self.noise;
         let n = self.accel.norm();
-        let accel = if n > threshold {
+        let mut accel = if n > threshold {
             self.accel * (1.0 - threshold / n)
         } else {
             Vec3::zeros()
         };
-        let dv = accel * self.lag_s.1;
-        let n = dv.norm();
-        let dv = if n > max_dv && n > 0.0 {
-            dv * (max_dv / n)
-        } else {
-            dv
-        };
-        (accel * self.lag_s.0, dv)
+        let dv = accel.norm() * self.lag_s.1;
+        if dv > max_dv {
+            accel *= max_dv / dv;
+        }
+        (accel * self.lag_s.0, accel * self.lag_s.1)
     }
 }
 
@@ -1014,6 +1012,27 @@ mod tests {
         let f = plain.forecast(ObstacleShape::Sphere, 0.25, 0.0).unwrap();
         assert_eq!(plain.acceleration(), Vec3::zeros());
         assert_eq!((f.p0, f.v0), (plain.position(), plain.velocity()));
+    }
+
+    /// A measurement that jumps (a 3 m step, as after a swap of two tracks) makes a huge
+    /// acceleration estimate; the compensation shifts the forecast's velocity by at most `mu`,
+    /// and its position in proportion.
+    #[test]
+    fn a_jump_shifts_the_forecast_by_at_most_its_growth_rate() {
+        let mut ekf = CvEkf::new(0.0, Vec3::zeros(), EkfParams::default()).unwrap();
+        for k in 1..=100 {
+            let t = k as f64 / 20.0;
+            let y = if k >= 90 { 3.0 } else { 0.0 };
+            ekf.step(t, Some(Vec3::new(0.0, y, 0.0))).unwrap();
+        }
+        let f = ekf.forecast(ObstacleShape::Sphere, 0.25, 0.0).unwrap();
+        assert!(ekf.acceleration().norm() > 2.0, "{}", ekf.acceleration());
+        // Held at the bound.
+        let dv = (f.v0 - ekf.velocity()).norm();
+        assert_relative_eq!(dv, ekf.uncertainty_rate(), max_relative = 1e-9);
+        // Δp / Δv = τ_p / τ_v (about 0.27 with the defaults).
+        let dp = (f.p0 - ekf.position()).norm();
+        assert!(dp > 0.0 && dp < 0.5 * dv, "{dp} vs {dv}");
     }
 
     #[test]
