@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use trust_plot::{Bar, BarChart, Color, Figure};
 use trust_world::World;
 use trust_world::planner::PlannerPreset;
-use trust_world::scenario::Scenario;
+use trust_world::scenario::{Latency, Scenario};
 
 use crate::ExperimentError;
 use crate::study::{create_dir, fly_logged, write_json, write_text};
@@ -40,6 +40,10 @@ pub struct SuiteConfig {
     pub planners: Vec<PlannerPreset>,
     /// Simulated time limit (s), replacing the files' if set.
     pub time_limit_s: Option<f64>,
+    /// The loop's latency model, replacing the files' `sim.latency` if set (the real-time
+    /// mode: `trust-sim suite --real-time`).
+    #[serde(default)]
+    pub latency: Option<Latency>,
 }
 
 /// How to run a suite (nothing here changes its results).
@@ -91,18 +95,25 @@ pub struct SuiteRow {
     pub forecast_warning_s: Option<f64>,
     /// The vehicle's `v_max` (m/s).
     pub v_max: f64,
+    /// The longest planning cycle's wall time (ms).
+    pub cycle_ms_max: f64,
+    /// Cycles longer than the manager's cycle budget.
+    pub over_budget: usize,
+    /// Replanning ticks skipped because the planner was busy (real-time mode; 0 otherwise).
+    pub skipped_ticks: u64,
 }
 
 impl SuiteRow {
     const COLUMNS: &'static str = "class,planner,seed,status,with,flight_time_s,distance_m,\
                                    ideal_time_s,path_length_m,min_clearance_static_m,\
                                    min_clearance_dynamic_m,max_accel,a_max,fallbacks,log,\
-                                   forecast_warning_s,v_max";
+                                   forecast_warning_s,v_max,cycle_ms_max,over_budget,\
+                                   skipped_ticks";
 
     fn to_line(&self) -> String {
         let clean = |s: &str| s.replace([',', '\n', '\r', '"'], ";");
         format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             clean(&self.class),
             clean(&self.planner),
             self.seed,
@@ -121,6 +132,9 @@ impl SuiteRow {
             self.forecast_warning_s
                 .map_or(String::new(), |w| w.to_string()),
             self.v_max,
+            self.cycle_ms_max,
+            self.over_budget,
+            self.skipped_ticks,
         )
     }
 }
@@ -142,6 +156,18 @@ pub struct ClassSummary {
     pub timed_out: usize,
     /// Invalid runs (the planner rejected its input).
     pub invalid: usize,
+    /// Flights ended by the planner's verdict that the goal cannot be reached.
+    #[serde(default)]
+    pub unreachable: usize,
+    /// The longest planning cycle over every flight (ms).
+    #[serde(default)]
+    pub worst_cycle_ms: f64,
+    /// Cycles longer than the cycle budget, over every flight.
+    #[serde(default)]
+    pub over_budget: usize,
+    /// Replanning ticks skipped, over every flight (real-time mode).
+    #[serde(default)]
+    pub skipped_ticks: u64,
     /// Mean flight time of the arrivals (s).
     pub mean_arrival_time_s: Option<f64>,
     /// Mean `distance / v_max` of the arrivals (s).
@@ -329,6 +355,9 @@ fn flight_scenario(
     if let Some(t) = config.time_limit_s {
         s.time_limit_s = t;
     }
+    if let Some(latency) = config.latency {
+        s.sim.latency = latency;
+    }
     if let Some(p) = preset
         && p != s.planner.name
     {
@@ -377,6 +406,9 @@ fn fly_one(class: &str, s: &Scenario, out: &Path) -> Result<SuiteRow, Experiment
         log: rel,
         forecast_warning_s: o.forecast_warning_s,
         v_max: limits.v_max,
+        cycle_ms_max: sm.cycle_ms_max,
+        over_budget: sm.over_budget_count,
+        skipped_ticks: sm.skipped_tick_count,
     })
 }
 
@@ -410,6 +442,10 @@ pub fn summarize(rows: &[SuiteRow]) -> Vec<ClassSummary> {
                 collided: count("collided"),
                 timed_out: count("timed_out"),
                 invalid: count("invalid"),
+                unreachable: count("unreachable"),
+                worst_cycle_ms: rs.iter().map(|r| r.cycle_ms_max).fold(0.0, f64::max),
+                over_budget: rs.iter().map(|r| r.over_budget).sum(),
+                skipped_ticks: rs.iter().map(|r| r.skipped_ticks).sum(),
                 mean_arrival_time_s: mean(&|r| r.flight_time_s),
                 mean_ideal_time_s: mean(&|r| r.ideal_time_s),
                 worst_time_ratio: arrivals
@@ -444,6 +480,13 @@ fn report(config: &SuiteConfig, summary: &[ClassSummary], rows: &[SuiteRow]) -> 
             .time_limit_s
             .map_or(String::new(), |t| format!(", time limit {t} s")),
     ));
+    if let Some(Latency::Measured { cpu_scale }) = config.latency {
+        s.push_str(&format!(
+            "Flown in real time (CPU scale {}): each cycle's measured wall time is charged and a \
+             busy planner skips replanning ticks.\n\n",
+            cpu_scale.unwrap_or(1.0)
+        ));
+    }
     let total = |f: fn(&ClassSummary) -> usize| summary.iter().map(f).sum::<usize>();
     s.push_str(&format!(
         "**Total: {} flights — {} arrived, {} collided, {} timed out, {} invalid.**\n\n",
@@ -452,6 +495,19 @@ fn report(config: &SuiteConfig, summary: &[ClassSummary], rows: &[SuiteRow]) -> 
         total(|c| c.collided),
         total(|c| c.timed_out),
         total(|c| c.invalid),
+    ));
+    if total(|c| c.unreachable) > 0 {
+        s.push_str(&format!(
+            "**{} flight(s) ended with the goal proved unreachable.**\n\n",
+            total(|c| c.unreachable)
+        ));
+    }
+    s.push_str(&format!(
+        "**Worst planning cycle {:.1} ms; {} cycle(s) over the budget; {} replanning tick(s) \
+         skipped.**\n\n",
+        summary.iter().map(|c| c.worst_cycle_ms).fold(0.0, f64::max),
+        total(|c| c.over_budget),
+        summary.iter().map(|c| c.skipped_ticks).sum::<u64>(),
     ));
     let mut class = "";
     for c in summary {
@@ -576,6 +632,9 @@ mod tests {
             log: String::new(),
             forecast_warning_s: (status == "collided").then_some(1.25),
             v_max: 1.0,
+            cycle_ms_max: 4.0,
+            over_budget: 0,
+            skipped_ticks: 0,
         }
     }
 
@@ -602,6 +661,7 @@ mod tests {
                 seed: 0,
                 planners: vec![],
                 time_limit_s: None,
+                latency: None,
             },
             &s,
             &rows,
@@ -625,6 +685,7 @@ mod tests {
             seed: 0,
             planners: vec![],
             time_limit_s: None,
+            latency: None,
         };
         assert!(c.validate().unwrap_err().to_string().contains("SCENARIOS"));
         c.files = vec![PathBuf::from("x/a.toml"), PathBuf::from("y/a.toml")];

@@ -300,6 +300,8 @@ fn without_branches_there_is_no_branch_channel_and_a_log_file_exports() {
                     samples: vec![[t, 1.0, 1.0, 1.0], [t + 1.0, 2.0, 1.5, 1.0]],
                 }]),
                 forecasts: None,
+                charged_ms: None,
+                overrun_ticks: None,
             }
         })
         .collect();

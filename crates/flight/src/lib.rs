@@ -3,67 +3,55 @@
 //! The simulator's middle stage (paper Sec. IV-D): it takes a [`World`] built by `trust-world`,
 //! assembles the planner the scenario names ([`trust_world::planner::build`]), flies it and writes
 //! the run log of `trust-runlog`. Use [`fly`] for one flight; studies and experiments
-//! (`trust-experiments`) call it once per trial and planner.
-//!
+//! (`trust-experiments`) call it once per trial and planner. To drive the loop yourself (another
+//! observer, a flight paused and inspected), use [`closed_loop::step`] with a [`FlightState`].
 //!
 //! Every `physics_dt_s` the true obstacles move ([`trust_world::traffic::Traffic`]) and the vehicle
 //! integrates its dynamics toward the committed plan ([`trust_vehicle::Vehicle`]); at the sensor
 //! rate the obstacles are measured with noise and dropouts into the trackers
 //! ([`trust_world::sensing::Sensing`]); at the replanning rate the manager plans from the measured
-//! vehicle state and the trackers' forecasts — never from the true obstacles — and the new plan
-//! takes effect after the latency (fixed, or the cycle's measured wall time). After every physics
-//! step the true vehicle sphere is checked against the true static geometry and the true
-//! obstacles; the flight ends when it collides, arrives within the goal tolerance, or runs out of
-//! time.
+//! vehicle state and the trackers' forecasts — never from the true obstacles. When its plan takes
+//! effect, and whether a busy planner skips replanning ticks, is the [`Clock`]'s: a fixed latency
+//! (reproducible), or real time (the cycle's measured wall time, optionally scaled, is charged).
+//! After every physics step the true vehicle sphere is checked against the true static geometry
+//! and the true obstacles; the flight ends when it collides, arrives within the goal tolerance,
+//! when the planner's verdict that the goal cannot be reached has held for
+//! [`UNREACHABLE_SETTLE_S`], or when it runs out of time.
 //!
 //! The run log ([`trust_runlog`]) holds a `state` record at the log rate and at the last instant
 //! (so a collision or arrival between two log ticks is in the log), a `cycle` record per planning
 //! cycle, and the `outcome`, whose figures are computed from the logged states exactly as the
 //! contract defines them.
-//!
-//! # Changelog
-//!
-//! - Issue 19: cycle records carry the route the manager planned (`route`, `route_ms`) and a
-//!   fallback's shortfall (`fallback_shortfall_m`). The forecasts the manager gets carry their
-//!   obstacle's region when it is not the world (`trust_predict::Forecast::walls`: the traffic
-//!   turns the obstacle back at its walls), and the logged forecasts the growth stop
-//!   (`ForecastRecord::growth_s`).
-//! - Moved out of `trust-sim` (issue 17): `trust_sim::run::{fly, header, RunOptions, RunSummary,
-//!   Flight, FlightRecord}` are at this crate's root.
-//! - `trust_sim::error::SimError` is split by stage; this crate's errors are [`FlightError`]s
-//!   (wrapping `trust_world::WorldError` for setup, vehicle, planner and run-log errors).
-//! - Added [`set_up`] / [`Setup`]: the traffic, sensing and planner at `t = 0`, shared by [`fly`]
-//!   and E3.
-//! - Added (issue 20): [`RunOptions::log_branches`] writes the kept branches and the forecasts
-//!   into the `cycle` records ([`BRANCH_SAMPLE_STEP_S`]).
-//! - [`RunSummary::cycle_ms_median`] and `cycle_ms_p99` use `trust_plot::quantile_sorted` (the same
-//!   type-7 quantile as before; still 0 without cycles).
 #![warn(missing_docs)]
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
-use trust_core::{PolyTraj, Scene, Vec3};
+use trust_core::{PolyTraj, Vec3};
 use trust_manager::{Event, Hit, StepReport};
 use trust_plot::quantile_sorted;
-use trust_route::GlobalRoute;
-
-use trust_world::World;
-use trust_world::planner::{self, AnyManager, ResolvedPlanner};
-use trust_world::scenario::{Latency, VehicleModel};
-use trust_world::sensing::Sensing;
-use trust_world::traffic::{MovingShape, Traffic};
-
-mod error;
-pub use error::FlightError;
 use trust_predict::{Forecast, ObstacleShape};
+use trust_route::GlobalRoute;
 use trust_runlog::{
     Bounds, BranchSamples, CycleRecord, Dropped, ForecastRecord, ForecastShape, Header, LimitsInfo,
     LogWriter, ObstacleInfo, ObstacleKind, Outcome, Record, SCHEMA, StateRecord, Status,
     VehicleInfo,
 };
-use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle};
+use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle, VehicleState};
+use trust_world::World;
+use trust_world::planner::{self, AnyManager, ResolvedPlanner};
+use trust_world::scenario::VehicleModel;
+use trust_world::sensing::Sensing;
+use trust_world::traffic::{MovingShape, Traffic};
+
+pub mod closed_loop;
+mod error;
+pub use closed_loop::{
+    Clearances, Clock, Contact, CycleEvent, Ending, FlightObserver, FlightState, LoopParams,
+    UNREACHABLE_SETTLE_S, obstacle_walls,
+};
+pub use error::FlightError;
 
 /// Stand-in for "no obstacle of this kind" in the outcome's clearances (JSON has no infinity).
 pub const NO_OBSTACLE_CLEARANCE_M: f64 = 1e9;
@@ -107,6 +95,18 @@ pub struct RunSummary {
     pub cycle_ms_median: f64,
     /// See `cycle_ms_median`.
     pub cycle_ms_p99: f64,
+    /// The longest cycle's wall time (ms).
+    #[serde(default)]
+    pub cycle_ms_max: f64,
+    /// Cycles whose wall time exceeded the manager's cycle budget (`cycle_budget_ms`).
+    #[serde(default)]
+    pub over_budget_count: usize,
+    /// Cycles that made the planner skip replanning ticks (real-time latency mode only).
+    #[serde(default)]
+    pub overrun_count: usize,
+    /// Replanning ticks skipped in all (real-time latency mode only).
+    #[serde(default)]
+    pub skipped_tick_count: u64,
     /// Mean solve time per optimized trajectory (ms).
     pub solve_ms_per_trajectory: f64,
     /// Mean CPU time per optimized trajectory, frontend and checks included (ms): the paper's
@@ -297,7 +297,8 @@ pub fn set_up(world: &World, planner: &ResolvedPlanner) -> Result<Setup, FlightE
     })
 }
 
-/// Flies `planner` through `world` once (see the module docs).
+/// Flies `planner` through `world` once (see the module docs): [`closed_loop::step`] until the
+/// flight ends, with the run log, the cycle statistics and the forecast history as observers.
 ///
 /// # Errors
 /// [`FlightError`] for a world or planner that cannot be set up, or a log that cannot be written.
@@ -311,27 +312,27 @@ pub fn fly(
 ) -> Result<Flight, FlightError> {
     let wall_start = Instant::now();
     let scenario = world.scenario();
-    let sim = &scenario.sim;
-    let dt = sim.physics_dt_s;
-    let steps_per = |rate_hz: f64| ((1.0 / rate_hz) / dt).round().max(1.0) as u64;
-    let replan_steps = steps_per(sim.replan_rate_hz);
-    let log_steps = steps_per(sim.log_rate_hz);
-    let max_steps = (scenario.time_limit_s / dt).ceil() as u64;
-    let radius = world.vehicle_radius_m();
-    let (start, goal) = (world.start(), world.goal());
-    let tolerance = scenario.mission.goal_tolerance_m;
-
+    let params = LoopParams::new(world, planner);
+    // In real time the planner's wall-clock budgets back its work budgets.
+    let real_time = matches!(params.clock, Clock::RealTime { .. });
+    let planner = &{
+        let mut p = planner.clone();
+        if real_time {
+            p.reproducible = false;
+        }
+        p
+    };
     let Setup {
-        mut traffic,
-        mut sensing,
-        mut manager,
+        traffic,
+        sensing,
+        manager,
     } = set_up(world, planner)?;
-    let hover = Reference::hover(start);
+    let hover = Reference::hover(world.start());
     // The controller keeps the commanded acceleration within the vehicle's limit unless the
     // scenario's gains say otherwise.
     let mut gains = scenario.vehicle.gains;
     gains.max_accel_m_s2 = gains.max_accel_m_s2.or(Some(scenario.vehicle.limits.a_max));
-    let mut vehicle: Box<dyn Vehicle> = match scenario.vehicle.model {
+    let vehicle: Box<dyn Vehicle> = match scenario.vehicle.model {
         VehicleModel::Quadrotor => Box::new(ControlledQuadrotor::starting_on(
             scenario.vehicle.quadrotor,
             gains,
@@ -340,9 +341,18 @@ pub fn fly(
         )?),
         VehicleModel::Perfect => Box::new(PerfectTracking::new(0.0, &hover)?),
     };
-    let fixed_latency = match sim.latency {
-        Latency::Fixed { seconds } => Some(seconds.unwrap_or(planner.manager.latency())),
-        Latency::Measured {} => None,
+    let mut state = FlightState {
+        traffic,
+        sensing,
+        manager,
+        vehicle,
+        hover,
+        active: None,
+        pending: None,
+        step: 0,
+        t: 0.0,
+        busy_until: 0.0,
+        unreachable_since: None,
     };
 
     let writer = match &options.log_path {
@@ -365,182 +375,85 @@ pub fn fly(
         }
         None => None,
     };
-
-    let mut log = Logger {
-        writer,
-        record: FlightRecord {
-            states: Vec::new(),
-            cycles: Vec::new(),
-            static_clearance: Vec::new(),
-            dynamic_clearance: Vec::new(),
-            plans: Vec::new(),
+    let growth_s = planner.manager.forecast_growth();
+    let mut observers = (
+        Logger {
+            writer,
+            record: FlightRecord {
+                states: Vec::new(),
+                cycles: Vec::new(),
+                static_clearance: Vec::new(),
+                dynamic_clearance: Vec::new(),
+                plans: Vec::new(),
+            },
+            tally: Tally::new(),
+            zero_timing: options.zero_timing,
+            log_branches: options.log_branches,
+            real_time,
+            growth_s,
+            next_plan_snapshot: 0.0,
         },
-        tally: Tally::new(),
-    };
-
-    let clearances = |p: &Vec3, traffic: &trust_world::traffic::Traffic| {
-        let static_c = world.true_static_clearance(p) - radius;
-        let (d, id) = traffic.clearance(p);
-        (static_c, d - radius, id)
-    };
+        (
+            CycleStats::new(params.cycle_budget_ms),
+            GivenForecasts {
+                given: ForecastHistory::new(),
+                remember_s: 2.0 * planner.manager.horizon_s,
+                growth_s,
+            },
+        ),
+    );
 
     // t = 0.
     {
-        let (sc, dc, _) = clearances(&vehicle.state().p, &traffic);
-        log.state(0.0, vehicle.as_ref(), traffic.positions(), sc, dc)?;
+        let v = state.vehicle.state();
+        let c = Clearances::at(world, &state.traffic, params.vehicle_radius_m, &v.p);
+        observers.state(0.0, v, state.traffic.positions(), &c)?;
     }
-
-    let mut active: Option<PolyTraj> = None;
-    let mut pending: Option<(f64, PolyTraj)> = None;
-    let mut cycle_walls = Vec::new();
-    let (mut solve_ms, mut cpu_ms, mut trajectories) = (0.0, 0.0, 0usize);
-    let (mut fallbacks, mut unsafe_fallbacks, mut switches, mut reanchors) = (0, 0, 0, 0);
-    let mut ended: Option<(Status, Option<String>, Option<String>)> = None;
+    let walls = obstacle_walls(world);
     let mut next_progress = options.progress_every_s.unwrap_or(f64::INFINITY);
-    let mut next_plan_snapshot = 0.0;
-    // The forecasts the planner planned against (growth stopped as its manager stops it) over
-    // the last two horizons, by obstacle id, newest last: a collision's outcome says how long
-    // they had the obstacle where it hit.
-    let mut given = ForecastHistory::new();
-    let remember_s = 2.0 * planner.manager.horizon_s;
-    let growth_s = planner.manager.forecast_growth();
-    let regions = obstacle_walls(world);
-    let mut step = 0u64;
-    let mut t = 0.0;
-    while ended.is_none() {
-        // Plan.
-        if step.is_multiple_of(replan_steps) {
-            // Each forecast knows the box its obstacle stays inside when that is not the map
-            // (a scenario's obstacle region, where the traffic turns it back).
-            let ids = sensing.tracked_ids();
-            let forecasts: Vec<Forecast> = sensing
-                .forecasts(t)?
-                .into_iter()
-                .zip(&ids)
-                .map(|(f, &id)| match regions.get(id).copied().flatten() {
-                    Some(region) => f.with_walls(region),
-                    None => f,
-                })
-                .collect();
-            given.push_back((
-                t,
-                ids.iter()
-                    .copied()
-                    .zip(forecasts.iter().map(|f| f.with_growth_for(growth_s)))
-                    .collect(),
-            ));
-            while given.front().is_some_and(|(tk, _)| *tk < t - remember_s) {
-                given.pop_front();
-            }
-            let scene = Scene::new(world.planner_map(), &forecasts, t)?;
-            let measured = vehicle.state().kinematic();
-            let cycle_start = Instant::now();
-            match manager.step(t, &measured, &goal, &scene) {
-                Ok(report) => {
-                    let wall = cycle_start.elapsed().as_secs_f64();
-                    let latency = fixed_latency.unwrap_or(wall);
-                    let effective = t + (latency / dt).ceil() * dt;
-                    if let Some(plan) = manager.plan() {
-                        pending = Some((effective, plan.clone()));
-                        if t >= next_plan_snapshot {
-                            log.record.plans.push(plan.clone());
-                            next_plan_snapshot = t + 1.0;
-                        }
-                    }
-                    cycle_walls.push(report.timing.wall_ms);
-                    solve_ms += report.timing.backend_ms;
-                    cpu_ms += report.timing.frontend_ms
-                        + report.timing.backend_ms
-                        + report.timing.checker_ms;
-                    trajectories += report.timing.solve_count;
-                    if let Some(f) = &report.fallback {
-                        fallbacks += 1;
-                        if !f.collision_free {
-                            unsafe_fallbacks += 1;
-                        }
-                    }
-                    switches += usize::from(report.switched());
-                    reanchors += report
-                        .events
-                        .iter()
-                        .filter(|e| matches!(e, trust_manager::Event::Reanchored { .. }))
-                        .count();
-                    let mut record =
-                        cycle_record(&report, manager.route(), effective, options.zero_timing);
-                    if options.log_branches {
-                        record.branch_samples = Some(branch_samples(&manager));
-                        record.forecasts = Some(forecast_records(&ids, &forecasts, growth_s));
-                    }
-                    log.cycle(record)?;
-                }
-                Err(e) => {
-                    ended = Some((Status::Invalid, None, Some(e.to_string())));
-                    break;
-                }
-            }
-        }
-        if let Some((te, _)) = &pending
-            && t + 0.5 * dt >= *te
+    let ending = loop {
+        if let Some(ending) = closed_loop::step(&params, world, &walls, &mut state, &mut observers)?
         {
-            active = pending.take().map(|(_, p)| p);
+            break ending;
         }
-
-        // Physics.
-        let reference = |tau: f64| match &active {
-            Some(plan) => Reference::from_traj(plan, tau, 0.0),
-            None => hover,
-        };
-        vehicle.step(dt, &reference)?;
-        traffic.step(dt)?;
-        step += 1;
-        t = step as f64 * dt;
-
-        // Checks.
-        let p = vehicle.state().p;
-        let (sc, dc, id) = clearances(&p, &traffic);
-        if sc < 0.0 || dc < 0.0 {
-            let with = if sc <= dc {
-                "static".to_string()
-            } else {
-                format!("obstacle:{}", id.unwrap_or(0))
-            };
-            ended = Some((Status::Collided, Some(with), None));
-        } else if (p - goal).norm() <= tolerance {
-            ended = Some((Status::Arrived, None, None));
-        } else if step >= max_steps {
-            ended = Some((Status::TimedOut, None, None));
-        }
-        if ended.is_some() || step.is_multiple_of(log_steps) {
-            log.state(t, vehicle.as_ref(), traffic.positions(), sc, dc)?;
-        }
-        sensing.update(t, traffic.positions())?;
-        if t >= next_progress {
-            progress(t);
+        if state.t >= next_progress {
+            progress(state.t);
             next_progress += options.progress_every_s.unwrap_or(f64::INFINITY);
         }
-    }
+    };
 
-    let Logger {
-        writer,
-        record,
-        tally,
-    } = log;
-    let (status, with, reason) = ended.unwrap_or((Status::Invalid, None, None));
-    let forecast_warning_s = with
-        .as_deref()
-        .and_then(|w| w.strip_prefix("obstacle:"))
-        .and_then(|id| id.parse::<usize>().ok())
-        .and_then(|id| {
-            let centre = traffic.positions().get(id).copied()?;
-            Some(forecast_warning(
-                &given,
-                id,
-                &centre,
-                t,
-                radius,
-                world.planner_map().bounds(),
-            ))
-        });
+    let (
+        Logger {
+            writer,
+            record,
+            tally,
+            ..
+        },
+        (stats, history),
+    ) = observers;
+    let t = state.t;
+    let (status, with, reason) = match &ending {
+        Ending::Arrived => (Status::Arrived, None, None),
+        Ending::Collided(contact) => (Status::Collided, Some(contact.log_tag()), None),
+        Ending::TimedOut => (Status::TimedOut, None, None),
+        Ending::Unreachable { reason } => (Status::Unreachable, None, Some(reason.clone())),
+        Ending::Invalid { reason } => (Status::Invalid, None, Some(reason.clone())),
+    };
+    let forecast_warning_s = match ending {
+        Ending::Collided(Contact::Obstacle(id)) => {
+            state.traffic.positions().get(id).map(|centre| {
+                forecast_warning(
+                    &history.given,
+                    id,
+                    centre,
+                    t,
+                    params.vehicle_radius_m,
+                    world.planner_map().bounds(),
+                )
+            })
+        }
+        _ => None,
+    };
     let outcome = Outcome {
         status,
         t,
@@ -559,23 +472,27 @@ pub fn fly(
         w.write(&Record::Outcome(outcome.clone()))?;
         w.finish()?;
     }
-    let mut walls = cycle_walls;
-    walls.sort_by(f64::total_cmp);
+    let mut walls_ms = stats.walls_ms;
+    walls_ms.sort_by(f64::total_cmp);
     let wall_s = wall_start.elapsed().as_secs_f64();
     let summary = RunSummary {
         scenario: scenario.name.clone(),
         planner: planner.label.clone(),
         seed: scenario.seed,
         cycle_count: record.cycles.len(),
-        cycle_ms_median: quantile_sorted(&walls, 0.5).unwrap_or(0.0),
-        cycle_ms_p99: quantile_sorted(&walls, 0.99).unwrap_or(0.0),
-        solve_ms_per_trajectory: solve_ms / trajectories.max(1) as f64,
-        cpu_ms_per_trajectory: cpu_ms / trajectories.max(1) as f64,
-        trajectory_count: trajectories,
-        fallback_count: fallbacks,
-        unsafe_fallback_count: unsafe_fallbacks,
-        switch_count: switches,
-        reanchor_count: reanchors,
+        cycle_ms_median: quantile_sorted(&walls_ms, 0.5).unwrap_or(0.0),
+        cycle_ms_p99: quantile_sorted(&walls_ms, 0.99).unwrap_or(0.0),
+        cycle_ms_max: walls_ms.last().copied().unwrap_or(0.0),
+        over_budget_count: stats.over_budget,
+        overrun_count: stats.overruns,
+        skipped_tick_count: stats.skipped_ticks,
+        solve_ms_per_trajectory: stats.solve_ms / stats.trajectories.max(1) as f64,
+        cpu_ms_per_trajectory: stats.cpu_ms / stats.trajectories.max(1) as f64,
+        trajectory_count: stats.trajectories,
+        fallback_count: stats.fallbacks,
+        unsafe_fallback_count: stats.unsafe_fallbacks,
+        switch_count: stats.switches,
+        reanchor_count: stats.reanchors,
         wall_s,
         real_time_factor: outcome.t / wall_s.max(1e-9),
         log_path: options.log_path.clone(),
@@ -584,23 +501,26 @@ pub fn fly(
     Ok(Flight { summary, record })
 }
 
-/// The run log being written and the in-memory record of the flight.
+/// The run log being written and the in-memory record of the flight (an observer).
 struct Logger {
     writer: Option<LogWriter>,
     record: FlightRecord,
     tally: Tally,
+    zero_timing: bool,
+    log_branches: bool,
+    real_time: bool,
+    growth_s: f64,
+    next_plan_snapshot: f64,
 }
 
-impl Logger {
+impl FlightObserver for Logger {
     fn state(
         &mut self,
         t: f64,
-        vehicle: &dyn Vehicle,
+        s: &VehicleState,
         positions: &[Vec3],
-        static_c: f64,
-        dynamic_c: f64,
+        c: &Clearances,
     ) -> Result<(), FlightError> {
-        let s = vehicle.state();
         let rec = StateRecord {
             t,
             p: v3(&s.p),
@@ -608,21 +528,129 @@ impl Logger {
             a: v3(&s.a),
             obstacles: positions.iter().map(v3).collect(),
         };
-        self.tally.add(&s.p, &s.v, &s.a, static_c, dynamic_c);
+        self.tally.add(&s.p, &s.v, &s.a, c.static_m, c.dynamic_m);
         if let Some(w) = self.writer.as_mut() {
             w.write(&Record::State(rec.clone()))?;
         }
         self.record.states.push(rec);
-        self.record.static_clearance.push(static_c);
-        self.record.dynamic_clearance.push(dynamic_c);
+        self.record.static_clearance.push(c.static_m);
+        self.record.dynamic_clearance.push(c.dynamic_m);
         Ok(())
     }
 
-    fn cycle(&mut self, rec: CycleRecord) -> Result<(), FlightError> {
+    fn cycle(&mut self, cycle: &CycleEvent<'_>) -> Result<(), FlightError> {
+        if let Some(plan) = cycle.manager.plan()
+            && cycle.t >= self.next_plan_snapshot
+        {
+            self.record.plans.push(plan.clone());
+            self.next_plan_snapshot = cycle.t + 1.0;
+        }
+        let mut rec = cycle_record(
+            cycle.report,
+            cycle.manager.route(),
+            cycle.effective_t,
+            self.zero_timing,
+        );
+        if self.real_time {
+            rec.charged_ms = Some(cycle.charged_s * 1e3);
+            rec.overrun_ticks = (cycle.overrun_ticks > 0).then_some(cycle.overrun_ticks);
+        }
+        if self.log_branches {
+            rec.branch_samples = Some(branch_samples(cycle.manager));
+            rec.forecasts = Some(forecast_records(cycle.ids, cycle.forecasts, self.growth_s));
+        }
         if let Some(w) = self.writer.as_mut() {
             w.write(&Record::Cycle(rec.clone()))?;
         }
         self.record.cycles.push(rec);
+        Ok(())
+    }
+}
+
+/// The cycles' statistics for the summary (an observer).
+#[derive(Debug, Clone, Default)]
+struct CycleStats {
+    budget_ms: f64,
+    walls_ms: Vec<f64>,
+    solve_ms: f64,
+    cpu_ms: f64,
+    trajectories: usize,
+    fallbacks: usize,
+    unsafe_fallbacks: usize,
+    switches: usize,
+    reanchors: usize,
+    over_budget: usize,
+    overruns: usize,
+    skipped_ticks: u64,
+}
+
+impl CycleStats {
+    fn new(budget_ms: f64) -> Self {
+        CycleStats {
+            budget_ms,
+            ..CycleStats::default()
+        }
+    }
+}
+
+impl FlightObserver for CycleStats {
+    fn cycle(&mut self, cycle: &CycleEvent<'_>) -> Result<(), FlightError> {
+        let report = cycle.report;
+        let timing = &report.timing;
+        self.walls_ms.push(timing.wall_ms);
+        self.over_budget += usize::from(timing.wall_ms > self.budget_ms);
+        self.overruns += usize::from(cycle.overrun_ticks > 0);
+        self.skipped_ticks += cycle.overrun_ticks;
+        self.solve_ms += timing.backend_ms;
+        self.cpu_ms += timing.frontend_ms + timing.backend_ms + timing.checker_ms;
+        self.trajectories += timing.solve_count;
+        if let Some(f) = &report.fallback {
+            self.fallbacks += 1;
+            self.unsafe_fallbacks += usize::from(!f.collision_free);
+        }
+        self.switches += usize::from(report.switched());
+        self.reanchors += report
+            .events
+            .iter()
+            .filter(|e| matches!(e, Event::Reanchored { .. }))
+            .count();
+        Ok(())
+    }
+}
+
+/// The forecasts the planner planned against (growth stopped as its manager stops it) over the
+/// last two horizons, by obstacle id, newest last (an observer): a collision's outcome says how
+/// long they had the obstacle where it hit.
+struct GivenForecasts {
+    given: ForecastHistory,
+    remember_s: f64,
+    growth_s: f64,
+}
+
+impl FlightObserver for GivenForecasts {
+    fn cycle(&mut self, cycle: &CycleEvent<'_>) -> Result<(), FlightError> {
+        let t = cycle.t;
+        self.given.push_back((
+            t,
+            cycle
+                .ids
+                .iter()
+                .copied()
+                .zip(
+                    cycle
+                        .forecasts
+                        .iter()
+                        .map(|f| f.with_growth_for(self.growth_s)),
+                )
+                .collect(),
+        ));
+        while self
+            .given
+            .front()
+            .is_some_and(|(tk, _)| *tk < t - self.remember_s)
+        {
+            self.given.pop_front();
+        }
         Ok(())
     }
 }
@@ -668,6 +696,8 @@ fn cycle_record(
         route_ms: planned.then(|| time(report.timing.route_ms)),
         branch_samples: None,
         forecasts: None,
+        charged_ms: None,
+        overrun_ticks: None,
     }
 }
 
@@ -698,17 +728,6 @@ fn branch_samples(manager: &AnyManager) -> Vec<BranchSamples> {
                 .collect();
             BranchSamples { id: b.id, samples }
         })
-        .collect()
-}
-
-/// By obstacle, the box it is known to stay inside when that is not the map: the region of a
-/// moving obstacle that the traffic turns back at its walls ([`Forecast::walls`]). `None` for
-/// an obstacle whose region is the world and for scripted ones (a script does not reflect).
-fn obstacle_walls(world: &World) -> Vec<Option<trust_predict::Aabb>> {
-    world
-        .obstacles()
-        .iter()
-        .map(|o| (!o.motion.is_scripted() && o.region != *world.bounds()).then_some(o.region))
         .collect()
 }
 

@@ -96,8 +96,8 @@ pub use manager::{Branch, MainDecision, Manager, choose_main};
 pub use params::{GROWTH_FRACTION, ManagerParams, ReanchorParams, SafetyParams};
 pub use progress::{ProgressMonitor, ProgressParams, StallRule};
 pub use report::{
-    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
-    Origin, STUB_FRACTION, StepReport,
+    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, GoalUnreachable,
+    LimitExcess, Origin, STUB_FRACTION, StepReport,
 };
 pub use routing::Router;
 pub use safety::{Hit, SafetyVerdict, Violation, assess_trajectory, check_trajectory};

@@ -221,6 +221,8 @@ pub struct Manager<F, B, H> {
     routed_goal: Option<Vec3>,
     /// When the last route was planned (or failed), s.
     routed_at: f64,
+    /// The standing verdict that the goal cannot be reached ([`crate::GoalUnreachable`]).
+    unreachable: Option<crate::GoalUnreachable>,
 }
 
 impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
@@ -264,6 +266,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             router: None,
             routed_goal: None,
             routed_at: f64::NEG_INFINITY,
+            unreachable: None,
             cycle_count: 0,
         })
     }
@@ -497,6 +500,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             straight_guide: explored.straight_guide,
             timing: spans.finish(),
             fallback,
+            goal_unreachable: self.unreachable.clone(),
         })
     }
 

@@ -189,6 +189,15 @@ pub enum Event {
         /// The route planner's error message.
         error: String,
     },
+    /// The route planner proved the goal cannot be reached ([`GoalUnreachable`]); the manager
+    /// holds a stop at the reachable point nearest the goal and re-checks.
+    GoalUnreachable {
+        /// Why, in words (sealed off, narrower than the vehicle plus its margin, ...).
+        cause: String,
+        /// The reachable point nearest the goal the manager now aims at, if any.
+        #[serde(default)]
+        held_at: Option<[f64; 3]>,
+    },
     /// The vehicle progressed again after [`Event::Stalled`] (or came near the goal).
     Escaped {
         /// How long the stall lasted (s).
@@ -238,6 +247,7 @@ impl Event {
             Event::Escaped { .. } => "escaped",
             Event::Rerouted { .. } => "rerouted",
             Event::RouteFailed { .. } => "route_failed",
+            Event::GoalUnreachable { .. } => "goal_unreachable",
         }
     }
 }
@@ -359,12 +369,34 @@ pub struct StepReport {
     pub timing: CycleTiming,
     /// The braking fallback, when no branch was feasible.
     pub fallback: Option<FallbackReport>,
+    /// The manager's standing verdict that the goal cannot be reached, while it holds.
+    #[serde(default)]
+    pub goal_unreachable: Option<GoalUnreachable>,
+}
+
+/// The manager's verdict that the goal cannot be reached (beyond the paper): the route planner
+/// proved it ([`trust_route::RouteProgress::Unreachable`]); it stands until a re-check finds a
+/// route or the goal changes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GoalUnreachable {
+    /// Why, in words.
+    pub cause: String,
+    /// The reachable point nearest the goal, where the manager holds a stop (`None`: where the
+    /// vehicle is).
+    pub held_at: Option<[f64; 3]>,
+    /// When the verdict was first reached (s).
+    pub since_t: f64,
 }
 
 impl StepReport {
     /// The event tags in order (the run log's `events`).
     pub fn event_tags(&self) -> Vec<&'static str> {
         self.events.iter().map(Event::tag).collect()
+    }
+
+    /// The standing verdict that the goal cannot be reached, if any.
+    pub fn goal_unreachable(&self) -> Option<&GoalUnreachable> {
+        self.goal_unreachable.as_ref()
     }
 
     /// Whether the main branch changed this cycle.

@@ -165,6 +165,8 @@ fn write_log(path: &Path, t_end: f64, with_branches: bool) {
                         },
                     ]
                 }),
+                charged_ms: None,
+                overrun_ticks: None,
             }))
             .unwrap();
         }

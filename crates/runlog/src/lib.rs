@@ -240,6 +240,14 @@ pub struct CycleRecord {
     /// Added (issue 20), only when branch logging is on: the forecasts the cycle planned against.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub forecasts: Option<Vec<ForecastRecord>>,
+    /// Added (issue 31), only in the real-time latency mode: the time the planner was charged
+    /// for the cycle (ms): its wall time times the mode's `cpu_scale`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub charged_ms: Option<f64>,
+    /// Added (issue 31), only when positive: replanning ticks skipped because the planner was
+    /// still busy with this cycle (real-time latency mode).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overrun_ticks: Option<u64>,
 }
 
 /// One kept branch's trajectory, sampled (added, issue 20).
@@ -360,6 +368,11 @@ pub enum Status {
     TimedOut,
     /// The run could not be carried out as specified (e.g. the planner rejected the input).
     Invalid,
+    /// The planner proved the goal cannot be reached (sealed off, inside an obstacle, outside
+    /// the bounds, or behind passages narrower than the vehicle plus its margin) and held that
+    /// verdict for the settling time; the outcome's `reason` says why. Beyond the contract's
+    /// four statuses (an added value, `docs/run-log.md`).
+    Unreachable,
 }
 
 impl Status {
@@ -370,6 +383,7 @@ impl Status {
             Status::Collided => "collided",
             Status::TimedOut => "timed_out",
             Status::Invalid => "invalid",
+            Status::Unreachable => "unreachable",
         }
     }
 }
@@ -817,6 +831,8 @@ mod tests {
             route_ms: None,
             branch_samples: None,
             forecasts: None,
+            charged_ms: None,
+            overrun_ticks: None,
         }
     }
 

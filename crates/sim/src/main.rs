@@ -2,6 +2,7 @@
 //!
 //! ```text
 //! trust-sim run SCENARIO.toml [--planner NAME] [--seed S] [--out DIR] [--vehicle quadrotor|perfect]
+//!                             [--real-time [CPU_SCALE]]
 //! trust-sim validate SCENARIO.toml...
 //! trust-sim audit RUN.jsonl...
 //! trust-sim replay RUN.jsonl [--out DIR] [--gif-width PX] [--gif-frames N]
@@ -10,7 +11,7 @@
 //!                  [--out DIR] [--jobs J] [--shard K/M] [--time-limit T] [--no-plots]
 //! trust-sim ablate-merge --out DIR SHARD_DIR...
 //! trust-sim suite [SCENARIO.toml|DIR...] [--seeds K] [--seed S] [--planners a,b] [--out DIR]
-//!                 [--jobs J] [--time-limit T] [--no-plots]
+//!                 [--jobs J] [--time-limit T] [--no-plots] [--real-time [CPU_SCALE]]
 //! trust-sim e3 [--scenario FILE] [--seed S] [--out DIR]
 //! ```
 //!
@@ -32,7 +33,7 @@ use trust_runlog::RunLog;
 use trust_runlog::audit::audit;
 use trust_world::World;
 use trust_world::planner::PlannerPreset;
-use trust_world::scenario::{Scenario, VehicleModel};
+use trust_world::scenario::{Latency, MAX_CPU_SCALE, Scenario, VehicleModel};
 
 #[derive(Parser)]
 #[command(
@@ -85,6 +86,11 @@ enum Cmd {
         /// Also write the replay (run.replay.html and run.replay.gif) next to the log.
         #[arg(long)]
         replay: bool,
+        /// Fly in real time, replacing the scenario's `sim.latency`: each cycle's measured wall
+        /// time (times CPU_SCALE, default 1: a computer CPU_SCALE times slower) is charged, and
+        /// a busy planner skips replanning ticks (logged as the cycle's `overrun_ticks`).
+        #[arg(long, value_name = "CPU_SCALE", num_args = 0..=1, default_missing_value = "1")]
+        real_time: Option<f64>,
     },
     /// Write the replay of a run log: one self-contained HTML page that plays the flight, and an
     /// animated GIF of its top view (RUN.replay.html, RUN.replay.gif).
@@ -177,6 +183,10 @@ enum Cmd {
         /// Skip the chart.
         #[arg(long)]
         no_plots: bool,
+        /// Fly in real time (see `run --real-time`), replacing the files' `sim.latency`.
+        /// Measured times depend on the machine's load: use `--jobs 1` on a quiet machine.
+        #[arg(long, value_name = "CPU_SCALE", num_args = 0..=1, default_missing_value = "1")]
+        real_time: Option<f64>,
     },
     /// Experiment E3 (paper Table Sim-B-1): the branches of one cold cycle, beside the paper's
     /// table; writes summary.json, report.md and a top view with the forecasts.
@@ -262,6 +272,14 @@ fn main() -> ExitCode {
     }
 }
 
+/// The real-time latency at `--real-time CPU_SCALE`.
+fn real_time_latency(scale: f64) -> Result<Latency> {
+    if !(scale > 0.0 && scale <= MAX_CPU_SCALE) {
+        bail!("--real-time takes a CPU scale in (0, {MAX_CPU_SCALE}], got {scale}");
+    }
+    Ok(Latency::real_time(scale))
+}
+
 fn run_cli() -> Result<ExitCode> {
     match Cli::parse().command {
         Cmd::Run {
@@ -276,6 +294,7 @@ fn run_cli() -> Result<ExitCode> {
             log_branches,
             no_log_branches,
             replay,
+            real_time,
         } => {
             // Checked once, with the overrides applied, where the world is built (`run`).
             let mut s = Scenario::parse_file(&scenario)?;
@@ -300,6 +319,9 @@ fn run_cli() -> Result<ExitCode> {
                     bail!("--time-limit must be a positive number of seconds, got {limit}");
                 }
                 s.time_limit_s = limit;
+            }
+            if let Some(scale) = real_time {
+                s.sim.latency = real_time_latency(scale)?;
             }
             let branches = if log_branches {
                 true
@@ -384,6 +406,7 @@ fn run_cli() -> Result<ExitCode> {
             jobs,
             time_limit,
             no_plots,
+            real_time,
         } => {
             let planners = parse_presets(&planners)?;
             let config = SuiteConfig {
@@ -392,6 +415,7 @@ fn run_cli() -> Result<ExitCode> {
                 seed,
                 planners,
                 time_limit_s: time_limit,
+                latency: real_time.map(real_time_latency).transpose()?,
             };
             eprintln!(
                 "{} file(s) × {} seed(s) × {} planner setting(s)",
@@ -597,12 +621,28 @@ fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
         o.max_speed,
         o.max_accel
     );
+    if let (trust_runlog::Status::Unreachable | trust_runlog::Status::Invalid, Some(why)) =
+        (o.status, &o.reason)
+    {
+        out!("why: {why}");
+    }
     out!(
-        "{} cycles: median {:.2} ms, p99 {:.2} ms; {:.3} ms solve per trajectory; \
-         {} fallbacks; {:.1}× real time",
+        "{} cycles: median {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} over the {} ms budget{}); \
+         {:.3} ms solve per trajectory; {} fallbacks; {:.1}× real time",
         summary.cycle_count,
         summary.cycle_ms_median,
         summary.cycle_ms_p99,
+        summary.cycle_ms_max,
+        summary.over_budget_count,
+        planner.manager.cycle_budget_ms,
+        if world.scenario().sim.latency.is_real_time() {
+            format!(
+                "; real time: {} replanning tick(s) skipped",
+                summary.skipped_tick_count
+            )
+        } else {
+            String::new()
+        },
         summary.solve_ms_per_trajectory,
         summary.fallback_count,
         summary.real_time_factor

@@ -212,13 +212,19 @@ pub struct RunRow {
     pub cpu_ms_per_trajectory: f64,
     /// Wall time of the flight, simulation included (s). Timing.
     pub wall_s: f64,
+    /// The longest cycle's wall time (ms). Timing.
+    pub cycle_ms_max: f64,
+    /// Cycles longer than the manager's cycle budget. Timing.
+    pub over_budget: usize,
+    /// Replanning ticks skipped because the planner was busy (real-time variants). Timing.
+    pub skipped_ticks: u64,
     /// The run log, relative to the study directory.
     pub log: String,
 }
 
 impl RunRow {
     /// The CSV header.
-    pub const COLUMNS: [&'static str; 20] = [
+    pub const COLUMNS: [&'static str; 23] = [
         "trial",
         "planner",
         "seed",
@@ -237,6 +243,9 @@ impl RunRow {
         "solve_ms_per_trajectory",
         "cpu_ms_per_trajectory",
         "wall_s",
+        "cycle_ms_max",
+        "over_budget",
+        "skipped_ticks",
         "log",
         "",
     ];
@@ -244,17 +253,17 @@ impl RunRow {
     /// The columns that hold measured times (they differ between runs of the same study):
     /// `cycle_ms_median` … `wall_s` of [`RunRow::COLUMNS`].
     pub fn timing_columns() -> &'static [&'static str] {
-        &Self::COLUMNS[13..18]
+        &Self::COLUMNS[13..21]
     }
 
     fn header_line() -> String {
-        Self::COLUMNS[..19].join(",")
+        Self::COLUMNS[..22].join(",")
     }
 
     fn to_line(&self) -> String {
         let clean = |s: &str| s.replace([',', '\n', '\r', '"'], ";");
         format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             self.trial,
             clean(&self.planner),
             self.seed,
@@ -273,17 +282,20 @@ impl RunRow {
             self.solve_ms_per_trajectory,
             self.cpu_ms_per_trajectory,
             self.wall_s,
+            self.cycle_ms_max,
+            self.over_budget,
+            self.skipped_ticks,
             clean(&self.log),
         )
     }
 
     fn from_line(line: &str, place: &str) -> Result<RunRow, ExperimentError> {
         let f: Vec<&str> = line.split(',').collect();
-        if f.len() != 19 {
+        if f.len() != 22 {
             return Err(ExperimentError::input(
                 place,
                 line,
-                "19 comma-separated fields (runs.csv of trust-sim ablate)",
+                "22 comma-separated fields (runs.csv of trust-sim ablate)",
             ));
         }
         fn num<T: std::str::FromStr>(
@@ -314,7 +326,10 @@ impl RunRow {
             solve_ms_per_trajectory: num(f[15], "solve_ms_per_trajectory", place)?,
             cpu_ms_per_trajectory: num(f[16], "cpu_ms_per_trajectory", place)?,
             wall_s: num(f[17], "wall_s", place)?,
-            log: f[18].to_string(),
+            cycle_ms_max: num(f[18], "cycle_ms_max", place)?,
+            over_budget: num(f[19], "over_budget", place)?,
+            skipped_ticks: num(f[20], "skipped_ticks", place)?,
+            log: f[21].to_string(),
         })
     }
 
@@ -326,6 +341,9 @@ impl RunRow {
             solve_ms_per_trajectory: 0.0,
             cpu_ms_per_trajectory: 0.0,
             wall_s: 0.0,
+            cycle_ms_max: 0.0,
+            over_budget: 0,
+            skipped_ticks: 0,
             ..self.clone()
         }
     }
@@ -477,6 +495,9 @@ fn run_trial(
             solve_ms_per_trajectory: s.solve_ms_per_trajectory,
             cpu_ms_per_trajectory: s.cpu_ms_per_trajectory,
             wall_s: s.wall_s,
+            cycle_ms_max: s.cycle_ms_max,
+            over_budget: s.over_budget_count,
+            skipped_ticks: s.skipped_tick_count,
             log: rel,
         });
         bar.inc(1);
@@ -664,7 +685,10 @@ mod tests {
                 "cycle_ms_p99",
                 "solve_ms_per_trajectory",
                 "cpu_ms_per_trajectory",
-                "wall_s"
+                "wall_s",
+                "cycle_ms_max",
+                "over_budget",
+                "skipped_ticks"
             ]
         );
     }
@@ -703,6 +727,9 @@ mod tests {
             solve_ms_per_trajectory: 0.75,
             cpu_ms_per_trajectory: 1.0,
             wall_s: 3.0,
+            cycle_ms_max: 48.5,
+            over_budget: 1,
+            skipped_ticks: 2,
             log: "logs/trust/trial-0003.jsonl".into(),
         };
         let dir = std::env::temp_dir().join(format!("trust-sim-csv-{}", std::process::id()));

@@ -73,6 +73,16 @@ pub struct PlannerSummary {
     pub cycle_ms_median: Option<f64>,
     /// Median over flights of the per-flight 99th-percentile cycle time (ms). Timing.
     pub cycle_ms_p99: Option<f64>,
+    /// The longest cycle over every flight (ms). Timing.
+    #[serde(default)]
+    pub cycle_ms_max: Option<f64>,
+    /// Cycles longer than the cycle budget, over every flight. Timing.
+    #[serde(default)]
+    pub over_budget: usize,
+    /// Replanning ticks skipped because the planner was busy, over every flight (real-time
+    /// variants). Timing.
+    #[serde(default)]
+    pub skipped_ticks: u64,
     /// The paper's numbers, where stated.
     pub paper: PaperNumbers,
 }
@@ -125,6 +135,9 @@ pub fn summarize(scenario: &str, planner: &str, rows: &[&RunRow]) -> PlannerSumm
         ),
         cycle_ms_median: median(&rows.iter().map(|r| r.cycle_ms_median).collect::<Vec<_>>()),
         cycle_ms_p99: median(&rows.iter().map(|r| r.cycle_ms_p99).collect::<Vec<_>>()),
+        cycle_ms_max: rows.iter().map(|r| r.cycle_ms_max).max_by(f64::total_cmp),
+        over_budget: rows.iter().map(|r| r.over_budget).sum(),
+        skipped_ticks: rows.iter().map(|r| r.skipped_ticks).sum(),
         paper: paper_numbers(scenario, planner),
     }
 }
@@ -214,9 +227,10 @@ pub fn report_md(s: &StudySummary) -> String {
     let _ = writeln!(
         md,
         "| planner | success (95 % CI) | collisions (static) | time-outs | invalid | flight time s | \
-         fallbacks / flight | CPU ms / trajectory | cycle ms median / p99 | paper |"
+         fallbacks / flight | CPU ms / trajectory | cycle ms median / p99 | worst cycle ms \
+         | over budget / skipped ticks | paper |"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for p in &s.planners {
         let paper = match (
             p.paper.success_rate,
@@ -229,7 +243,7 @@ pub fn report_md(s: &StudySummary) -> String {
         };
         let _ = writeln!(
             md,
-            "| {} | {} [{}, {}] ({}/{}) | {} ({}) | {} | {} | {} | {} | {} | {} / {} | {} |",
+            "| {} | {} [{}, {}] ({}/{}) | {} ({}) | {} | {} | {} | {} | {} | {} / {} | {} | {} / {} | {} |",
             p.planner,
             pct(p.success.rate),
             pct(p.success.ci95_low),
@@ -245,6 +259,9 @@ pub fn report_md(s: &StudySummary) -> String {
             mean_text(&p.cpu_ms_per_trajectory, 2),
             opt(p.cycle_ms_median, 2),
             opt(p.cycle_ms_p99, 2),
+            opt(p.cycle_ms_max, 1),
+            p.over_budget,
+            p.skipped_ticks,
             paper
         );
     }

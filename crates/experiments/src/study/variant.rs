@@ -9,7 +9,7 @@ use trust_topo_prm::{UvdParams, VprmParams};
 
 use crate::ExperimentError;
 use trust_world::planner::{BackendSpec, CheckerSpec, FrontendSpec};
-use trust_world::scenario::{Scenario, VehicleModel};
+use trust_world::scenario::{Latency, MAX_CPU_SCALE, Scenario, VehicleModel};
 
 /// An ablation: one component changed for every planner it concerns (the others fly as they
 /// are). Written and parsed as in the list below.
@@ -51,13 +51,18 @@ pub enum Variant {
     /// (`[planner.route]`, beyond the paper). Without it a study flies the paper's setting: every
     /// query aims at the final goal.
     Route,
+    /// `real-time` or `real-time=X`: the loop charges each cycle's measured wall time (times
+    /// `X`, default 1: an onboard computer `X` times slower) and a busy planner skips replanning
+    /// ticks (`sim.latency = { kind = "measured", cpu_scale = X }`). Machine-dependent: fly it
+    /// with `--jobs 1` on a quiet machine.
+    RealTime(f64),
 }
 
 impl Variant {
     /// Every variant name, for help texts.
     pub const NAMES: &'static str = "none, vprm, minco, uvd, no-pdc, no-ggs, no-history, \
                                      no-hysteresis, perfect, quadrotor, mu=X, fault=X, \
-                                     explore=K, route";
+                                     explore=K, route, real-time, real-time=X";
 
     /// Applies the variant to `scenario` (whose planner preset is already chosen): replaces the
     /// preset's part it concerns, or the scenario section it sweeps.
@@ -126,6 +131,7 @@ impl Variant {
             Variant::Fault(x) => scenario.traffic.fault_level = x,
             Variant::Explore(k) => manager_overrides(planner).explore_period_cycles = Some(k),
             Variant::Route => planner.route.enabled = true,
+            Variant::RealTime(x) => scenario.sim.latency = Latency::real_time(x),
         }
         Ok(())
     }
@@ -155,6 +161,8 @@ impl fmt::Display for Variant {
             Variant::Fault(x) => write!(f, "fault={x}"),
             Variant::Explore(k) => write!(f, "explore={k}"),
             Variant::Route => f.write_str("route"),
+            Variant::RealTime(x) if *x == 1.0 => f.write_str("real-time"),
+            Variant::RealTime(x) => write!(f, "real-time={x}"),
         }
     }
 }
@@ -185,9 +193,20 @@ impl FromStr for Variant {
             "no-hysteresis" => Variant::NoHysteresis,
             "perfect" => Variant::Perfect,
             "quadrotor" => Variant::Quadrotor,
+            "real-time" => Variant::RealTime(1.0),
             t => match t.split_once('=') {
                 Some(("mu", v)) => Variant::Mu(number(v, "mu")?),
                 Some(("fault", v)) => Variant::Fault(number(v, "fault")?),
+                Some(("real-time", v)) => match number(v, "real-time")? {
+                    x if x > 0.0 && x <= MAX_CPU_SCALE => Variant::RealTime(x),
+                    _ => {
+                        return Err(ExperimentError::input(
+                            "--variant",
+                            text,
+                            format!("real-time=X with X in (0, {MAX_CPU_SCALE}]"),
+                        ));
+                    }
+                },
                 Some(("explore", v)) => match v.parse::<usize>() {
                     Ok(k) if k >= 1 => Variant::Explore(k),
                     _ => {
@@ -253,6 +272,8 @@ mod tests {
             "fault=0.5",
             "explore=3",
             "route",
+            "real-time",
+            "real-time=3",
         ] {
             let v: Variant = name.parse().unwrap();
             assert_eq!(v.to_string(), name);
@@ -264,6 +285,8 @@ mod tests {
             "mu=inf",
             "explore=0",
             "explore=1.5",
+            "real-time=0",
+            "real-time=1000",
         ] {
             let e = bad.parse::<Variant>().unwrap_err().to_string();
             assert!(e.contains("--variant") && e.contains(bad), "{e}");

@@ -140,8 +140,9 @@ use trust_core::Aabb;
 pub use crate::problem::Problem;
 pub use generator::{E1Params, E2Params, E3Params, E4Params, GeneratorSpec};
 pub use sections::{
-    BoundsSpec, Latency, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec, RandomEndpoints,
-    RandomObstacles, SimSection, StaticSection, VehicleModel, VehicleSection, WorldSection,
+    BoundsSpec, Latency, MAX_CPU_SCALE, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec,
+    RandomEndpoints, RandomObstacles, SimSection, StaticSection, VehicleModel, VehicleSection,
+    WorldSection,
 };
 
 /// A static obstacle of `[[static.shapes]]`: the run log's type (see [`StaticSection::shapes`]).

@@ -577,8 +577,34 @@ pub enum Latency {
         /// The delay (s), `≥ 0`.
         seconds: Option<f64>,
     },
-    /// The measured CPU time of each cycle: `{ kind = "measured" }` (machine-dependent).
-    Measured {},
+    /// Real time: `{ kind = "measured" }` (alias `"real-time"`), machine-dependent. The planner
+    /// is busy from a cycle's start for the cycle's measured wall time times `cpu_scale`; its
+    /// plan takes effect when it finishes, the next cycle starts at the first replanning tick
+    /// after that, and the ticks in between are skipped (logged as the cycle's
+    /// `overrun_ticks`). The planner's wall-clock budgets are on in this mode.
+    #[serde(alias = "real-time")]
+    Measured {
+        /// The measured time is multiplied by this factor, to emulate a slower onboard computer
+        /// (3: a computer three times slower than this one). Range `(0, 100]`; default 1.
+        cpu_scale: Option<f64>,
+    },
+}
+
+/// Largest [`Latency::Measured`] `cpu_scale` accepted.
+pub const MAX_CPU_SCALE: f64 = 100.0;
+
+impl Latency {
+    /// The real-time mode at `cpu_scale` ([`Latency::Measured`]).
+    pub fn real_time(cpu_scale: f64) -> Self {
+        Latency::Measured {
+            cpu_scale: Some(cpu_scale),
+        }
+    }
+
+    /// Whether this is the real-time mode ([`Latency::Measured`]).
+    pub fn is_real_time(&self) -> bool {
+        matches!(self, Latency::Measured { .. })
+    }
 }
 
 impl Default for Latency {

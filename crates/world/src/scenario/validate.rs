@@ -3,7 +3,7 @@
 use trust_core::{Aabb, Vec3};
 use trust_geometry::{MAX_VOXELS, checked_voxel_count};
 
-use super::{Latency, MovingShapeKind, PointCloudSpec, Problem, Scenario};
+use super::{Latency, MAX_CPU_SCALE, MovingShapeKind, PointCloudSpec, Problem, Scenario};
 use crate::problem::{Problems, fmt_bounds, fmt_vec};
 use crate::scenario::points::read_points_file;
 use trust_vehicle::VehicleError;
@@ -418,6 +418,17 @@ impl Scenario {
                 format!(
                     "at least {MIN_LOG_RATE_HZ} Hz (run-log contract: state records at >= 50 Hz)"
                 ),
+            );
+        }
+        if let Latency::Measured {
+            cpu_scale: Some(scale),
+        } = s.latency
+            && !(scale > 0.0 && scale <= MAX_CPU_SCALE)
+        {
+            p.push(
+                "sim.latency.cpu_scale",
+                scale,
+                format!("a number in (0, {MAX_CPU_SCALE}]"),
             );
         }
         if let Latency::Fixed {

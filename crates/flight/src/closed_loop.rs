@@ -1,0 +1,438 @@
+//! The closed loop as a step: [`LoopParams`] (fixed for a flight), [`FlightState`] (everything
+//! a flight changes) and [`step`], which advances the flight by one physics step and reports to a
+//! [`FlightObserver`] (rapier's `PhysicsPipeline::step` is the model: every piece of state it
+//! touches is an argument, the observers are `&mut dyn` with a no-op `()`).
+//!
+//! The clock model is in one place, [`Clock`]:
+//!
+//! * [`Clock::Fixed`] — a cycle's plan takes effect a fixed latency after the cycle's start and
+//!   the next cycle starts at the next replanning tick, however long the cycle took. The log is
+//!   a function of the seed alone (byte-identical with zeroed timing fields).
+//! * [`Clock::RealTime`] — the planner is busy from a cycle's start for the cycle's measured wall
+//!   time times `cpu_scale`; its plan takes effect when it finishes (not before the instant it was
+//!   planned from, the manager's latency), the next cycle starts at the first replanning tick
+//!   after that, and the ticks in between are skipped: the cycle's `overrun_ticks`.
+
+use trust_core::{PolyTraj, Scene, Vec3};
+use trust_manager::StepReport;
+use trust_predict::Forecast;
+use trust_vehicle::{Reference, Vehicle, VehicleState};
+use trust_world::World;
+use trust_world::planner::{AnyManager, ResolvedPlanner};
+use trust_world::scenario::Latency;
+use trust_world::sensing::Sensing;
+use trust_world::traffic::Traffic;
+
+use crate::FlightError;
+
+/// When a cycle's plan takes effect and when the next cycle may start (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Clock {
+    /// A fixed latency (s) after the cycle's start; cycles start at every replanning tick.
+    Fixed {
+        /// The latency (s).
+        latency_s: f64,
+    },
+    /// The cycle's measured wall time times `cpu_scale`; a busy planner skips ticks.
+    RealTime {
+        /// The factor on the measured time (3: an onboard computer three times slower).
+        cpu_scale: f64,
+    },
+}
+
+impl Clock {
+    /// The clock a scenario's `sim.latency` names; `manager_latency_s` is the manager's own
+    /// (`ManagerParams::latency`), the fixed latency when the scenario gives none.
+    pub fn from_latency(latency: Latency, manager_latency_s: f64) -> Self {
+        match latency {
+            Latency::Fixed { seconds } => Clock::Fixed {
+                latency_s: seconds.unwrap_or(manager_latency_s),
+            },
+            Latency::Measured { cpu_scale } => Clock::RealTime {
+                cpu_scale: cpu_scale.unwrap_or(1.0),
+            },
+        }
+    }
+
+    /// The time (s) the planner is charged for a cycle whose wall time was `wall_ms`.
+    pub fn charged_s(&self, wall_ms: f64) -> f64 {
+        match *self {
+            Clock::Fixed { latency_s } => latency_s,
+            Clock::RealTime { cpu_scale } => wall_ms.max(0.0) * 1e-3 * cpu_scale,
+        }
+    }
+}
+
+/// What a flight keeps fixed: the clocks, the goal and when it ends.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoopParams {
+    /// Physics (and control) step (s).
+    pub dt_s: f64,
+    /// Physics steps per replanning period.
+    pub replan_steps: u64,
+    /// Physics steps per logged state.
+    pub log_steps: u64,
+    /// The flight times out after this many physics steps.
+    pub max_steps: u64,
+    /// The mission's goal.
+    pub goal: Vec3,
+    /// Arrival: the vehicle centre within this distance of the goal (m).
+    pub goal_tolerance_m: f64,
+    /// The vehicle's radius (m), for the clearances.
+    pub vehicle_radius_m: f64,
+    /// The clock model.
+    pub clock: Clock,
+    /// The latency the manager plans for (s): a plan starts this long after its cycle, and
+    /// never takes effect before that.
+    pub manager_latency_s: f64,
+    /// The manager's cycle budget (ms): a cycle longer than this is counted as over budget.
+    pub cycle_budget_ms: f64,
+    /// How long the manager's verdict that the goal cannot be reached must hold before the
+    /// flight ends as `unreachable` (s).
+    pub unreachable_settle_s: f64,
+}
+
+/// Default [`LoopParams::unreachable_settle_s`]: 2 s, a few re-checks of the verdict (the
+/// manager re-checks at least every planning horizon) and time to brake to the held stop.
+pub const UNREACHABLE_SETTLE_S: f64 = 2.0;
+
+impl LoopParams {
+    /// The loop of a flight of `planner` through `world`.
+    pub fn new(world: &World, planner: &ResolvedPlanner) -> Self {
+        let scenario = world.scenario();
+        let sim = &scenario.sim;
+        let dt = sim.physics_dt_s;
+        let steps_per = |rate_hz: f64| ((1.0 / rate_hz) / dt).round().max(1.0) as u64;
+        let manager_latency_s = planner.manager.latency();
+        LoopParams {
+            dt_s: dt,
+            replan_steps: steps_per(sim.replan_rate_hz),
+            log_steps: steps_per(sim.log_rate_hz),
+            max_steps: (scenario.time_limit_s / dt).ceil() as u64,
+            goal: world.goal(),
+            goal_tolerance_m: scenario.mission.goal_tolerance_m,
+            vehicle_radius_m: world.vehicle_radius_m(),
+            clock: Clock::from_latency(sim.latency, manager_latency_s),
+            manager_latency_s,
+            cycle_budget_ms: planner.manager.cycle_budget_ms,
+            unreachable_settle_s: UNREACHABLE_SETTLE_S,
+        }
+    }
+
+    /// The replanning period (s).
+    pub fn replan_period_s(&self) -> f64 {
+        self.replan_steps as f64 * self.dt_s
+    }
+}
+
+/// Everything a flight changes, step by step.
+pub struct FlightState {
+    /// The true moving obstacles.
+    pub traffic: Traffic,
+    /// The sensing and its trackers.
+    pub sensing: Sensing,
+    /// The planner.
+    pub manager: AnyManager,
+    /// The true vehicle.
+    pub vehicle: Box<dyn Vehicle>,
+    /// What the vehicle tracks before the first plan takes effect.
+    pub hover: Reference,
+    /// The plan the vehicle tracks.
+    pub active: Option<PolyTraj>,
+    /// The latest plan and when it takes effect (s).
+    pub pending: Option<(f64, PolyTraj)>,
+    /// Physics steps done.
+    pub step: u64,
+    /// Simulated time (s): `step · dt`.
+    pub t: f64,
+    /// The planner is busy until this time (s) ([`Clock::RealTime`]).
+    pub busy_until: f64,
+    /// Since when the manager has held that the goal cannot be reached (s), and why.
+    pub unreachable_since: Option<(f64, String)>,
+}
+
+/// What the vehicle touched.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Contact {
+    /// The static geometry.
+    Static,
+    /// The moving obstacle with this id.
+    Obstacle(usize),
+}
+
+impl Contact {
+    /// The run log's spelling (`"static"`, `"obstacle:<id>"`).
+    pub fn log_tag(&self) -> String {
+        match self {
+            Contact::Static => "static".to_owned(),
+            Contact::Obstacle(id) => format!("obstacle:{id}"),
+        }
+    }
+}
+
+/// How a flight ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ending {
+    /// Within the goal tolerance.
+    Arrived,
+    /// A clearance below zero.
+    Collided(Contact),
+    /// The time limit passed.
+    TimedOut,
+    /// The manager held that the goal cannot be reached for the settling time.
+    Unreachable {
+        /// The manager's cause.
+        reason: String,
+    },
+    /// The planner rejected its input.
+    Invalid {
+        /// The planner's error.
+        reason: String,
+    },
+}
+
+/// The vehicle's clearances at one instant (m, from the vehicle's surface).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clearances {
+    /// To the true static geometry.
+    pub static_m: f64,
+    /// To the nearest true moving obstacle (`+∞` without any).
+    pub dynamic_m: f64,
+    /// That obstacle's id.
+    pub nearest: Option<usize>,
+}
+
+impl Clearances {
+    /// The clearances of a vehicle at `p` in `world` among `traffic`.
+    pub fn at(world: &World, traffic: &Traffic, radius: f64, p: &Vec3) -> Self {
+        let (d, nearest) = traffic.clearance(p);
+        Clearances {
+            static_m: world.true_static_clearance(p) - radius,
+            dynamic_m: d - radius,
+            nearest,
+        }
+    }
+
+    /// What the vehicle touches, if anything (the nearer surface when both).
+    pub fn contact(&self) -> Option<Contact> {
+        if self.static_m >= 0.0 && self.dynamic_m >= 0.0 {
+            None
+        } else if self.static_m <= self.dynamic_m {
+            Some(Contact::Static)
+        } else {
+            // A negative dynamic clearance comes from an obstacle, so `nearest` is set.
+            self.nearest
+                .map(Contact::Obstacle)
+                .or(Some(Contact::Static))
+        }
+    }
+}
+
+/// One planning cycle as the loop saw it.
+pub struct CycleEvent<'a> {
+    /// The cycle's start (s).
+    pub t: f64,
+    /// The manager's report.
+    pub report: &'a StepReport,
+    /// The manager after the cycle.
+    pub manager: &'a AnyManager,
+    /// The tracked obstacles' ids, in the order of `forecasts`.
+    pub ids: &'a [usize],
+    /// The forecasts the manager planned against (as sensed, with their regions).
+    pub forecasts: &'a [Forecast],
+    /// When the cycle's plan takes effect (s).
+    pub effective_t: f64,
+    /// The time the planner was charged (s; [`Clock::charged_s`]).
+    pub charged_s: f64,
+    /// Replanning ticks skipped because the planner was still busy with this cycle.
+    pub overrun_ticks: u64,
+}
+
+/// Hooks into the loop (`()` does nothing). Errors end the flight with that error.
+pub trait FlightObserver {
+    /// A true state worth logging: every log tick, and the last instant.
+    fn state(
+        &mut self,
+        _t: f64,
+        _vehicle: &VehicleState,
+        _obstacles: &[Vec3],
+        _clearances: &Clearances,
+    ) -> Result<(), FlightError> {
+        Ok(())
+    }
+
+    /// A planning cycle that returned a report.
+    fn cycle(&mut self, _cycle: &CycleEvent<'_>) -> Result<(), FlightError> {
+        Ok(())
+    }
+}
+
+impl FlightObserver for () {}
+
+impl<A: FlightObserver, B: FlightObserver> FlightObserver for (A, B) {
+    fn state(
+        &mut self,
+        t: f64,
+        vehicle: &VehicleState,
+        obstacles: &[Vec3],
+        clearances: &Clearances,
+    ) -> Result<(), FlightError> {
+        self.0.state(t, vehicle, obstacles, clearances)?;
+        self.1.state(t, vehicle, obstacles, clearances)
+    }
+
+    fn cycle(&mut self, cycle: &CycleEvent<'_>) -> Result<(), FlightError> {
+        self.0.cycle(cycle)?;
+        self.1.cycle(cycle)
+    }
+}
+
+/// By obstacle, the box it is known to stay inside when that is not the map: the region of a
+/// moving obstacle that the traffic turns back at its walls ([`Forecast::walls`]). `None` for
+/// an obstacle whose region is the world and for scripted ones (a script does not reflect).
+pub fn obstacle_walls(world: &World) -> Vec<Option<trust_predict::Aabb>> {
+    world
+        .obstacles()
+        .iter()
+        .map(|o| (!o.motion.is_scripted() && o.region != *world.bounds()).then_some(o.region))
+        .collect()
+}
+
+/// Advances the flight by one physics step: a planning cycle first when the step is on a
+/// replanning tick and the planner is free, then the vehicle and the obstacles move, the
+/// vehicle is checked against the true geometry and the sensors measure. `walls` is
+/// [`obstacle_walls`] of `world`. Returns how the flight ended, if it did.
+///
+/// # Errors
+/// [`FlightError`] from the sensing, the vehicle model or an observer. A planner that rejects
+/// its input is not an error: the flight ends [`Ending::Invalid`].
+pub fn step(
+    params: &LoopParams,
+    world: &World,
+    walls: &[Option<trust_predict::Aabb>],
+    state: &mut FlightState,
+    observer: &mut dyn FlightObserver,
+) -> Result<Option<Ending>, FlightError> {
+    let dt = params.dt_s;
+    let t = state.t;
+    if state.step.is_multiple_of(params.replan_steps)
+        && t + 0.5 * dt >= state.busy_until
+        && let Some(ending) = plan(params, world, walls, state, observer)?
+    {
+        return Ok(Some(ending));
+    }
+    if let Some((te, _)) = &state.pending
+        && t + 0.5 * dt >= *te
+    {
+        state.active = state.pending.take().map(|(_, p)| p);
+    }
+
+    // Physics.
+    let hover = state.hover;
+    let active = &state.active;
+    let reference = |tau: f64| match active {
+        Some(plan) => Reference::from_traj(plan, tau, 0.0),
+        None => hover,
+    };
+    state.vehicle.step(dt, &reference)?;
+    state.traffic.step(dt)?;
+    state.step += 1;
+    state.t = state.step as f64 * dt;
+    let t = state.t;
+
+    // Checks.
+    let vehicle = state.vehicle.state();
+    let clearances = Clearances::at(world, &state.traffic, params.vehicle_radius_m, &vehicle.p);
+    let ending = if let Some(contact) = clearances.contact() {
+        Some(Ending::Collided(contact))
+    } else if (vehicle.p - params.goal).norm() <= params.goal_tolerance_m {
+        Some(Ending::Arrived)
+    } else if let Some((since, reason)) = &state.unreachable_since
+        && t - since >= params.unreachable_settle_s - 0.5 * dt
+    {
+        Some(Ending::Unreachable {
+            reason: reason.clone(),
+        })
+    } else if state.step >= params.max_steps {
+        Some(Ending::TimedOut)
+    } else {
+        None
+    };
+    if ending.is_some() || state.step.is_multiple_of(params.log_steps) {
+        observer.state(t, vehicle, state.traffic.positions(), &clearances)?;
+    }
+    state.sensing.update(t, state.traffic.positions())?;
+    Ok(ending)
+}
+
+/// One planning cycle at `state.t` (see [`step`]).
+fn plan(
+    params: &LoopParams,
+    world: &World,
+    walls: &[Option<trust_predict::Aabb>],
+    state: &mut FlightState,
+    observer: &mut dyn FlightObserver,
+) -> Result<Option<Ending>, FlightError> {
+    let t = state.t;
+    let dt = params.dt_s;
+    // Each forecast knows the box its obstacle stays inside when that is not the map (a
+    // scenario's obstacle region, where the traffic turns it back).
+    let ids = state.sensing.tracked_ids();
+    let forecasts: Vec<Forecast> = state
+        .sensing
+        .forecasts(t)?
+        .into_iter()
+        .zip(&ids)
+        .map(|(f, &id)| match walls.get(id).copied().flatten() {
+            Some(region) => f.with_walls(region),
+            None => f,
+        })
+        .collect();
+    let scene = Scene::new(world.planner_map(), &forecasts, t)?;
+    let measured = state.vehicle.state().kinematic();
+    let report = match state.manager.step(t, &measured, &params.goal, &scene) {
+        Ok(report) => report,
+        Err(e) => {
+            return Ok(Some(Ending::Invalid {
+                reason: e.to_string(),
+            }));
+        }
+    };
+    let charged_s = params.clock.charged_s(report.timing.wall_ms);
+    // A plan starts `manager_latency_s` after its cycle (where it leaves the committed plan):
+    // it takes effect then, or when the planner is done with it if that is later.
+    let delay = charged_s.max(params.manager_latency_s);
+    let effective_t = t + (delay / dt).ceil() * dt;
+    let overrun_ticks = match params.clock {
+        Clock::Fixed { .. } => 0,
+        Clock::RealTime { .. } => {
+            state.busy_until = t + charged_s;
+            let periods = (charged_s / params.replan_period_s() - 1e-9)
+                .ceil()
+                .max(1.0);
+            periods as u64 - 1
+        }
+    };
+    if let Some(plan) = state.manager.plan() {
+        state.pending = Some((effective_t, plan.clone()));
+    }
+    match report.goal_unreachable() {
+        Some(verdict) => {
+            if state.unreachable_since.is_none() {
+                state.unreachable_since = Some((t, verdict.cause.clone()));
+            }
+        }
+        None => state.unreachable_since = None,
+    }
+    observer.cycle(&CycleEvent {
+        t,
+        report: &report,
+        manager: &state.manager,
+        ids: &ids,
+        forecasts: &forecasts,
+        effective_t,
+        charged_s,
+        overrun_ticks,
+    })?;
+    Ok(None)
+}

@@ -1,0 +1,175 @@
+//! The loop's clock models (issue 31, items 4 and 5): the fixed latency charges nothing for a
+//! slow cycle and starts a cycle at every replanning tick; the real-time mode charges the
+//! measured wall time (times `cpu_scale`) and a busy planner skips ticks, which the log says.
+
+use trust_flight::closed_loop::{self, FlightObserver};
+use trust_flight::{
+    Clearances, Clock, Contact, CycleEvent, Ending, FlightError, LoopParams, RunOptions, fly,
+};
+use trust_runlog::RunLog;
+use trust_world::World;
+use trust_world::scenario::{Latency, Scenario, VehicleModel};
+
+/// The quickstart scene with a perfect-tracking vehicle, flown for at most `limit_s`.
+fn quickstart(latency: Latency, limit_s: f64) -> Scenario {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenarios/quickstart.toml"
+    );
+    let mut s = Scenario::load(std::path::Path::new(path)).expect("quickstart loads");
+    s.vehicle.model = VehicleModel::Perfect;
+    s.time_limit_s = limit_s;
+    s.sim.latency = latency;
+    s
+}
+
+#[test]
+fn the_clock_charges_the_fixed_latency_or_the_scaled_wall_time() {
+    let fixed = Clock::from_latency(Latency::Fixed { seconds: None }, 0.05);
+    assert_eq!(fixed, Clock::Fixed { latency_s: 0.05 });
+    assert_eq!(fixed.charged_s(1234.0), 0.05);
+    let real = Clock::from_latency(Latency::real_time(3.0), 0.05);
+    assert_eq!(real, Clock::RealTime { cpu_scale: 3.0 });
+    assert!((real.charged_s(20.0) - 0.06).abs() < 1e-12);
+    assert_eq!(real.charged_s(-1.0), 0.0);
+    let default_scale = Clock::from_latency(Latency::Measured { cpu_scale: None }, 0.05);
+    assert_eq!(default_scale, Clock::RealTime { cpu_scale: 1.0 });
+}
+
+/// Counts what the loop reports.
+#[derive(Default)]
+struct Counts {
+    cycles: usize,
+    cycle_times: Vec<f64>,
+    overrun_ticks: u64,
+    states: usize,
+}
+
+impl FlightObserver for Counts {
+    fn state(
+        &mut self,
+        _t: f64,
+        _v: &trust_vehicle::VehicleState,
+        _o: &[trust_core::Vec3],
+        _c: &Clearances,
+    ) -> Result<(), FlightError> {
+        self.states += 1;
+        Ok(())
+    }
+
+    fn cycle(&mut self, cycle: &CycleEvent<'_>) -> Result<(), FlightError> {
+        self.cycles += 1;
+        self.cycle_times.push(cycle.t);
+        self.overrun_ticks += cycle.overrun_ticks;
+        assert!(
+            cycle.effective_t >= cycle.t + 0.05 - 1e-9,
+            "a plan before its start"
+        );
+        Ok(())
+    }
+}
+
+/// Steps `s` for `seconds` of simulated time with the loop's own step function.
+fn step_for(s: &Scenario, seconds: f64) -> (Counts, Option<Ending>) {
+    let world = World::build(s).expect("world");
+    let planner = {
+        let mut p = s.resolve_planner();
+        p.reproducible = !s.sim.latency.is_real_time();
+        p
+    };
+    let params = LoopParams::new(&world, &planner);
+    let setup = trust_flight::set_up(&world, &planner).expect("setup");
+    let hover = trust_vehicle::Reference::hover(world.start());
+    let mut state = trust_flight::FlightState {
+        traffic: setup.traffic,
+        sensing: setup.sensing,
+        manager: setup.manager,
+        vehicle: Box::new(trust_vehicle::PerfectTracking::new(0.0, &hover).expect("vehicle")),
+        hover,
+        active: None,
+        pending: None,
+        step: 0,
+        t: 0.0,
+        busy_until: 0.0,
+        unreachable_since: None,
+    };
+    let walls = trust_flight::obstacle_walls(&world);
+    let mut counts = Counts::default();
+    let mut ending = None;
+    while state.t < seconds && ending.is_none() {
+        ending = closed_loop::step(&params, &world, &walls, &mut state, &mut counts).expect("step");
+    }
+    (counts, ending)
+}
+
+#[test]
+fn with_a_fixed_latency_every_tick_plans() {
+    let (counts, ending) = step_for(&quickstart(Latency::Fixed { seconds: None }, 30.0), 1.0);
+    assert_eq!(ending, None);
+    // 10 Hz over 1 s: ticks at 0, 0.1, ..., 0.9.
+    assert_eq!(counts.cycles, 10);
+    assert_eq!(counts.overrun_ticks, 0);
+    assert_eq!(counts.states, 50, "50 Hz log");
+}
+
+#[test]
+fn a_planner_a_hundred_times_slower_skips_ticks_and_says_so() {
+    // At cpu_scale 100 every cycle that takes more than 1 ms is charged more than the 0.1 s
+    // period: the next cycle waits for the first tick after it.
+    let (counts, _) = step_for(&quickstart(Latency::real_time(100.0), 30.0), 2.0);
+    assert!(counts.cycles < 20, "{} cycles in 2 s", counts.cycles);
+    assert!(counts.overrun_ticks > 0);
+    // Ticks planned plus ticks skipped cover the flight's ticks (at most the last is pending).
+    let ticks = counts.cycles as u64 + counts.overrun_ticks;
+    assert!((20..=21 + 100).contains(&ticks), "{ticks}");
+    for w in counts.cycle_times.windows(2) {
+        assert!(w[1] > w[0] + 0.099, "cycles at {} and {}", w[0], w[1]);
+    }
+}
+
+#[test]
+fn a_real_time_flight_logs_its_charged_time_and_skipped_ticks() {
+    let dir = std::env::temp_dir().join(format!("trust-flight-clock-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log_path = dir.join("run.jsonl");
+    let s = quickstart(Latency::real_time(100.0), 2.0);
+    let world = World::build(&s).expect("world");
+    let options = RunOptions {
+        log_path: Some(log_path.clone()),
+        ..RunOptions::default()
+    };
+    let flight = fly(&world, &s.resolve_planner(), &options, |_| {}).expect("flight");
+    let log = RunLog::read(&log_path).expect("log reads");
+    assert!(log.cycles.iter().all(|c| c.charged_ms.is_some()));
+    let skipped: u64 = log.cycles.iter().filter_map(|c| c.overrun_ticks).sum();
+    assert_eq!(skipped, flight.summary.skipped_tick_count);
+    assert!(skipped > 0);
+    assert!(flight.summary.overrun_count > 0);
+    let audit = trust_runlog::audit::audit(&log, &dir).expect("audit runs");
+    assert!(audit.findings.is_empty(), "{:?}", audit.findings);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_contact_is_typed_and_logged_as_the_contract_spells_it() {
+    assert_eq!(Contact::Static.log_tag(), "static");
+    assert_eq!(Contact::Obstacle(7).log_tag(), "obstacle:7");
+    let c = Clearances {
+        static_m: 0.5,
+        dynamic_m: -0.01,
+        nearest: Some(3),
+    };
+    assert_eq!(c.contact(), Some(Contact::Obstacle(3)));
+    let c = Clearances {
+        static_m: -0.2,
+        dynamic_m: -0.01,
+        nearest: Some(3),
+    };
+    assert_eq!(c.contact(), Some(Contact::Static));
+    let c = Clearances {
+        static_m: 0.2,
+        dynamic_m: f64::INFINITY,
+        nearest: None,
+    };
+    assert_eq!(c.contact(), None);
+}
