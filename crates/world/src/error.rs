@@ -21,6 +21,24 @@ pub enum WorldError {
         /// The operating system's reason.
         source: std::io::Error,
     },
+    /// A path the scenario reads is not a regular file (a folder, a device such as `/dev/zero`,
+    /// a pipe): only regular files are read ([`crate::scenario::files`]).
+    #[error("cannot read {}: not a regular file", path.display())]
+    NotAFile {
+        /// The path.
+        path: PathBuf,
+    },
+    /// A file is larger than the cap for its kind ([`crate::scenario::files`]); nothing beyond
+    /// the cap was read.
+    #[error("cannot read {}: larger than the cap of {} for {what}", path.display(), fmt_bytes(*limit_bytes))]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// The cap (bytes).
+        limit_bytes: u64,
+        /// What kind of file (`"a scenario file"`, `"a track file"`, `"a points file"`).
+        what: &'static str,
+    },
     /// A scenario file is not valid TOML or does not match the scenario format (syntax error,
     /// wrong type, unknown field, unknown name). `message` is toml's own message, with the line,
     /// the column and the offending snippet.
@@ -67,6 +85,15 @@ pub enum WorldError {
     /// Invalid input to a vehicle model or controller.
     #[error(transparent)]
     Vehicle(#[from] VehicleError),
+}
+
+/// `4 MiB` for whole mebibytes, else bytes.
+fn fmt_bytes(n: u64) -> String {
+    if n >= 1 << 20 && n.is_multiple_of(1 << 20) {
+        format!("{} MiB", n >> 20)
+    } else {
+        format!("{n} bytes")
+    }
 }
 
 impl WorldError {

@@ -6,7 +6,8 @@ use trust_core::{Aabb, Rng, Vec3};
 use trust_geometry::{AaBox, Cylinder, Shape};
 use trust_predict::ObstacleShape;
 
-use crate::problem::{Problems, fmt_bounds, fmt_vec};
+use crate::problem::{Problems, fmt_bounds, fmt_count, fmt_num, fmt_vec};
+use crate::scenario::scale::{MAX_PLACEMENT_WORK, check_sampled_points, sampled_point_bound};
 use crate::scenario::{
     E4Params, GeneratorSpec, PointCloudSpec, Problem, RandomObstacles, Scenario,
 };
@@ -24,6 +25,47 @@ pub(crate) struct Layout {
     /// Generated obstacles, then `[[obstacles]]`, then each `[[random_obstacles]]` group.
     pub(crate) obstacles: Vec<MovingObstacle>,
     pub(crate) obstacle_origins: Vec<String>,
+}
+
+/// Distance tests the placements of one world may still make (the scale policy's
+/// [`MAX_PLACEMENT_WORK`]): every rejection-sampling attempt spends one test per shape it is
+/// compared with.
+struct Work {
+    left: u64,
+}
+
+impl Work {
+    fn new() -> Self {
+        Work {
+            left: MAX_PLACEMENT_WORK,
+        }
+    }
+
+    /// Spends `n` tests; `false` once the budget is gone.
+    fn spend(&mut self, n: usize) -> bool {
+        let n = n.max(1) as u64;
+        if n > self.left {
+            self.left = 0;
+            false
+        } else {
+            self.left -= n;
+            true
+        }
+    }
+}
+
+/// The problem of a placement that ran out of [`Work`].
+fn out_of_work(field: String, count: usize, placed: usize) -> Problem {
+    Problem::new(
+        field,
+        count,
+        format!(
+            "a count that can be placed within the placement budget ({} distance tests per world, \
+             scale policy; {placed} were placed): fewer obstacles, more room, or fewer shapes to \
+             avoid",
+            fmt_count(MAX_PLACEMENT_WORK as u128)
+        ),
+    )
 }
 
 impl Layout {
@@ -62,6 +104,7 @@ pub(crate) fn generate(s: &Scenario, bounds: &Aabb, seed: u64) -> Result<Layout,
     };
     let mut layout = Layout::default();
     let mut problems = Problems::default();
+    let mut work = Work::new();
     let explicit: Vec<Shape> = s
         .static_map
         .shapes
@@ -75,6 +118,7 @@ pub(crate) fn generate(s: &Scenario, bounds: &Aabb, seed: u64) -> Result<Layout,
             &explicit,
             &ends,
             &mut rng,
+            &mut work,
             &mut layout,
             &mut problems,
         );
@@ -97,7 +141,7 @@ pub(crate) fn generate(s: &Scenario, bounds: &Aabb, seed: u64) -> Result<Layout,
         let field = format!("random_obstacles[{i}]");
         let region = g.region.map_or(*bounds, |r| r.aabb());
         let statics = layout.shapes.clone();
-        match random_group(g, &region, &statics, &ends, &mut rng, &field) {
+        match random_group(g, &region, &statics, &ends, &mut rng, &mut work, &field) {
             Ok(obs) => {
                 for (k, o) in obs.into_iter().enumerate() {
                     layout.obstacles.push(o);
@@ -117,12 +161,14 @@ pub(crate) fn generate(s: &Scenario, bounds: &Aabb, seed: u64) -> Result<Layout,
 }
 
 /// Runs generator `g`; its moving obstacles avoid the `explicit` static shapes too.
+#[allow(clippy::too_many_arguments)]
 fn run_generator(
     g: &GeneratorSpec,
     bounds: &Aabb,
     explicit: &[Shape],
     ends: &Endpoints,
     rng: &mut Rng,
+    work: &mut Work,
     layout: &mut Layout,
     problems: &mut Problems,
 ) {
@@ -133,7 +179,7 @@ fn run_generator(
                 motion: e.motion.clone(),
                 ..RandomObstacles::default()
             };
-            push_group(&group, bounds, explicit, ends, rng, layout, problems);
+            push_group(&group, bounds, explicit, ends, rng, work, layout, problems);
         }
         GeneratorSpec::E2Static(_) | GeneratorSpec::E2Dynamic(_) => {
             let case = if matches!(g, GeneratorSpec::E2Static(_)) {
@@ -178,10 +224,10 @@ fn run_generator(
                 region: Some(crate::scenario::BoundsSpec::from_aabb(&region)),
                 ..RandomObstacles::default()
             };
-            push_group(&group, bounds, explicit, ends, rng, layout, problems);
+            push_group(&group, bounds, explicit, ends, rng, work, layout, problems);
         }
         GeneratorSpec::E4(e) => {
-            match e4_static(e, bounds, ends, rng) {
+            match e4_static(e, bounds, ends, rng, work) {
                 Ok(shapes) => layout.shapes.extend(shapes),
                 Err(p) => problems.list.push(p),
             }
@@ -202,23 +248,25 @@ fn run_generator(
                 motion: e.moving_motion.clone(),
             };
             let statics: Vec<Shape> = layout.shapes.iter().chain(explicit).copied().collect();
-            push_group(&group, bounds, &statics, ends, rng, layout, problems);
+            push_group(&group, bounds, &statics, ends, rng, work, layout, problems);
         }
     }
 }
 
 /// Draws a generator's random group and appends it to the layout (or a problem).
+#[allow(clippy::too_many_arguments)]
 fn push_group(
     group: &RandomObstacles,
     bounds: &Aabb,
     statics: &[Shape],
     ends: &Endpoints,
     rng: &mut Rng,
+    work: &mut Work,
     layout: &mut Layout,
     problems: &mut Problems,
 ) {
     let region = group.region.map_or(*bounds, |r| r.aabb());
-    match random_group(group, &region, statics, ends, rng, "world.generator") {
+    match random_group(group, &region, statics, ends, rng, work, "world.generator") {
         Ok(obs) => {
             for (k, o) in obs.into_iter().enumerate() {
                 layout.obstacles.push(o);
@@ -247,6 +295,7 @@ fn random_group(
     statics: &[Shape],
     ends: &Endpoints,
     rng: &mut Rng,
+    work: &mut Work,
     field: &str,
 ) -> Result<Vec<MovingObstacle>, Problem> {
     if !crate::scenario::BoundsSpec::from_aabb(region).is_valid() {
@@ -266,10 +315,14 @@ fn random_group(
     };
     let height = region.max.z - region.min.z;
     let sin_climb = g.max_climb_deg.to_radians().sin();
-    let mut out = Vec::with_capacity(g.count);
+    // Validation caps the count (scale policy); the capacity is capped again here.
+    let mut out = Vec::with_capacity(g.count.min(crate::scenario::scale::MAX_OBSTACLE_COUNT));
     for i in 0..g.count {
         let mut placed = None;
         for _ in 0..PLACEMENT_ATTEMPTS {
+            if !work.spend(if g.avoid_static { statics.len() } else { 1 }) {
+                return Err(out_of_work(format!("{field}.count"), g.count, i));
+            }
             let cylinder = rng.random_bool(g.cylinder_fraction);
             let shape = if cylinder {
                 let radius = uniform(rng, g.cylinder_radius_m);
@@ -413,6 +466,7 @@ fn e4_static(
     bounds: &Aabb,
     ends: &Endpoints,
     rng: &mut Rng,
+    work: &mut Work,
 ) -> Result<Vec<Shape>, Problem> {
     let mut placed: Vec<Footprint> = Vec::new();
     let mut shapes = Vec::new();
@@ -445,6 +499,9 @@ fn e4_static(
         for i in 0..count {
             let mut ok = false;
             for _ in 0..PLACEMENT_ATTEMPTS {
+                if !work.spend(placed.len()) {
+                    return Err(out_of_work(format!("world.generator.{name}"), count, i));
+                }
                 let (foot, shape) = match name {
                     "block_count" => {
                         let sx = uniform(rng, e.block_size_m);
@@ -504,7 +561,8 @@ fn e4_static(
                     format!(
                         "a count that fits in world.bounds with min_gap_m = {} and endpoint_clear_m = {} \
                          (only {i} could be placed)",
-                        e.min_gap_m, e.endpoint_clear_m
+                        fmt_num(e.min_gap_m),
+                        fmt_num(e.endpoint_clear_m)
                     ),
                 ));
             }
@@ -522,16 +580,28 @@ pub(crate) fn check_layout(
     cloud: Option<&[Vec3]>,
 ) {
     let r = scenario.vehicle.radius_m;
-    if matches!(
-        scenario.static_map.point_cloud,
-        Some(PointCloudSpec::Shapes { .. })
-    ) && layout.shapes.is_empty()
+    if let Some(PointCloudSpec::Shapes {
+        esdf_voxel_m,
+        spacing_m,
+    }) = &scenario.static_map.point_cloud
     {
-        p.push(
-            "static.point_cloud.source",
-            "\"shapes\"",
-            "static shapes to sample (none are given or generated)",
-        );
+        if layout.shapes.is_empty() {
+            p.push(
+                "static.point_cloud.source",
+                "\"shapes\"",
+                "static shapes to sample (none are given or generated)",
+            );
+        } else if let Some(bounds) = scenario.bounds() {
+            // Counted before sampling (scale policy), on the field that sets the spacing.
+            let spacing = spacing_m.unwrap_or(*esdf_voxel_m);
+            let field = if spacing_m.is_some() {
+                "static.point_cloud.spacing_m"
+            } else {
+                "static.point_cloud.esdf_voxel_m"
+            };
+            let bound = sampled_point_bound(&layout.shapes, &bounds, spacing);
+            check_sampled_points(p, field, spacing, bound);
+        }
     }
     for (name, q) in [
         ("mission.start", &scenario.mission.start),
@@ -545,8 +615,9 @@ pub(crate) fn check_layout(
                     name,
                     fmt_vec(q),
                     format!(
-                        "a point at least vehicle.radius_m = {r} m from every static obstacle \
+                        "a point at least vehicle.radius_m = {} m from every static obstacle \
                          ({} is at {d:.3} m)",
+                        fmt_num(r),
                         layout.shape_origin(i)
                     ),
                 );
@@ -563,8 +634,9 @@ pub(crate) fn check_layout(
                     name,
                     fmt_vec(q),
                     format!(
-                        "a point at least vehicle.radius_m = {r} m from every static cloud \
+                        "a point at least vehicle.radius_m = {} m from every static cloud \
                          point (point {i} at {} is at {d:.3} m)",
+                        fmt_num(r),
                         fmt_vec(points[i].as_slice())
                     ),
                 );
@@ -579,8 +651,9 @@ pub(crate) fn check_layout(
                 "mission.start",
                 fmt_vec(&scenario.mission.start),
                 format!(
-                    "a start at least vehicle.radius_m = {r} m from every moving obstacle at \
+                    "a start at least vehicle.radius_m = {} m from every moving obstacle at \
                      t = 0 ({} is at {d:.3} m)",
+                    fmt_num(r),
                     layout.obstacle_origin(i)
                 ),
             );

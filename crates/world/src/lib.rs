@@ -79,43 +79,12 @@
 //! (occupancy, the outside and inside transforms and the points, at once). Build it once per
 //! trial and share it.
 //!
-//! # Changelog
+//! # Validation
 //!
-//! - Issue 19: `[planner.route]` (`planner::RouteSpec`, on by default) and
-//!   `planner.tracking_margin_m` (default `planner::tracking_margin_for(a_max)`), applied by
-//!   `planner::effective` to the safety check, the backend and the frontends.
-//!
-//! Issue 17 split `trust-sim` along the data path; this crate holds its first stage.
-//!
-//! - Moves: `trust_sim::{scenario, planner, sensing, traffic}` are `trust_world::{scenario,
-//!   planner, sensing, traffic}`; `trust_sim::world::{World, Seeds, mix_seed, PointTree,
-//!   sample_shapes, esdf_error_bound}` are at this crate's root; `trust_sim::scenario::Problem`
-//!   lives in [`problem`] (still re-exported by [`scenario`]).
-//! - `trust_sim::error::SimError` is split by stage: [`WorldError`] here (reading, parsing,
-//!   validating, building; its plotting, run-log and file-writing variants are gone),
-//!   `trust_flight::FlightError` for the loop, `trust_experiments::ExperimentError` for studies and
-//!   E3.
-//! - [`planner::PlannerSpec::resolve`] and [`scenario::Scenario::resolve_planner`] are infallible:
-//!   they return a `ResolvedPlanner`, not a `Result` (presets and overrides merge on Rust types;
-//!   invalid values are reported by validation and by [`planner::build`]).
-//! - [`scenario::Scenario::validate`] and [`scenario::Scenario::load`] check what the file alone
-//!   shows, without the layout checks (start and goal against the generated layout); those run
-//!   once, where the layout is generated: [`World::build`], [`check`] and [`load_checked`]
-//!   (`trust-sim validate`).
-//! - Issue 20: scripted obstacle motion and moving boxes. [`traffic::Motion`] gained `Samples`
-//!   (time-stamped samples, inline or from a CSV file) and `Fourier` (a closed curve), evaluated
-//!   by [`script`]; [`traffic::MovingShape`] gained `Box`. In the scenario file an
-//!   `[[obstacles]]` entry's `radius_m` and `position` became optional
-//!   ([`scenario::ObstacleSpec`]: `radius_m` is required for spheres and cylinders,
-//!   `half_extents` for boxes; `position` and `velocity` are not allowed with a scripted motion,
-//!   whose script gives them); validation names every bad sample (by index, or by CSV line).
-//! - `World::planner_map_arc` is removed (unused; [`World::planner_map`] gives the map).
-//! - `scenario::ShapeSpec` is replaced by the run log's `trust_runlog::StaticShape`, re-exported as
-//!   [`scenario::StaticShape`] (the TOML form, tagged by `kind`, is unchanged);
-//!   [`World::static_shape_specs`] returns it. `ShapeSpec::{shape, from_shape, is_valid}` are gone:
-//!   validation names the bad field of a shape ([`scenario::Scenario::validate`]).
-//! - Added (issue 20): the scenario section `[log]` ([`scenario::LogSection`], field
-//!   [`scenario::Scenario::log`]) switching the cycles' branches and forecasts in the run log.
+//! [`check`] (`trust-sim validate`) runs every check [`World::build`] and a flight's set-up run:
+//! the file's checks with the scale policy ([`scenario::scale`]), the layout, and the traffic,
+//! sensor, planner assembly and vehicle model of the flight; a file it accepts builds and
+//! starts. Files the scenario names are read under [`scenario::files`]' caps and path policy.
 
 #![warn(missing_docs)]
 
@@ -268,9 +237,10 @@ impl World {
                     truth_map.clone()
                 };
                 let n = points.len();
+                let _ = spacing;
                 (
                     base.with_point_cloud(&points, voxel)?,
-                    esdf_error_bound(voxel, spacing),
+                    static_map_error_for(scenario),
                     n,
                 )
             }
@@ -487,9 +457,109 @@ struct Prepared {
     cloud_points: Option<Vec<Vec3>>,
 }
 
-/// Every check of a scenario: the file's ([`Scenario::validate`]) and, when the geometry is valid,
-/// start and goal against the generated layout. The layout is generated once and the points file
-/// read once; `Err` holds every problem, in file order, layout problems last.
+/// The planner map's error bound of `scenario`'s static map ([`esdf_error_bound`] of its cloud,
+/// 0 without one): what [`World::static_map_error_m`] will be, known before the map is built.
+fn static_map_error_for(scenario: &Scenario) -> f64 {
+    match &scenario.static_map.point_cloud {
+        None => 0.0,
+        Some(PointCloudSpec::Shapes {
+            esdf_voxel_m,
+            spacing_m,
+        }) => esdf_error_bound(*esdf_voxel_m, Some(spacing_m.unwrap_or(*esdf_voxel_m))),
+        Some(
+            PointCloudSpec::Inline { esdf_voxel_m, .. } | PointCloudSpec::File { esdf_voxel_m, .. },
+        ) => esdf_error_bound(*esdf_voxel_m, None),
+    }
+}
+
+/// What a flight sets up before its first step (`trust_flight::set_up` and the vehicle), run
+/// on the generated layout so that validation rejects what the flight would: the true traffic,
+/// the warmed-up sensor and its first round, the assembled planner ([`planner::build`]) and the
+/// vehicle model at rest on the start. Their errors are reported on the section the file wrote
+/// (`obstacles`, `sensing`, `planner`, `vehicle`); the scale policy keeps every derived
+/// parameter in range, so these are a backstop, not the usual message.
+fn preflight(scenario: &Scenario, layout: &generate::Layout, p: &mut problem::Problems) {
+    let seeds = scenario.seeds();
+    let mut problem = |section: &str, what: &str, e: &dyn std::fmt::Display| {
+        p.push(
+            section,
+            "(the file's values)",
+            format!("values {what} accepts; it reports: {e}"),
+        );
+    };
+    let traffic = match Traffic::new(
+        &layout.obstacles,
+        scenario.traffic.fault_level,
+        seeds.traffic,
+    ) {
+        Ok(t) => Some(t),
+        Err(e) => {
+            problem("obstacles", "the obstacle traffic", &e);
+            None
+        }
+    };
+    let shapes: Vec<_> = layout.obstacles.iter().map(|o| o.shape).collect();
+    let positions: Vec<Vec3> = layout.obstacles.iter().map(|o| o.position).collect();
+    let velocities: Vec<Vec3> = layout.obstacles.iter().map(|o| o.velocity).collect();
+    let sensed = Sensing::new(
+        &scenario.sensing,
+        &shapes,
+        scenario.vehicle.radius_m,
+        seeds.sensing,
+    )
+    .and_then(|mut s| {
+        s.warm_up(&positions, &velocities)?;
+        if let Some(t) = &traffic {
+            s.update(0.0, t.positions())?;
+        }
+        Ok(s)
+    });
+    if let Err(e) = sensed {
+        problem("sensing", "the sensor and tracker", &e);
+    }
+    let ctx = PlannerContext {
+        limits: scenario.vehicle.limits,
+        vehicle_radius_m: scenario.vehicle.radius_m,
+        static_map_error_m: static_map_error_for(scenario),
+        seed: seeds.planner,
+    };
+    if let Err(e) = planner::build(&scenario.resolve_planner(), &ctx) {
+        problem(
+            "planner",
+            "the planner assembly (with vehicle.limits and vehicle.radius_m)",
+            &e,
+        );
+    }
+    let hover = trust_vehicle::Reference::hover(Vec3::from(scenario.mission.start));
+    let vehicle = match scenario.vehicle.model {
+        scenario::VehicleModel::Quadrotor => {
+            let mut gains = scenario.vehicle.gains;
+            gains.max_accel_m_s2 = gains.max_accel_m_s2.or(Some(scenario.vehicle.limits.a_max));
+            trust_vehicle::ControlledQuadrotor::starting_on(
+                scenario.vehicle.quadrotor,
+                gains,
+                0.0,
+                &hover,
+            )
+            .map(|_| ())
+        }
+        scenario::VehicleModel::Perfect => {
+            trust_vehicle::PerfectTracking::new(0.0, &hover).map(|_| ())
+        }
+    };
+    if let Err(e) = vehicle {
+        problem(
+            "vehicle",
+            "the vehicle model (with vehicle.limits.a_max)",
+            &e,
+        );
+    }
+}
+
+/// Every check of a scenario: the file's ([`Scenario::validate`]), and, when the geometry is
+/// valid, start and goal against the generated layout, and then what a flight sets up before
+/// its first step ([`preflight`]). The layout is generated once and the points file read once;
+/// `Err` holds every problem, in file order, layout problems last.
 fn prepare(scenario: &Scenario) -> Result<Prepared, Vec<scenario::Problem>> {
     let file = scenario.check_file();
     let mut problems = file.problems;
@@ -500,6 +570,9 @@ fn prepare(scenario: &Scenario) -> Result<Prepared, Vec<scenario::Problem>> {
         match generate::generate(scenario, bounds, scenario.seeds().world) {
             Ok(l) => {
                 generate::check_layout(scenario, &mut problems, &l, file.cloud_points.as_deref());
+                if problems.list.is_empty() {
+                    preflight(scenario, &l, &mut problems);
+                }
                 layout = Some(l);
             }
             Err(p) => problems.list.extend(p),
@@ -521,8 +594,11 @@ fn prepare(scenario: &Scenario) -> Result<Prepared, Vec<scenario::Problem>> {
 }
 
 /// Every problem of `scenario`, as [`World::build`] finds them, without building the maps:
-/// [`Scenario::validate`]'s and start and goal against the generated layout (`trust-sim
-/// validate`). Empty: [`World::build`] will not reject the scenario.
+/// [`Scenario::validate`]'s (with the scale policy, [`scenario::scale`]), start and goal against
+/// the generated layout, and what a flight sets up before its first step (traffic, sensing,
+/// [`planner::build`], the vehicle model) — `trust-sim validate`. Empty: [`World::build`] will
+/// not reject the scenario and a flight of it starts (its maps are within the caps checked
+/// here: ESDF voxels, cloud points).
 pub fn check(scenario: &Scenario) -> Vec<scenario::Problem> {
     prepare(scenario).err().unwrap_or_default()
 }

@@ -42,10 +42,65 @@ impl std::fmt::Display for Problem {
     }
 }
 
-/// Formats a vector as `[x, y, z]` with each number as Rust's shortest round-trip `Display`
-/// (`300`, `0.25`, `NaN`, `inf`).
+/// Formats a number for a message, readably, with at most 6 significant digits: for a magnitude
+/// in `[1e-4, 1e6)` Rust's shortest round-trip form (`300`, `0.25`, `NaN`, `inf`), rounded to 6
+/// significant digits when it has more (`123457`, `0.3`); otherwise scientific notation rounded
+/// the same way (`1e308`, `1.23457e6`, `2e-6`), so that `1e308` never prints as 309 digits.
+/// Every number in a [`Problem`] goes through it.
+pub fn fmt_num(x: f64) -> String {
+    let plain = format!("{x}");
+    let a = x.abs();
+    if !x.is_finite() || x == 0.0 {
+        return plain;
+    }
+    let digits = plain
+        .trim_start_matches('-')
+        .replace('.', "")
+        .trim_start_matches('0')
+        .trim_end_matches('0')
+        .len();
+    if (1e-4..1e6).contains(&a) {
+        if digits <= 6 {
+            return plain;
+        }
+        // 6 significant digits in fixed notation, trailing zeros dropped.
+        let decimals = (5 - a.log10().floor() as i32).max(0) as usize;
+        let fixed = format!("{x:.decimals$}");
+        return if fixed.contains('.') {
+            fixed
+                .trim_end_matches('0')
+                .trim_end_matches('.')
+                .to_string()
+        } else {
+            fixed
+        };
+    }
+    let sci = format!("{x:.5e}");
+    match sci.split_once('e') {
+        Some((mantissa, exp)) => {
+            let mantissa = if mantissa.contains('.') {
+                mantissa.trim_end_matches('0').trim_end_matches('.')
+            } else {
+                mantissa
+            };
+            format!("{mantissa}e{exp}")
+        }
+        None => sci,
+    }
+}
+
+/// A count for a message: exact up to 10⁹, else scientific ([`fmt_num`]).
+pub fn fmt_count(n: u128) -> String {
+    if n <= 1_000_000_000 {
+        n.to_string()
+    } else {
+        fmt_num(n as f64)
+    }
+}
+
+/// Formats a vector as `[x, y, z]`, each number by [`fmt_num`].
 pub(crate) fn fmt_vec(v: &[f64]) -> String {
-    let parts: Vec<String> = v.iter().map(|x| format!("{x}")).collect();
+    let parts: Vec<String> = v.iter().map(|x| fmt_num(*x)).collect();
     format!("[{}]", parts.join(", "))
 }
 
@@ -75,7 +130,7 @@ impl Problems {
         if value.is_finite() {
             true
         } else {
-            self.push(field, value, "a finite number");
+            self.push(field, fmt_num(value), "a finite number");
             false
         }
     }
@@ -95,7 +150,7 @@ impl Problems {
         if value.is_finite() && value > 0.0 {
             true
         } else {
-            self.push(field, value, "a finite number > 0");
+            self.push(field, fmt_num(value), "a finite number > 0");
             false
         }
     }
@@ -105,7 +160,7 @@ impl Problems {
         if value.is_finite() && value >= 0.0 {
             true
         } else {
-            self.push(field, value, "a finite number >= 0");
+            self.push(field, fmt_num(value), "a finite number >= 0");
             false
         }
     }
@@ -130,12 +185,87 @@ impl Problems {
         ok
     }
 
+    /// A finite `value` with `|value| <= max` (the scenario scale policy,
+    /// [`crate::scenario::scale`]); non-finite values are left to the other checks. Returns
+    /// whether it passes.
+    pub(crate) fn within(&mut self, field: &str, value: f64, max: f64, unit: &str) -> bool {
+        if value.is_finite() && value.abs() > max {
+            self.push(
+                field,
+                fmt_num(value),
+                format!(
+                    "a magnitude of at most {} {unit} (scale policy)",
+                    fmt_num(max)
+                ),
+            );
+            false
+        } else {
+            true
+        }
+    }
+
+    /// [`Problems::within`] for every component of a vector (one problem for the vector).
+    pub(crate) fn within_vec(&mut self, field: &str, v: &[f64], max: f64, unit: &str) -> bool {
+        if v.iter().any(|x| x.is_finite() && x.abs() > max) {
+            self.push(
+                field,
+                fmt_vec(v),
+                format!(
+                    "components of magnitude at most {} {unit} (scale policy)",
+                    fmt_num(max)
+                ),
+            );
+            false
+        } else {
+            true
+        }
+    }
+
+    /// A finite `value` in `[lo, hi]`; non-finite values are left to the other checks.
+    pub(crate) fn in_range(
+        &mut self,
+        field: &str,
+        value: f64,
+        lo: f64,
+        hi: f64,
+        unit: &str,
+    ) -> bool {
+        if value.is_finite() && !(lo..=hi).contains(&value) {
+            self.push(
+                field,
+                fmt_num(value),
+                format!(
+                    "a value in [{}, {}] {unit} (scale policy)",
+                    fmt_num(lo),
+                    fmt_num(hi)
+                ),
+            );
+            false
+        } else {
+            true
+        }
+    }
+
+    /// A count at most `cap`, checked before anything is allocated or drawn for it.
+    pub(crate) fn count(&mut self, field: &str, count: u128, cap: usize, what: &str) -> bool {
+        if count > cap as u128 {
+            self.push(
+                field,
+                fmt_count(count),
+                format!("at most {} {what} (scale policy)", fmt_count(cap as u128)),
+            );
+            false
+        } else {
+            true
+        }
+    }
+
     /// A probability in `[0, 1]`.
     pub(crate) fn probability(&mut self, field: &str, value: f64) -> bool {
         if (0.0..=1.0).contains(&value) {
             true
         } else {
-            self.push(field, value, "a probability in [0, 1]");
+            self.push(field, fmt_num(value), "a probability in [0, 1]");
             false
         }
     }
@@ -163,6 +293,30 @@ mod tests {
             fmt_vec(&[f64::NAN, 0.25, f64::INFINITY]),
             "[NaN, 0.25, inf]"
         );
+    }
+
+    #[test]
+    fn numbers_print_readably() {
+        for (x, text) in [
+            (300.0, "300"),
+            (0.25, "0.25"),
+            (-12.5, "-12.5"),
+            (0.002, "0.002"),
+            (123456.0, "123456"),
+            (1e308, "1e308"),
+            (-1e7, "-1e7"),
+            (1e6, "1e6"),
+            (1e-6, "1e-6"),
+            (1234567.0, "1.23457e6"),
+            (0.1 + 0.2, "0.3"),
+            (123456.7, "123457"),
+            (1.2345678, "1.23457"),
+            (f64::MAX, "1.79769e308"),
+        ] {
+            assert_eq!(fmt_num(x), text, "{x:?}");
+        }
+        assert_eq!(fmt_count(9_223_372_036_854_775_807), "9.22337e18");
+        assert_eq!(fmt_count(1000), "1000");
     }
 
     #[test]

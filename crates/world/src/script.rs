@@ -112,8 +112,14 @@ impl SamplesSpec {
     /// The samples of `file` (resolved by `resolve`) in place of the file name: inline samples
     /// are returned as they are.
     ///
+    /// The file is read incrementally under [`crate::scenario::files`]'s policy (a regular file
+    /// of at most [`crate::scenario::files::MAX_TRACK_BYTES`]), and at most [`MAX_SAMPLES`]
+    /// samples.
+    ///
     /// # Errors
-    /// [`WorldError::Read`] or [`WorldError::PointsFile`] (the CSV line that does not parse).
+    /// [`WorldError::Read`], [`WorldError::NotAFile`], [`WorldError::TooLarge`], or
+    /// [`WorldError::PointsFile`] (the CSV line that does not parse, the line beyond
+    /// [`MAX_SAMPLES`] samples, or a file with no sample: "only a header").
     pub fn load(&self, resolve: impl Fn(&Path) -> PathBuf) -> Result<SamplesSpec, WorldError> {
         let Some(file) = &self.file else {
             return Ok(self.clone());
@@ -122,15 +128,20 @@ impl SamplesSpec {
             return Ok(self.clone());
         }
         let full = resolve(file);
-        let text = std::fs::read_to_string(&full).map_err(|source| WorldError::Read {
-            path: full.clone(),
-            source,
-        })?;
-        let rows = parse_samples_csv(&text).map_err(|(line, message)| WorldError::PointsFile {
-            path: full.clone(),
-            line,
-            message,
-        })?;
+        let mut csv = CsvTrack::default();
+        crate::scenario::files::for_each_line(
+            &full,
+            crate::scenario::files::MAX_TRACK_BYTES,
+            "a track file",
+            |n, line| csv.line(n, line),
+        )?;
+        let rows = csv
+            .finish()
+            .map_err(|(line, message)| WorldError::PointsFile {
+                path: full.clone(),
+                line,
+                message,
+            })?;
         Ok(SamplesSpec {
             samples: rows.iter().map(|r| r.1).collect(),
             file: Some(file.clone()),
@@ -389,8 +400,11 @@ pub(crate) fn check_samples(
         {
             p.push(
                 format!("{label}.t"),
-                s[0],
-                format!("a time after the previous sample's ({prev} s): times must increase"),
+                crate::problem::fmt_num(s[0]),
+                format!(
+                    "a time after the previous sample's ({} s): times must increase",
+                    crate::problem::fmt_num(prev)
+                ),
             );
         }
         previous = Some(s[0]);
@@ -405,8 +419,9 @@ pub(crate) fn check_samples(
                 fmt_vec(&b),
                 format!(
                     "the first sample's position {} for end = \"loop\" (the track must close; \
-                     it ends {gap} m away)",
-                    fmt_vec(&a[1..])
+                     it ends {} m away)",
+                    fmt_vec(&a[1..]),
+                    crate::problem::fmt_num(gap)
                 ),
             );
         }
@@ -421,7 +436,7 @@ pub(crate) fn check_fourier(field: &str, f: &FourierSpec, p: &mut Problems) -> b
     if !(f.period_s.is_finite() && f.period_s > 0.0 && f.period_s <= MAX_TIME_S) {
         p.push(
             format!("{field}.period_s"),
-            f.period_s,
+            crate::problem::fmt_num(f.period_s),
             "a finite period in (0, 1e7] s",
         );
     }
@@ -482,34 +497,66 @@ pub type CsvRow = (usize, [f64; 4]);
 
 /// Parses the text of a CSV track into `(1-based line, [t, x, y, z])` rows; on error, the line
 /// number and what is wrong. Non-finite numbers parse (validation names them with their line).
+/// A text without any sample (empty, comments only, or only the header) is an error.
 pub fn parse_samples_csv(text: &str) -> Result<Vec<CsvRow>, (usize, String)> {
-    let mut rows = Vec::new();
-    let mut seen_data = false;
+    let mut csv = CsvTrack::default();
     for (i, raw) in text.lines().enumerate() {
+        csv.line(i + 1, raw)?;
+    }
+    csv.finish()
+}
+
+/// A CSV track parsed line by line (as it is read).
+#[derive(Default)]
+struct CsvTrack {
+    rows: Vec<CsvRow>,
+    /// The line of the header, if the first non-comment line was one.
+    header: Option<usize>,
+    seen_data: bool,
+    last_line: usize,
+}
+
+impl CsvTrack {
+    fn line(&mut self, n: usize, raw: &str) -> Result<(), (usize, String)> {
+        use crate::scenario::files::echo;
+        self.last_line = n;
         let line = raw.trim();
         if line.is_empty() || line.starts_with('#') {
-            continue;
+            return Ok(());
+        }
+        if self.rows.len() >= MAX_SAMPLES {
+            return Err((
+                n,
+                format!("more than {MAX_SAMPLES} samples (the cap on a track, scale policy)"),
+            ));
         }
         let fields: Vec<&str> = line
             .split(|c: char| c.is_whitespace() || c == ',')
             .filter(|f| !f.is_empty())
+            .take(5)
             .collect();
         let is_header = fields.len() == 4
             && fields
                 .iter()
                 .zip(["t", "x", "y", "z"])
                 .all(|(f, h)| f.eq_ignore_ascii_case(h));
-        if is_header && !seen_data {
-            seen_data = true;
-            continue;
+        if is_header && !self.seen_data {
+            self.seen_data = true;
+            self.header = Some(n);
+            return Ok(());
         }
-        seen_data = true;
+        self.seen_data = true;
         if fields.len() != 4 {
+            let count = if fields.len() > 4 {
+                "more than 4".to_string()
+            } else {
+                fields.len().to_string()
+            };
             return Err((
-                i + 1,
+                n,
                 format!(
-                    "{line:?} has {} fields, expected four numbers `t,x,y,z`",
-                    fields.len()
+                    "{} has {count} fields, expected four numbers `t,x,y,z`",
+                    echo(line)
                 ),
             ));
         }
@@ -517,17 +564,39 @@ pub fn parse_samples_csv(text: &str) -> Result<Vec<CsvRow>, (usize, String)> {
         for (k, f) in fields.iter().enumerate() {
             s[k] = f.parse::<f64>().map_err(|_| {
                 (
-                    i + 1,
+                    n,
                     format!(
-                        "{line:?}: field {} = {f:?} is not a number",
-                        ["t", "x", "y", "z"][k]
+                        "{}: field {} = {} is not a number",
+                        echo(line),
+                        ["t", "x", "y", "z"][k],
+                        echo(f)
                     ),
                 )
             })?;
         }
-        rows.push((i + 1, s));
+        self.rows.push((n, s));
+        Ok(())
     }
-    Ok(rows)
+
+    fn finish(self) -> Result<Vec<CsvRow>, (usize, String)> {
+        if !self.rows.is_empty() {
+            return Ok(self.rows);
+        }
+        Err(match self.header {
+            Some(h) => (
+                h,
+                "only a header line `t,x,y,z` and no sample: a track needs at least 2 `t,x,y,z` \
+                 lines"
+                    .to_string(),
+            ),
+            None => (
+                self.last_line.max(1),
+                "no sample (the file is empty or only comments): a track needs at least 2 \
+                 `t,x,y,z` lines"
+                    .to_string(),
+            ),
+        })
+    }
 }
 
 #[cfg(test)]
@@ -718,5 +787,13 @@ mod tests {
         assert!(msg.contains("3 fields"), "{msg}");
         // A header after data is an error on its line.
         assert_eq!(parse_samples_csv("0,1,2,3\nt,x,y,z\n").unwrap_err().0, 2);
+        // Only a header: a clear message, not "(not loaded)".
+        let (line, msg) = parse_samples_csv("# walker\nt,x,y,z\n").unwrap_err();
+        assert_eq!(line, 2);
+        assert!(msg.contains("only a header"), "{msg}");
+        assert!(parse_samples_csv("").unwrap_err().1.contains("no sample"));
+        // A bad line is quoted, cut short.
+        let (_, msg) = parse_samples_csv(&format!("0,1,2,{}\n", "y".repeat(5000))).unwrap_err();
+        assert!(msg.len() < 200, "{msg}");
     }
 }

@@ -116,6 +116,16 @@
 //! serde's internally tagged enums keep `deny_unknown_fields` working there, and an unknown
 //! `kind` is reported with the list of accepted names.
 //!
+//! # Files it names, scale policy
+//!
+//! Track and points files are read under [`files`]' policy: only regular files, a size cap per
+//! kind (4 MiB scenario, 16 MiB track, 512 MiB points file), read line by line; a relative path
+//! is resolved against the scenario's folder and may not leave it with `..` (an absolute path is
+//! read as written). Every value and count the file sets is checked against the scale policy of
+//! [`scale`] (coordinates within ±1e5 m, obstacle speeds up to 1e3 m/s, `v_max` in
+//! [0.01, 100] m/s, `a_max` in [0.1, 100] m/s², at most 10 000 moving obstacles and 10 000 static
+//! shapes, 2e7 cloud points, …) before anything is read, allocated or drawn for it.
+//!
 //! # Errors
 //!
 //! [`Scenario::load`] keeps toml's message for syntax errors, wrong types, unknown fields and
@@ -126,8 +136,10 @@
 //! generated — once per world, in [`crate::World::build`] — or by [`crate::load_checked`]
 //! (`trust-sim validate`), which generates the layout without building the maps.
 
+pub mod files;
 pub(crate) mod generator;
 pub mod points;
+pub mod scale;
 
 pub(crate) mod sections;
 mod validate;
@@ -142,7 +154,7 @@ pub use generator::{E1Params, E2Params, E3Params, E4Params, GeneratorSpec};
 pub use sections::{
     BoundsSpec, Latency, MAX_CPU_SCALE, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec,
     RandomEndpoints, RandomObstacles, SimSection, StaticSection, VehicleModel, VehicleSection,
-    WorldSection,
+    WorldSection, endpoint_draw_count,
 };
 
 /// A static obstacle of `[[static.shapes]]`: the run log's type (see [`StaticSection::shapes`]).
@@ -246,15 +258,14 @@ impl Scenario {
         Ok(s.with_seed(s.seed))
     }
 
-    /// Reads and parses a scenario file without validating it.
+    /// Reads and parses a scenario file without validating it: a regular file of at most
+    /// [`files::MAX_SCENARIO_BYTES`] ([`files`]).
     ///
     /// # Errors
-    /// [`WorldError::Read`], [`WorldError::Parse`].
+    /// [`WorldError::Read`], [`WorldError::NotAFile`], [`WorldError::TooLarge`],
+    /// [`WorldError::Parse`].
     pub fn parse_file(path: &Path) -> Result<Scenario, WorldError> {
-        let text = std::fs::read_to_string(path).map_err(|source| WorldError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = files::read_text(path, files::MAX_SCENARIO_BYTES, "a scenario file")?;
         Scenario::from_toml_str(&text, path)
     }
 
@@ -285,8 +296,11 @@ impl Scenario {
             seed,
             ..self.clone()
         };
-        // A random flight draws its start and goal from the seed.
-        if let (Some(random), Some(bounds)) = (&s.mission.random, s.bounds()) {
+        // A random flight draws its start and goal from the seed, in a region within the scale
+        // policy (validation reports one outside it; the draw would not be uniform there).
+        if let (Some(random), Some(bounds)) = (&s.mission.random, s.bounds())
+            && random.drawable(&bounds)
+        {
             use trust_geometry::{AaBox, Cylinder, Shape, Sphere};
             // Clear of the static shapes and of the explicit moving obstacles where they are at
             // t = 0 (a start inside a person is invalid).
@@ -342,12 +356,10 @@ impl Scenario {
         }
     }
 
-    /// A path from the file, resolved against the folder of [`Scenario::path`].
+    /// A path from the file, resolved against the folder of [`Scenario::path`] (validation
+    /// refuses a relative path that leaves it: [`files`]).
     pub fn resolve_path(&self, path: &Path) -> PathBuf {
-        match self.path.as_deref().and_then(Path::parent) {
-            Some(dir) if path.is_relative() => dir.join(path),
-            _ => path.to_path_buf(),
-        }
+        files::resolve(self.path.as_deref().and_then(Path::parent), path)
     }
 
     /// What errors call this scenario: its file, or `<scenario NAME>`.

@@ -408,8 +408,10 @@ pub struct Mission {
 /// `[mission] random = { ... }`: the start and the goal drawn uniformly in `region` from the
 /// trial seed (a stream of its own, so the world, the traffic and the noise of a seed do not
 /// change), each at least `vehicle.radius_m + clearance_m` from every explicit static shape
-/// (`[[static.shapes]]`), and at least `min_distance_m` apart. Up to 10 000 draws per point; if
-/// none fits, the best draw is kept and validation names the problem.
+/// (`[[static.shapes]]`), and at least `min_distance_m` apart. Up to 200 starts with 200 goals
+/// each, and at most [`endpoint_draw_count`] points in all (draws × static shapes within the
+/// scale policy); if no pair fits, the farthest clear pair is kept and validation names
+/// `mission.random.min_distance_m`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RandomEndpoints {
@@ -494,15 +496,24 @@ impl RandomEndpoints {
         // near the middle of a small region may have no goal far enough, so the start is drawn
         // again (drawing the start alone first failed for 1 seed in 20 in the suite's rooms).
         // Without a valid pair, the farthest clear pair seen (validation then names the field).
-        const START_DRAWS: usize = 200;
-        const GOAL_DRAWS: usize = 200;
+        // At most `endpoint_draw_count(shapes)` points in all, so that draws × shapes stays
+        // within the scale policy's MAX_ENDPOINT_WORK.
+        let mut left = endpoint_draw_count(shapes.len());
         let mut best: Option<(f64, Vec3, Vec3)> = None;
-        for _ in 0..START_DRAWS {
+        'starts: for _ in 0..START_DRAWS {
+            if left == 0 {
+                break;
+            }
+            left -= 1;
             let start = draw_point(&mut rng);
             if clear(&start) < need {
                 continue;
             }
             for _ in 0..GOAL_DRAWS {
+                if left == 0 {
+                    break 'starts;
+                }
+                left -= 1;
                 let goal = draw_point(&mut rng);
                 if clear(&goal) < need {
                     continue;
@@ -519,6 +530,33 @@ impl RandomEndpoints {
         let (start, goal) = best.map_or((region.min, region.max), |(_, a, b)| (a, b));
         (start.into(), goal.into())
     }
+
+    /// Whether [`RandomEndpoints::draw`] can draw in this region (its own or `bounds`): finite,
+    /// `min <= max`, within the scale policy's coordinates. Otherwise the scenario keeps the
+    /// file's start and goal and validation names the region.
+    pub fn drawable(&self, bounds: &Aabb) -> bool {
+        let region = self.region.as_ref().map_or(*bounds, BoundsSpec::aabb);
+        (0..3).all(|k| {
+            let (lo, hi) = (region.min[k], region.max[k]);
+            lo.is_finite()
+                && hi.is_finite()
+                && lo <= hi
+                && lo.abs() <= super::scale::MAX_COORD_M
+                && hi.abs() <= super::scale::MAX_COORD_M
+        })
+    }
+}
+
+/// Start draws of [`RandomEndpoints::draw`].
+const START_DRAWS: usize = 200;
+/// Goal draws per start.
+const GOAL_DRAWS: usize = 200;
+
+/// How many points [`RandomEndpoints::draw`] draws at most with `shape_count` static shapes:
+/// `200 + 200 · 200`, fewer when the draws times the shapes would exceed
+/// [`super::scale::MAX_ENDPOINT_WORK`] (at least 2).
+pub fn endpoint_draw_count(shape_count: usize) -> usize {
+    (super::scale::MAX_ENDPOINT_WORK / shape_count.max(1)).clamp(2, START_DRAWS * (1 + GOAL_DRAWS))
 }
 
 fn default_goal_tolerance() -> f64 {

@@ -4,7 +4,7 @@ use trust_core::{Aabb, Vec3};
 use trust_geometry::{MAX_VOXELS, checked_voxel_count};
 
 use super::{Latency, MAX_CPU_SCALE, MovingShapeKind, PointCloudSpec, Problem, Scenario};
-use crate::problem::{Problems, fmt_bounds, fmt_vec};
+use crate::problem::{Problems, fmt_bounds, fmt_num, fmt_vec};
 use crate::scenario::points::read_points_file;
 use trust_vehicle::VehicleError;
 
@@ -58,6 +58,8 @@ impl Scenario {
 
         let geometry_start = p.list.len();
         let bounds = self.check_world(&mut p);
+        // The scale policy first: no file is read and nothing is generated beyond it.
+        self.check_scale(&mut p, bounds.as_ref());
         let cloud_points = self.check_static(&mut p, bounds.as_ref());
         self.check_obstacles(&mut p, bounds.as_ref());
         self.check_mission(&mut p, bounds.as_ref());
@@ -117,11 +119,14 @@ impl Scenario {
                 let count = dims.iter().map(|&d| d as f64).product::<f64>();
                 p.push(
                     "static.point_cloud.esdf_voxel_m",
-                    voxel,
+                    fmt_num(voxel),
                     format!(
                         "a voxel size giving at most {MAX_VOXELS} voxels over world.bounds \
-                         (this one gives {} x {} x {} = {count:.3e})",
-                        dims[0], dims[1], dims[2]
+                         (this one gives {} x {} x {} = {})",
+                        dims[0],
+                        dims[1],
+                        dims[2],
+                        fmt_num(count)
                     ),
                 );
             }
@@ -149,6 +154,14 @@ impl Scenario {
                 ok.then(|| points.iter().map(|q| Vec3::from(*q)).collect())
             }
             PointCloudSpec::File { path, .. } => {
+                if let Some(why) = super::files::relative_path_problem(path) {
+                    p.push(
+                        "static.point_cloud.path",
+                        format!("{:?}", path.display().to_string()),
+                        why,
+                    );
+                    return None;
+                }
                 let full = self.resolve_path(path);
                 match read_points_file(&full) {
                     Ok(pts) if pts.is_empty() => {
@@ -191,8 +204,8 @@ impl Scenario {
                 _ => o.shape == MovingShapeKind::Box,
             };
             for (name, given) in [
-                ("radius_m", o.radius_m.map(|r| r.to_string())),
-                ("half_height_m", o.half_height_m.map(|h| h.to_string())),
+                ("radius_m", o.radius_m.map(fmt_num)),
+                ("half_height_m", o.half_height_m.map(fmt_num)),
                 ("half_extents", o.half_extents.map(|h| fmt_vec(&h))),
             ] {
                 match (wants(name), given) {
@@ -231,6 +244,16 @@ impl Scenario {
                 }
             }
             if let crate::traffic::Motion::Samples(s) = &o.motion {
+                if let Some(file) = &s.file
+                    && let Some(why) = super::files::relative_path_problem(file)
+                {
+                    p.push(
+                        format!("{field}.motion.file"),
+                        format!("{:?}", file.display().to_string()),
+                        why,
+                    );
+                    continue;
+                }
                 match (s.samples.is_empty(), &s.file) {
                     (false, Some(file)) => p.push(
                         format!("{field}.motion"),
@@ -280,7 +303,7 @@ impl Scenario {
             if !(0.0..=90.0).contains(&g.max_climb_deg) {
                 p.push(
                     f("max_climb_deg"),
-                    g.max_climb_deg,
+                    fmt_num(g.max_climb_deg),
                     "an angle in [0, 90] degrees",
                 );
             }
@@ -348,17 +371,20 @@ impl Scenario {
             if let Some(b) = bounds {
                 let (a, g) = (Vec3::from(m.start), Vec3::from(m.goal));
                 if r.min_distance_m.is_finite() && (a - g).norm() < r.min_distance_m {
+                    let draws = super::sections::endpoint_draw_count(self.static_map.shapes.len());
                     p.push(
                         "mission.random.min_distance_m",
-                        r.min_distance_m,
+                        fmt_num(r.min_distance_m),
                         format!(
-                            "a distance the region allows: the farthest clear pair of 200 x 200 \
-                             draws in {} is {:.3} m apart",
+                            "a distance the region allows: the farthest clear pair of {draws} \
+                             draws in {} is {} m apart (the draw gives up after {draws} points: \
+                             at most {} distance tests to the static shapes)",
                             match &r.region {
                                 Some(region) => fmt_bounds(&region.min, &region.max),
                                 None => fmt_bounds(b.min.as_slice(), b.max.as_slice()),
                             },
-                            (a - g).norm()
+                            fmt_num((a - g).norm()),
+                            super::scale::MAX_ENDPOINT_WORK
                         ),
                     );
                 }
@@ -402,11 +428,14 @@ impl Scenario {
             if k < 1.0 || (n - k).abs() > DIVIDE_TOLERANCE * n {
                 p.push(
                     name,
-                    rate,
+                    fmt_num(rate),
                     format!(
-                        "a rate whose period (1/{rate} = {period} s) is an integer multiple of \
-                         sim.physics_dt_s ({} s); it is {n} steps",
-                        s.physics_dt_s
+                        "a rate whose period (1/{} = {} s) is an integer multiple of \
+                         sim.physics_dt_s ({} s); it is {} steps",
+                        fmt_num(rate),
+                        fmt_num(period),
+                        fmt_num(s.physics_dt_s),
+                        fmt_num(n)
                     ),
                 );
             }
@@ -414,7 +443,7 @@ impl Scenario {
         if s.log_rate_hz.is_finite() && s.log_rate_hz > 0.0 && s.log_rate_hz < MIN_LOG_RATE_HZ {
             p.push(
                 "sim.log_rate_hz",
-                s.log_rate_hz,
+                fmt_num(s.log_rate_hz),
                 format!(
                     "at least {MIN_LOG_RATE_HZ} Hz (run-log contract: state records at >= 50 Hz)"
                 ),
@@ -427,7 +456,7 @@ impl Scenario {
         {
             p.push(
                 "sim.latency.cpu_scale",
-                scale,
+                fmt_num(scale),
                 format!("a number in (0, {MAX_CPU_SCALE}]"),
             );
         }
@@ -446,10 +475,11 @@ impl Scenario {
             {
                 p.push(
                     "planner.manager.latency_s",
-                    manager,
+                    fmt_num(manager),
                     format!(
-                        "the same value as sim.latency.seconds ({seconds}) or no value: the \
-                         manager plans for the delay the loop applies; set it in one place"
+                        "the same value as sim.latency.seconds ({}) or no value: the manager \
+                         plans for the delay the loop applies; set it in one place",
+                        fmt_num(seconds)
                     ),
                 );
             }
@@ -489,8 +519,8 @@ fn check_shape(p: &mut Problems, field: &str, s: &super::StaticShape) {
             if a && b && z_min >= z_max {
                 p.push(
                     format!("{field}.z_max"),
-                    z_max,
-                    format!("a top above z_min = {z_min}"),
+                    fmt_num(z_max),
+                    format!("a top above z_min = {}", fmt_num(z_min)),
                 );
             }
         }
@@ -503,7 +533,10 @@ fn check_shape(p: &mut Problems, field: &str, s: &super::StaticShape) {
                         p.push(
                             format!("{field}.max"),
                             fmt_vec(&max),
-                            format!("max.{axis} > min.{axis} = {} (a box with volume)", min[i]),
+                            format!(
+                                "max.{axis} > min.{axis} = {} (a box with volume)",
+                                fmt_num(min[i])
+                            ),
                         );
                     }
                 }
@@ -514,14 +547,16 @@ fn check_shape(p: &mut Problems, field: &str, s: &super::StaticShape) {
 
 fn vehicle_problem(e: VehicleError, prefix: &str) -> Problem {
     match e {
-        VehicleError::NonFinite { field, value } => {
-            Problem::new(format!("{prefix}.{field}"), value, "a finite number")
-        }
+        VehicleError::NonFinite { field, value } => Problem::new(
+            format!("{prefix}.{field}"),
+            fmt_num(value),
+            "a finite number",
+        ),
         VehicleError::OutOfRange {
             field,
             value,
             expected,
-        } => Problem::new(format!("{prefix}.{field}"), value, expected),
+        } => Problem::new(format!("{prefix}.{field}"), fmt_num(value), expected),
         // `VehicleError` is `#[non_exhaustive]`: a future variant still names the section.
         other => Problem::new(prefix, other, "valid vehicle parameters"),
     }

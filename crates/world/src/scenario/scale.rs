@@ -1,0 +1,519 @@
+//! The scenario scale policy: the magnitudes and counts a scenario file may set.
+//!
+//! The planning crates accept the library-wide policy of `trust_core::scale` (coordinates within
+//! ±1e6 m, speeds up to 1e4 m/s, …); a scenario is checked against tighter, drone-sized limits,
+//! so that every value the file sets — and every parameter derived from it (the presets'
+//! goal radius `1.5 v_max²/a_max`, the tracking margin `0.01 + 0.0015 a_max`, noisy
+//! measurements `p + noise`) — stays inside the library's policy, and a file `trust-sim
+//! validate` accepts can be flown. Each limit is reported on the field the file wrote.
+//!
+//! | what | accepted | constant |
+//! |---|---|---|
+//! | coordinates (bounds, regions, shapes, positions, start, goal, points, samples, curve centres and coefficients) | `|x| ≤ 1e5` m | [`MAX_COORD_M`] |
+//! | sizes, distances, clearances, tolerances, margins | `≤ 1e5` m | [`MAX_SIZE_M`] |
+//! | obstacle speeds and velocity components | `≤ 1e3` m/s | [`MAX_SPEED_M_S`] |
+//! | obstacle acceleration bounds (random maneuvers) | `≤ 1e3` m/s² | [`MAX_OBSTACLE_ACCEL_M_S2`] |
+//! | `vehicle.limits.v_max` | `[0.01, 100]` m/s | [`V_MAX_RANGE`] |
+//! | `vehicle.limits.a_max` | `[0.1, 100]` m/s² | [`A_MAX_RANGE`] |
+//! | `vehicle.radius_m` | `≤ 100` m | [`MAX_VEHICLE_RADIUS_M`] |
+//! | `sensing.position_noise_m` | `≤ 1e3` m and `≤` the world's diagonal | [`MAX_NOISE_M`] |
+//! | `sensing.warmup_s` | `≤ 3600` s | [`MAX_WARMUP_S`] |
+//! | `traffic.fault_level` | `≤ 100` | [`MAX_FAULT_LEVEL`] |
+//! | `sim.physics_dt_s` | `[1e-5, 0.1]` s | [`PHYSICS_DT_RANGE`] |
+//! | `time_limit_s` | `≤ 86 400` s | [`MAX_TIME_LIMIT_S`] |
+//! | a Fourier `period_s`, a maneuver's `mean_interval_s` | `≥ sim.physics_dt_s` | |
+//! | a Fourier `phase_s` | `|φ| ≤ 1e7` s | |
+//! | moving obstacles in all (explicit, random groups, generators) | `≤ 10 000` | [`MAX_OBSTACLE_COUNT`] |
+//! | static shapes in all (explicit and E4's blocks, walls, pillars) | `≤ 10 000` | [`MAX_STATIC_SHAPE_COUNT`] |
+//! | cloud points (inline, file, or sampled from shapes: counted before sampling) | `≤ 2e7` | [`MAX_CLOUD_POINTS`] |
+//! | sampling lattice of `spacing_m` over the bounds | `≤ trust_geometry::MAX_VOXELS` | |
+//! | samples of a track, harmonics of a Fourier list | `≤ 1e5`, `≤ 64` | [`crate::script::MAX_SAMPLES`], [`crate::script::MAX_HARMONICS`] |
+//! | random draws of `[mission] random` | `≤ 40 200`, and draws × static shapes `≤ 4e6` | [`MAX_ENDPOINT_WORK`] |
+//! | placement work of random obstacles and E4's static shapes | `≤ 2e7` distance tests per world | [`MAX_PLACEMENT_WORK`] |
+//!
+//! Counts are checked before anything is allocated or drawn for them; files are read under the
+//! caps of [`super::files`].
+
+use trust_core::Aabb;
+use trust_geometry::{MAX_VOXELS, Shape, checked_voxel_count};
+
+use super::generator::GeneratorSpec;
+use super::validate::esdf_dims;
+use super::{PointCloudSpec, Scenario};
+use crate::problem::{Problems, fmt_count, fmt_num};
+use crate::traffic::Motion;
+
+/// Largest coordinate magnitude (m).
+pub const MAX_COORD_M: f64 = 1.0e5;
+/// Largest size, distance, clearance, tolerance or margin (m).
+pub const MAX_SIZE_M: f64 = 1.0e5;
+/// Largest obstacle speed or velocity component (m/s).
+pub const MAX_SPEED_M_S: f64 = 1.0e3;
+/// Largest obstacle acceleration bound (m/s²).
+pub const MAX_OBSTACLE_ACCEL_M_S2: f64 = 1.0e3;
+/// Accepted `vehicle.limits.v_max` (m/s).
+pub const V_MAX_RANGE: (f64, f64) = (0.01, 100.0);
+/// Accepted `vehicle.limits.a_max` (m/s²).
+pub const A_MAX_RANGE: (f64, f64) = (0.1, 100.0);
+/// Largest `vehicle.radius_m` (m).
+pub const MAX_VEHICLE_RADIUS_M: f64 = 100.0;
+/// Largest `sensing.position_noise_m` (m); it must not exceed the world's diagonal either.
+pub const MAX_NOISE_M: f64 = 1.0e3;
+/// Largest `sensing.warmup_s` (s).
+pub const MAX_WARMUP_S: f64 = 3600.0;
+/// Largest `traffic.fault_level`.
+pub const MAX_FAULT_LEVEL: f64 = 100.0;
+/// Accepted `sim.physics_dt_s` (s).
+pub const PHYSICS_DT_RANGE: (f64, f64) = (1.0e-5, 0.1);
+/// Largest `time_limit_s` (s): a day.
+pub const MAX_TIME_LIMIT_S: f64 = 86_400.0;
+/// Largest absolute time offset (s) of a script.
+pub const MAX_SCRIPT_TIME_S: f64 = 1.0e7;
+/// Most moving obstacles in a world.
+pub const MAX_OBSTACLE_COUNT: usize = 10_000;
+/// Most static shapes in a world.
+pub const MAX_STATIC_SHAPE_COUNT: usize = 10_000;
+/// Most points of a cloud (480 MB of coordinates).
+pub const MAX_CLOUD_POINTS: usize = 20_000_000;
+/// Most shape distance tests of the `[mission] random` draw (draws × static shapes).
+pub const MAX_ENDPOINT_WORK: usize = 4_000_000;
+/// Most distance tests of the placements of one world's random obstacles and E4 shapes.
+pub const MAX_PLACEMENT_WORK: u64 = 20_000_000;
+
+/// Upper bound on the points [`crate::sample_shapes`] makes of `shapes` at `spacing` over
+/// `bounds`, computed without sampling: the lattice points of each shape's inflated box.
+pub(crate) fn sampled_point_bound(shapes: &[Shape], bounds: &Aabb, spacing: f64) -> f64 {
+    let h = spacing * 3f64.sqrt() / 2.0;
+    shapes
+        .iter()
+        .map(|s| {
+            let b = s.aabb().inflated(h);
+            (0..3)
+                .map(|k| {
+                    let lo = b.min[k].max(bounds.min[k]);
+                    let hi = b.max[k].min(bounds.max[k]);
+                    if hi < lo {
+                        0.0
+                    } else {
+                        ((hi - lo) / spacing).floor() + 1.0
+                    }
+                })
+                .product::<f64>()
+        })
+        .sum()
+}
+
+/// Checks `count` (with a description of where it comes from) against [`MAX_CLOUD_POINTS`].
+pub(crate) fn check_sampled_points(p: &mut Problems, field: &str, value: f64, count: f64) {
+    if count > MAX_CLOUD_POINTS as f64 {
+        p.push(
+            field,
+            fmt_num(value),
+            format!(
+                "a spacing giving at most {} sampled points (scale policy; this one gives up to \
+                 {})",
+                fmt_count(MAX_CLOUD_POINTS as u128),
+                fmt_num(count.round())
+            ),
+        );
+    }
+}
+
+impl Scenario {
+    /// The scale policy (module docs) on every value the file sets; `bounds` are the world
+    /// bounds if valid.
+    pub(crate) fn check_scale(&self, p: &mut Problems, bounds: Option<&Aabb>) {
+        p.within("time_limit_s", self.time_limit_s, MAX_TIME_LIMIT_S, "s");
+        self.scale_world(p);
+        self.scale_static(p, bounds);
+        self.scale_obstacles(p);
+        self.scale_mission_and_vehicle(p);
+        self.scale_sensing_and_sim(p, bounds);
+    }
+
+    fn scale_world(&self, p: &mut Problems) {
+        if let Some(b) = &self.world.bounds {
+            p.within_vec("world.bounds.min", &b.min, MAX_COORD_M, "m");
+            p.within_vec("world.bounds.max", &b.max, MAX_COORD_M, "m");
+        }
+        let Some(g) = &self.world.generator else {
+            return;
+        };
+        let f = |name: &str| format!("world.generator.{name}");
+        match g {
+            GeneratorSpec::E1(e) => {
+                p.count(
+                    &f("obstacle_count"),
+                    e.obstacle_count as u128,
+                    MAX_OBSTACLE_COUNT,
+                    "moving obstacles",
+                );
+                self.scale_motion(p, &f("motion"), &e.motion);
+            }
+            GeneratorSpec::E2Static(_) | GeneratorSpec::E2Dynamic(_) => {}
+            GeneratorSpec::E3(e) => {
+                p.count(
+                    &f("obstacle_count"),
+                    e.obstacle_count as u128,
+                    MAX_OBSTACLE_COUNT,
+                    "moving obstacles",
+                );
+                if let Some(r) = &e.region {
+                    p.within_vec(&f("region.min"), &r.min, MAX_COORD_M, "m");
+                    p.within_vec(&f("region.max"), &r.max, MAX_COORD_M, "m");
+                }
+                self.scale_motion(p, &f("motion"), &e.motion);
+            }
+            GeneratorSpec::E4(e) => {
+                for (name, n) in [
+                    ("pillar_count", e.pillar_count),
+                    ("wall_count", e.wall_count),
+                    ("block_count", e.block_count),
+                ] {
+                    p.count(&f(name), n as u128, MAX_STATIC_SHAPE_COUNT, "static shapes");
+                }
+                p.count(
+                    &f("moving_count"),
+                    e.moving_count as u128,
+                    MAX_OBSTACLE_COUNT,
+                    "moving obstacles",
+                );
+                for (name, r) in [
+                    ("pillar_radius_m", e.pillar_radius_m),
+                    ("wall_length_m", e.wall_length_m),
+                    ("wall_thickness_m", e.wall_thickness_m),
+                    ("wall_height_m", e.wall_height_m),
+                    ("block_size_m", e.block_size_m),
+                    ("block_height_m", e.block_height_m),
+                    ("moving_sphere_radius_m", e.moving_sphere_radius_m),
+                    ("moving_cylinder_radius_m", e.moving_cylinder_radius_m),
+                    (
+                        "moving_cylinder_half_height_m",
+                        e.moving_cylinder_half_height_m,
+                    ),
+                ] {
+                    p.within_vec(&f(name), &r, MAX_SIZE_M, "m");
+                }
+                p.within_vec(
+                    &f("moving_speed_m_s"),
+                    &e.moving_speed_m_s,
+                    MAX_SPEED_M_S,
+                    "m/s",
+                );
+                for (name, x) in [
+                    ("min_gap_m", e.min_gap_m),
+                    ("endpoint_clear_m", e.endpoint_clear_m),
+                    ("moving_end_margin_m", e.moving_end_margin_m),
+                ] {
+                    p.within(&f(name), x, MAX_SIZE_M, "m");
+                }
+                self.scale_motion(p, &f("moving_motion"), &e.moving_motion);
+            }
+        }
+    }
+
+    fn scale_static(&self, p: &mut Problems, bounds: Option<&Aabb>) {
+        use super::StaticShape;
+        let shapes = &self.static_map.shapes;
+        let generated = match &self.world.generator {
+            Some(GeneratorSpec::E4(e)) => {
+                e.pillar_count as u128 + e.wall_count as u128 + e.block_count as u128
+            }
+            _ => 0,
+        };
+        let total = shapes.len() as u128 + generated;
+        if total > MAX_STATIC_SHAPE_COUNT as u128 {
+            p.push(
+                "static.shapes",
+                format!(
+                    "{} shapes ({} generated)",
+                    fmt_count(total),
+                    fmt_count(generated)
+                ),
+                format!(
+                    "at most {MAX_STATIC_SHAPE_COUNT} static shapes in all, explicit and \
+                     generated (scale policy)"
+                ),
+            );
+        }
+        for (i, s) in shapes.iter().enumerate() {
+            let f = |name: &str| format!("static.shapes[{i}].{name}");
+            match *s {
+                StaticShape::Sphere { center, radius } => {
+                    p.within_vec(&f("center"), &center, MAX_COORD_M, "m");
+                    p.within(&f("radius"), radius, MAX_SIZE_M, "m");
+                }
+                StaticShape::Cylinder {
+                    center,
+                    radius,
+                    z_min,
+                    z_max,
+                } => {
+                    p.within_vec(&f("center"), &center, MAX_COORD_M, "m");
+                    p.within(&f("radius"), radius, MAX_SIZE_M, "m");
+                    p.within(&f("z_min"), z_min, MAX_COORD_M, "m");
+                    p.within(&f("z_max"), z_max, MAX_COORD_M, "m");
+                }
+                StaticShape::Box { min, max } => {
+                    p.within_vec(&f("min"), &min, MAX_COORD_M, "m");
+                    p.within_vec(&f("max"), &max, MAX_COORD_M, "m");
+                }
+            }
+        }
+        let Some(cloud) = &self.static_map.point_cloud else {
+            return;
+        };
+        p.within(
+            "static.point_cloud.esdf_voxel_m",
+            cloud.esdf_voxel_m(),
+            MAX_SIZE_M,
+            "m",
+        );
+        match cloud {
+            PointCloudSpec::Shapes {
+                spacing_m: Some(s), ..
+            } if s.is_finite() && *s > 0.0 => {
+                p.within("static.point_cloud.spacing_m", *s, MAX_SIZE_M, "m");
+                if let Some(b) = bounds {
+                    let dims = esdf_dims(b, *s);
+                    if checked_voxel_count(dims).is_err() {
+                        let count = dims.iter().map(|&d| d as f64).product::<f64>();
+                        p.push(
+                            "static.point_cloud.spacing_m",
+                            fmt_num(*s),
+                            format!(
+                                "a spacing giving at most {MAX_VOXELS} lattice points over \
+                                 world.bounds (scale policy; this one gives {} x {} x {} = {})",
+                                dims[0],
+                                dims[1],
+                                dims[2],
+                                fmt_num(count)
+                            ),
+                        );
+                    }
+                }
+            }
+            PointCloudSpec::Inline { points, .. }
+                if p.count(
+                    "static.point_cloud.points",
+                    points.len() as u128,
+                    MAX_CLOUD_POINTS,
+                    "points",
+                ) =>
+            {
+                for (i, q) in points.iter().enumerate() {
+                    p.within_vec(
+                        &format!("static.point_cloud.points[{i}]"),
+                        q,
+                        MAX_COORD_M,
+                        "m",
+                    );
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn scale_obstacles(&self, p: &mut Problems) {
+        let mut total = self.obstacles.len() as u128;
+        for (i, o) in self.obstacles.iter().enumerate() {
+            let f = |name: &str| format!("obstacles[{i}].{name}");
+            if let Some(x) = o.position {
+                p.within_vec(&f("position"), &x, MAX_COORD_M, "m");
+            }
+            if let Some(v) = o.velocity {
+                p.within_vec(&f("velocity"), &v, MAX_SPEED_M_S, "m/s");
+            }
+            if let Some(r) = o.radius_m {
+                p.within(&f("radius_m"), r, MAX_SIZE_M, "m");
+            }
+            if let Some(h) = o.half_height_m {
+                p.within(&f("half_height_m"), h, MAX_SIZE_M, "m");
+            }
+            if let Some(h) = o.half_extents {
+                p.within_vec(&f("half_extents"), &h, MAX_SIZE_M, "m");
+            }
+            if let Some(r) = &o.region {
+                p.within_vec(&f("region.min"), &r.min, MAX_COORD_M, "m");
+                p.within_vec(&f("region.max"), &r.max, MAX_COORD_M, "m");
+            }
+            self.scale_motion(p, &f("motion"), &o.motion);
+        }
+        for (i, g) in self.random_obstacles.iter().enumerate() {
+            let f = |name: &str| format!("random_obstacles[{i}].{name}");
+            p.count(
+                &f("count"),
+                g.count as u128,
+                MAX_OBSTACLE_COUNT,
+                "moving obstacles",
+            );
+            total += g.count as u128;
+            p.within_vec(&f("sphere_radius_m"), &g.sphere_radius_m, MAX_SIZE_M, "m");
+            p.within_vec(
+                &f("cylinder_radius_m"),
+                &g.cylinder_radius_m,
+                MAX_SIZE_M,
+                "m",
+            );
+            if let Some(h) = g.cylinder_half_height_m {
+                p.within_vec(&f("cylinder_half_height_m"), &h, MAX_SIZE_M, "m");
+            }
+            p.within_vec(&f("speed_m_s"), &g.speed_m_s, MAX_SPEED_M_S, "m/s");
+            p.within(
+                &f("endpoint_clearance_m"),
+                g.endpoint_clearance_m,
+                MAX_SIZE_M,
+                "m",
+            );
+            if let Some(r) = &g.region {
+                p.within_vec(&f("region.min"), &r.min, MAX_COORD_M, "m");
+                p.within_vec(&f("region.max"), &r.max, MAX_COORD_M, "m");
+            }
+            self.scale_motion(p, &f("motion"), &g.motion);
+        }
+        total += match &self.world.generator {
+            Some(GeneratorSpec::E1(e)) => e.obstacle_count as u128,
+            Some(GeneratorSpec::E3(e)) => e.obstacle_count as u128,
+            Some(GeneratorSpec::E4(e)) => e.moving_count as u128,
+            _ => 0,
+        };
+        if total > MAX_OBSTACLE_COUNT as u128 {
+            p.push(
+                "obstacles",
+                format!("{} moving obstacles in all", fmt_count(total)),
+                format!(
+                    "at most {MAX_OBSTACLE_COUNT} moving obstacles in all: [[obstacles]], \
+                     [[random_obstacles]] counts and the generator's (scale policy)"
+                ),
+            );
+        }
+    }
+
+    /// A motion model's magnitudes; a script's period against the physics step.
+    fn scale_motion(&self, p: &mut Problems, field: &str, m: &Motion) {
+        let dt = self.sim.physics_dt_s;
+        match m {
+            Motion::ConstantVelocity {} => {}
+            Motion::RandomManeuvers(r) => {
+                if let Some(s) = r.speed_m_s {
+                    p.within_vec(&format!("{field}.speed_m_s"), &s, MAX_SPEED_M_S, "m/s");
+                }
+                p.within(
+                    &format!("{field}.max_accel_m_s2"),
+                    r.max_accel_m_s2,
+                    MAX_OBSTACLE_ACCEL_M_S2,
+                    "m/s²",
+                );
+                if dt.is_finite() && r.mean_interval_s.is_finite() && r.mean_interval_s > 0.0 {
+                    p.in_range(
+                        &format!("{field}.mean_interval_s"),
+                        r.mean_interval_s,
+                        dt,
+                        MAX_SCRIPT_TIME_S,
+                        "s (at least sim.physics_dt_s)",
+                    );
+                }
+            }
+            Motion::Fourier(c) => {
+                if dt.is_finite()
+                    && dt > 0.0
+                    && c.period_s.is_finite()
+                    && c.period_s > 0.0
+                    && c.period_s < dt
+                {
+                    p.push(
+                        format!("{field}.period_s"),
+                        fmt_num(c.period_s),
+                        format!(
+                            "a period of at least sim.physics_dt_s = {} s (scale policy: the \
+                             simulation cannot follow a faster curve)",
+                            fmt_num(dt)
+                        ),
+                    );
+                }
+                p.within(
+                    &format!("{field}.phase_s"),
+                    c.phase_s,
+                    MAX_SCRIPT_TIME_S,
+                    "s",
+                );
+                p.within_vec(&format!("{field}.center"), &c.center, MAX_COORD_M, "m");
+            }
+            Motion::Samples(_) => {}
+        }
+    }
+
+    fn scale_mission_and_vehicle(&self, p: &mut Problems) {
+        let m = &self.mission;
+        if m.random.is_none() {
+            p.within_vec("mission.start", &m.start, MAX_COORD_M, "m");
+            p.within_vec("mission.goal", &m.goal, MAX_COORD_M, "m");
+        }
+        p.within(
+            "mission.goal_tolerance_m",
+            m.goal_tolerance_m,
+            MAX_SIZE_M,
+            "m",
+        );
+        if let Some(r) = &m.random {
+            p.within(
+                "mission.random.min_distance_m",
+                r.min_distance_m,
+                MAX_SIZE_M,
+                "m",
+            );
+            p.within("mission.random.clearance_m", r.clearance_m, MAX_SIZE_M, "m");
+            if let Some(region) = &r.region {
+                p.within_vec("mission.random.region.min", &region.min, MAX_COORD_M, "m");
+                p.within_vec("mission.random.region.max", &region.max, MAX_COORD_M, "m");
+            }
+        }
+        let v = &self.vehicle;
+        // Non-positive values are reported by the sign checks (validate.rs).
+        p.within("vehicle.radius_m", v.radius_m, MAX_VEHICLE_RADIUS_M, "m");
+        for (field, x, (lo, hi), unit) in [
+            ("vehicle.limits.v_max", v.limits.v_max, V_MAX_RANGE, "m/s"),
+            ("vehicle.limits.a_max", v.limits.a_max, A_MAX_RANGE, "m/s²"),
+        ] {
+            if x > 0.0 {
+                p.in_range(field, x, lo, hi, unit);
+            }
+        }
+    }
+
+    fn scale_sensing_and_sim(&self, p: &mut Problems, bounds: Option<&Aabb>) {
+        let s = &self.sensing;
+        let diagonal = bounds.map_or(f64::INFINITY, |b| b.extent().norm());
+        let noise_cap = MAX_NOISE_M.min(diagonal);
+        if s.position_noise_m.is_finite() && s.position_noise_m > noise_cap {
+            p.push(
+                "sensing.position_noise_m",
+                fmt_num(s.position_noise_m),
+                format!(
+                    "a noise of at most {} m (scale policy: at most {} m and at most the world's \
+                     diagonal, {} m)",
+                    fmt_num(noise_cap),
+                    fmt_num(MAX_NOISE_M),
+                    fmt_num(diagonal)
+                ),
+            );
+        }
+        p.within(
+            "sensing.r_safe_margin_m",
+            s.r_safe_margin_m,
+            MAX_SIZE_M,
+            "m",
+        );
+        p.within("sensing.warmup_s", s.warmup_s, MAX_WARMUP_S, "s");
+        p.within(
+            "traffic.fault_level",
+            self.traffic.fault_level,
+            MAX_FAULT_LEVEL,
+            "",
+        );
+        let (lo, hi) = PHYSICS_DT_RANGE;
+        if self.sim.physics_dt_s > 0.0 {
+            p.in_range("sim.physics_dt_s", self.sim.physics_dt_s, lo, hi, "s");
+        }
+    }
+}
