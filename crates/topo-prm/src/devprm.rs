@@ -16,9 +16,11 @@
 //! * the cones span `[query.start.t, query.start.t + query.horizon_s]`;
 //! * a cone that contains the start (or the goal, when paths end there) cannot be avoided in space
 //!   and is ignored by the roadmap — the trajectory backend handles it in time;
-//! * the time budget `t_max` covers the roadmap construction (obstacle-aware and random samples);
-//!   the search and selection that follow are bounded by counts (`max_expansions`,
-//!   `keep_raw_paths`), as in Fast-Planner;
+//! * the budget `t_max` (`budget_ms`) covers the roadmap construction (obstacle-aware and random
+//!   samples) and the shortcutting of the raw paths, as a deterministic work count
+//!   (`budget_ms · work_per_ms` units, [`crate::roadmap::RoadmapWork::units`]) and, unless
+//!   `wall_clock_budget` is off, the monotonic clock; the graph search is bounded by
+//!   `max_expansions`, and the selection tests only the paths it could keep;
 //! * besides `t_max` and `N_max`, random sampling stops when the roadmap stalls
 //!   ([`DevPrmParams::stall_samples`]): the coverage rule of the original visibility PRM (Siméon et
 //!   al. 2000), which Fast-Planner replaced by a fixed budget;
@@ -57,9 +59,24 @@ pub struct DevPrmParams {
     /// Resolution (m): edge threshold and UVD/shortcut step. Fast-Planner: 0.1.
     /// Accepted: `[1e-3, 1e6]` m ([`crate::ranges::MIN_RESOLUTION_M`]).
     pub resolution: f64,
-    /// Time budget `t_max` of the roadmap construction (ms). Fast-Planner's 5 ms (E1 uses 20 ms).
+    /// Budget `t_max` of the roadmap construction and shortcutting (ms): a work count
+    /// ([`DevPrmParams::work_per_ms`]) and the monotonic clock ([`DevPrmParams::wall_clock_budget`]).
+    /// Fast-Planner's 5 ms (E1 uses 20 ms).
     /// Accepted: `(0, 6e5]` ms ([`crate::ranges::MAX_BUDGET_MS`]).
     pub budget_ms: f64,
+    /// Work units per ms of `budget_ms` (units: [`crate::roadmap::RoadmapWork::units`], one
+    /// visibility test each): the search stops after `budget_ms · work_per_ms` units — 80 % for
+    /// the roadmap, the rest for shortcutting the raw paths — and returns the paths found so far
+    /// with `SearchStats::budget_exhausted` set. Unlike the clock, the count gives the same paths
+    /// for the same seed on any machine. Ours: 360, measured on the 2-core development machine
+    /// (2.8 µs per unit, least squares over the 96 DEV-PRM searches of E4 seed 0 on the point-cloud
+    /// ESDF, ratio of measured to predicted 0.63–1.26 at the 10th–90th percentile).
+    /// Accepted: `(0, 1e9]` ([`crate::ranges::MAX_WORK_PER_MS`]).
+    pub work_per_ms: f64,
+    /// Also stop on the monotonic clock at `budget_ms` (the wall-clock guard of real-time runs).
+    /// Default `true`; `false` leaves only the work budget and the counts, so a run depends on its
+    /// seed alone (`trust-world`'s reproducible mode).
+    pub wall_clock_budget: bool,
     /// Random-sample budget `N_max`. Fast-Planner's 2000.
     /// Accepted: `[0, 1e6]` (`scale::MAX_SAMPLE_COUNT`).
     pub max_samples: usize,
@@ -122,6 +139,8 @@ impl Default for DevPrmParams {
             clearance: 0.3,
             resolution: 0.1,
             budget_ms: 5.0,
+            work_per_ms: 360.0,
+            wall_clock_budget: true,
             max_samples: 2000,
             stall_samples: 200,
             beam_width: 16,

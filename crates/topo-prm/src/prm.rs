@@ -10,12 +10,12 @@ use trust_core::{
 };
 
 use crate::ggs::Terminal;
-use crate::roadmap::{RoadmapBuilder, RoadmapParams, SampleOutcome};
+use crate::roadmap::{RoadmapBuilder, RoadmapParams, RoadmapWork, SampleOutcome};
 use crate::sampling::SamplingBox;
 use crate::search::{
     SearchLimits, beam_paths, depth_first_paths, keep_fewest_nodes, keep_shortest,
 };
-use crate::select::{prune_equivalent, select_short_paths};
+use crate::select::select_distinct_short_paths;
 use crate::shortcut::shortcut;
 use crate::uvd::{UvdScratch, polylines_equivalent_among};
 use crate::visibility::{Obstacles, forecast_cones};
@@ -26,6 +26,13 @@ pub const COINCIDENT_M: f64 = 1e-9;
 
 /// Margin (m) added around the sampling region when selecting the cones that can matter.
 const REGION_MARGIN_M: f64 = 1.0;
+
+/// Dense points (one per `resolution` along a raw path) that shortcutting handles per work unit
+/// ([`RoadmapWork::units`]). Measured with the DEV-PRM searches of one E4 flight (seed 0).
+pub(crate) const SHORTCUT_POINTS_PER_UNIT: usize = 3;
+
+/// Part of the work budget the roadmap may use; the rest is left to shortcutting and selection.
+const ROADMAP_WORK_SHARE: f64 = 0.8;
 
 /// Validates a path query against a scene, as every frontend of this crate does first:
 /// [`PathQuery::validate`], finite forecasts with non-negative sizes, start and goal inside the map
@@ -111,8 +118,12 @@ pub(crate) struct PrmSetup {
     pub inflate: Vec3,
     pub clearance: f64,
     pub resolution: f64,
-    /// Time budget of the roadmap construction (ms; checked by [`PrmSetup::check_shared`]).
+    /// Time budget of the search (ms; checked by [`PrmSetup::check_shared`]).
     pub budget_ms: f64,
+    /// Work units ([`RoadmapWork::units`]) per ms of `budget_ms`: the deterministic work budget.
+    pub work_per_ms: f64,
+    /// Also stop on the monotonic clock at `budget_ms`.
+    pub wall_clock: bool,
     pub max_samples: usize,
     pub stall_samples: usize,
     pub search: GraphSearch,
@@ -143,7 +154,17 @@ impl PrmSetup {
         }
     }
 
-    /// The roadmap's time budget.
+    /// The deterministic work budget: `budget_ms · work_per_ms` units.
+    fn work_budget(&self) -> usize {
+        let units = (self.budget_ms * self.work_per_ms).ceil();
+        if units >= usize::MAX as f64 {
+            usize::MAX
+        } else {
+            units as usize
+        }
+    }
+
+    /// The search's time budget.
     fn budget(&self, prefix: &str) -> Result<Duration, PlanError> {
         Duration::try_from_secs_f64(self.budget_ms / 1000.0).map_err(|_| {
             PlanError::invalid(
@@ -171,6 +192,13 @@ impl PrmSetup {
         )?;
         ranges::budget_ms(&field("budget_ms"), self.budget_ms)?;
         self.budget(prefix)?;
+        ranges::range(
+            &field("work_per_ms"),
+            self.work_per_ms,
+            trust_core::scale::MIN_POSITIVE,
+            ranges::MAX_WORK_PER_MS,
+            "units/ms",
+        )?;
         ranges::count(&field("max_samples"), self.max_samples, 0, MAX_SAMPLE_COUNT)?;
         for (name, value, cap) in [
             ("max_raw_paths", self.max_raw_paths, ranges::MAX_PATH_COUNT),
@@ -213,6 +241,8 @@ macro_rules! impl_shared_setup {
                     clearance: self.clearance,
                     resolution: self.resolution,
                     budget_ms: self.budget_ms,
+                    work_per_ms: self.work_per_ms,
+                    wall_clock: self.wall_clock_budget,
                     max_samples: self.max_samples,
                     stall_samples: 0,
                     search: $crate::prm::GraphSearch::DepthFirst,
@@ -306,6 +336,11 @@ pub(crate) fn run(
     };
     let start = query.start.p;
     let deadline = since + setup.budget("prm")?;
+    let work_budget = setup.work_budget();
+    let roadmap_work_budget = (work_budget as f64 * ROADMAP_WORK_SHARE) as usize;
+    let out_of_budget = |work: RoadmapWork| {
+        work.units() >= roadmap_work_budget || (setup.wall_clock && Instant::now() >= deadline)
+    };
 
     let terminal = if setup.goal_surface {
         Terminal::goal_guidance_surface(&start, &query.goal, query.horizon_s, query.limits.v_max)
@@ -365,7 +400,7 @@ pub(crate) fn run(
                 })?;
         }
         for p in samples {
-            if Instant::now() >= deadline {
+            if out_of_budget(builder.work()) {
                 stats.budget_exhausted = true;
                 break;
             }
@@ -377,7 +412,7 @@ pub(crate) fn run(
     let mut random = 0;
     let mut stall = StallCounter::new(setup.stall_samples);
     while random < setup.max_samples && !stall.stalled() {
-        if Instant::now() >= deadline {
+        if out_of_budget(builder.work()) {
             stats.budget_exhausted = true;
             break;
         }
@@ -389,6 +424,7 @@ pub(crate) fn run(
         stats.budget_exhausted = true;
     }
     stats.stalled = stall.stalled();
+    let mut work_units = builder.work().units();
     let graph = builder.finish();
     stats.node_count = graph.alive_count();
 
@@ -410,23 +446,34 @@ pub(crate) fn run(
         }
     };
 
-    let short: Vec<Vec<Vec3>> = raw
-        .iter()
-        .map(|nodes| {
-            shortcut(
-                &graph.path_points(nodes),
-                &obstacles,
-                setup.resolution,
-                setup.resolution,
-                &region,
-            )
-        })
-        .collect();
+    // Shortcut the raw paths shortest (beam) or fewest-nodes (DFS) first while the work budget
+    // lasts; the first is always shortcut, so a search that found a path returns one.
+    let mut short: Vec<Vec<Vec3>> = Vec::with_capacity(raw.len());
+    for nodes in &raw {
+        let points = graph.path_points(nodes);
+        let dense = (crate::uvd::polyline_length(&points) / setup.resolution).ceil();
+        let units = (dense / SHORTCUT_POINTS_PER_UNIT as f64).min(usize::MAX as f64) as usize;
+        if !short.is_empty()
+            && (work_units.saturating_add(units) > work_budget
+                || (setup.wall_clock && Instant::now() >= deadline))
+        {
+            stats.budget_exhausted = true;
+            break;
+        }
+        work_units = work_units.saturating_add(units);
+        short.push(shortcut(
+            &points,
+            &obstacles,
+            setup.resolution,
+            setup.resolution,
+            &region,
+        ));
+    }
     let mut scratch = UvdScratch::default();
-    let distinct = prune_equivalent(short, |a, b| {
-        polylines_equivalent_among(&obstacles, a, b, setup.resolution, 0.0, &mut scratch)
-    });
-    let selected = select_short_paths(distinct, setup.length_ratio, setup.max_paths);
+    let selected =
+        select_distinct_short_paths(short, setup.length_ratio, setup.max_paths, |a, b| {
+            polylines_equivalent_among(&obstacles, a, b, setup.resolution, 0.0, &mut scratch)
+        });
     let paths = selected
         .into_iter()
         .map(GuidePath::new)

@@ -174,6 +174,39 @@ impl Roadmap {
     }
 }
 
+/// The expensive operations a [`RoadmapBuilder`] did: samples tested against the obstacles, visibility
+/// queries (line of sight from a sample to a guard, against the static map and the cones) and UVD
+/// equivalence tests of connector candidates. Deterministic for a given sample sequence, so a cap on
+/// them is a work budget that does not depend on the machine.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RoadmapWork {
+    /// Samples inserted (each costs one clearance query).
+    pub sample_count: usize,
+    /// Visibility tests of a sample against a guard (line of sight against the static map and the
+    /// cones; for the terminal, to its candidate end points until one is visible).
+    pub visibility_count: usize,
+    /// UVD equivalence tests of a new connector against the existing ones of its guard pair.
+    pub uvd_count: usize,
+}
+
+impl RoadmapWork {
+    /// Cost of one sample's clearance query, in visibility tests ([`RoadmapWork::units`]).
+    pub const SAMPLE_UNITS: usize = 7;
+    /// Cost of one UVD equivalence test, in visibility tests ([`RoadmapWork::units`]).
+    pub const UVD_UNITS: usize = 35;
+
+    /// The work in units of one visibility test: `visibility_count + 7·sample_count +
+    /// 35·uvd_count`. The weights are a least-squares fit of the roadmap time of the 96 DEV-PRM
+    /// searches of one E4 flight (point-cloud ESDF, seed 0): one unit took 2.8 µs on the 2-core
+    /// development machine, the searches' time per unit ranged 0.63–1.26× that (10th–90th
+    /// percentile).
+    pub fn units(&self) -> usize {
+        self.visibility_count
+            .saturating_add(Self::SAMPLE_UNITS.saturating_mul(self.sample_count))
+            .saturating_add(Self::UVD_UNITS.saturating_mul(self.uvd_count))
+    }
+}
+
 /// Builds a [`Roadmap`] one sample at a time.
 #[derive(Debug)]
 pub struct RoadmapBuilder<'o, 'm> {
@@ -191,6 +224,7 @@ pub struct RoadmapBuilder<'o, 'm> {
     visible: Vec<(usize, Option<Vec3>)>,
     /// Persistent samples that saw exactly one guard: the point and that guard (with its attach point).
     pending: Vec<(Vec3, (usize, Option<Vec3>))>,
+    work: RoadmapWork,
 }
 
 impl<'o, 'm> RoadmapBuilder<'o, 'm> {
@@ -246,6 +280,7 @@ impl<'o, 'm> RoadmapBuilder<'o, 'm> {
             candidates: Vec::new(),
             visible: Vec::new(),
             pending: Vec::new(),
+            work: RoadmapWork::default(),
         }
     }
 
@@ -254,9 +289,15 @@ impl<'o, 'm> RoadmapBuilder<'o, 'm> {
         &self.graph
     }
 
+    /// The expensive operations done so far.
+    pub fn work(&self) -> RoadmapWork {
+        self.work
+    }
+
     /// Whether `p` sees guard `g`; for the terminal, the end point of that edge.
     fn sees(&mut self, p: &Vec3, g: usize) -> Option<Option<Vec3>> {
         let obs = self.obstacles;
+        self.work.visibility_count += 1;
         match g {
             START => obs
                 .segment_clear(p, &self.graph.pos[START], self.start_threshold)
@@ -313,6 +354,7 @@ impl<'o, 'm> RoadmapBuilder<'o, 'm> {
     }
 
     fn insert(&mut self, p: Vec3, persistent: bool) -> SampleOutcome {
+        self.work.sample_count += 1;
         if !self.region.contains(&p)
             || self.graph.terminal.is_beyond(&p)
             || !self.obstacles.is_free(&p, self.params.sample_clearance)
@@ -379,6 +421,7 @@ impl<'o, 'm> RoadmapBuilder<'o, 'm> {
         let new_len = crate::uvd::polyline_length(&new_path);
         let existing: Vec<usize> = self.pairs.get(&(g1, g2)).cloned().unwrap_or_default();
         for c in existing {
+            self.work.uvd_count += 1;
             let old_path = self.connector_path(g1, self.graph.pos[c], g2, self.graph.attach[c]);
             let same = polylines_equivalent_among(
                 self.obstacles,
