@@ -50,12 +50,15 @@
 //! # Reproducible studies
 //!
 //! With `planner.reproducible = true` (the default) wall-clock budgets are switched off: the
-//! manager does not pass its cycle deadline to the backend (`enforce_budget = false`), and DEV-PRM,
-//! V-PRM and sparse A* get a budget of [`REPRODUCIBLE_BUDGET_MS`] so that only their sample,
-//! stall and expansion caps end a search. A run then depends only on the seeds, not on how loaded
-//! the machine is; wall-clock budgets make runs machine-dependent (a slower machine draws fewer
-//! samples). CPU times are still measured and reported. Set `reproducible = false` to study the
-//! real-time behaviour under the budgets.
+//! manager does not pass its cycle deadline to the backend (`enforce_budget = false`), DEV-PRM and
+//! V-PRM keep their `budget_ms` only as a deterministic work budget (`wall_clock_budget = false`:
+//! `budget_ms · work_per_ms` visibility-test units, measured on the development machine, see
+//! `trust_topo_prm::DevPrmParams::work_per_ms`), and sparse A* gets a budget of
+//! [`REPRODUCIBLE_BUDGET_MS`] so that only its expansion cap ends a search. A run then depends
+//! only on the seeds, not on how loaded the machine is; wall-clock budgets make runs
+//! machine-dependent (a slower machine draws fewer samples). CPU times are still measured and
+//! reported. Set `reproducible = false` to study the real-time behaviour under the budgets (the
+//! work budgets then stay, backed by the clock).
 
 use serde::{Deserialize, Serialize};
 use trust_core::RankingWeights;
@@ -75,9 +78,23 @@ use crate::error::WorldError;
 use crate::problem::Problem;
 use crate::problem::Problems;
 
-/// Search budget (ms) given to DEV-PRM, V-PRM and sparse A* in reproducible mode: one minute,
-/// far beyond what their sample and expansion caps need, so that the caps end every search.
+/// Search budget (ms) given to sparse A* in reproducible mode: one minute, far beyond what its
+/// expansion cap needs, so that the cap ends every search.
 pub const REPRODUCIBLE_BUDGET_MS: f64 = 60_000.0;
+
+/// DEV-PRM's budget in the presets (ms): [`DevPrmParams::default`] with `budget_ms` raised from
+/// Fast-Planner's 5 ms, so that a search does `PRESET_DEV_PRM_BUDGET_MS · work_per_ms` work units
+/// (about that many ms on the development machine) and leaves the rest of the manager's 50 ms
+/// cycle to the cold solves.
+pub const PRESET_DEV_PRM_BUDGET_MS: f64 = 15.0;
+
+/// DEV-PRM as the presets fly it: [`DevPrmParams::default`] with [`PRESET_DEV_PRM_BUDGET_MS`].
+pub fn preset_dev_prm() -> DevPrmParams {
+    DevPrmParams {
+        budget_ms: PRESET_DEV_PRM_BUDGET_MS,
+        ..DevPrmParams::default()
+    }
+}
 
 /// A frontend of any supported kind, implementing [`PathFrontend`] by delegation.
 #[derive(Debug, Clone)]
@@ -406,7 +423,7 @@ impl PlannerPreset {
         let checker = CheckerSpec::Tvd(TvdParams::default());
         match self {
             PlannerPreset::Trust => (
-                FrontendSpec::DevPrm(DevPrmParams::default()),
+                FrontendSpec::DevPrm(preset_dev_prm()),
                 backend,
                 checker,
                 ManagerParams::trust(),
@@ -424,7 +441,7 @@ impl PlannerPreset {
                 ManagerParams::single_branch(),
             ),
             PlannerPreset::Baseline3 => (
-                FrontendSpec::DevPrm(DevPrmParams::default()),
+                FrontendSpec::DevPrm(preset_dev_prm()),
                 backend,
                 checker,
                 ManagerParams::multi_branch_without_history(),
@@ -984,13 +1001,13 @@ pub fn effective(
             x.clearance = x.clearance.max(r + m);
             x.surface_offset = x.surface_offset.max(x.clearance);
             if out.reproducible {
-                x.budget_ms = x.budget_ms.max(REPRODUCIBLE_BUDGET_MS);
+                x.wall_clock_budget = false;
             }
         }
         FrontendSpec::VPrm(x) => {
             x.clearance = x.clearance.max(r + m);
             if out.reproducible {
-                x.budget_ms = x.budget_ms.max(REPRODUCIBLE_BUDGET_MS);
+                x.wall_clock_budget = false;
             }
         }
         FrontendSpec::SparseAStar(x) => {
