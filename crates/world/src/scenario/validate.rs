@@ -370,7 +370,11 @@ impl Scenario {
             }
             if let Some(b) = bounds {
                 let (a, g) = (Vec3::from(m.start), Vec3::from(m.goal));
-                if r.min_distance_m.is_finite() && (a - g).norm() < r.min_distance_m {
+                // A region outside the scale policy is not drawn from (reported there).
+                if r.drawable(b)
+                    && r.min_distance_m.is_finite()
+                    && (a - g).norm() < r.min_distance_m
+                {
                     let draws = super::sections::endpoint_draw_count(self.static_map.shapes.len());
                     p.push(
                         "mission.random.min_distance_m",
