@@ -1,8 +1,112 @@
 //! The crate's single error type.
 
+use std::fmt;
+
 use thiserror::Error;
+use trust_geometry::scale::MAX_COORD_M;
 
 use crate::Vec3;
+
+/// A length for messages: at most six significant digits, trailing zeros dropped (`0.3`, not
+/// `0.30000000000000004`); scientific notation outside `[1e-4, 1e6)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Readable(pub f64);
+
+impl fmt::Display for Readable {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let v = self.0;
+        let a = v.abs();
+        if !v.is_finite() || v == 0.0 {
+            return write!(f, "{v}");
+        }
+        if !(1.0e-4..1.0e6).contains(&a) {
+            return write!(f, "{v:.5e}");
+        }
+        // Digits after the point for six significant digits.
+        let decimals = (5 - a.log10().floor() as i32).max(0) as usize;
+        let s = format!("{v:.decimals$}");
+        let s = if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            &s
+        };
+        f.write_str(s)
+    }
+}
+
+/// A point for messages: `[x, y, z]` with [`Readable`] coordinates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ReadablePoint(pub(crate) Vec3);
+
+impl fmt::Display for ReadablePoint {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let p = self.0;
+        write!(
+            f,
+            "[{}, {}, {}]",
+            Readable(p.x),
+            Readable(p.y),
+            Readable(p.z)
+        )
+    }
+}
+
+/// Why a goal cannot be reached ([`crate::Unreachable`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum UnreachableCause {
+    /// The goal lies outside the map bounds.
+    GoalOutsideBounds,
+    /// The goal is closer to an obstacle than the vehicle radius (or inside one).
+    GoalInsideObstacle {
+        /// The goal's signed distance to the nearest obstacle, in metres (negative inside).
+        signed_distance_m: f64,
+    },
+    /// No opening joins the start and the goal even at the vehicle radius alone (no margin).
+    /// Proved on a grid of cell `h` (the fine grid, see the crate docs): every opening is
+    /// narrower than `2·radius + h` (for a slot between parallel faces, in any orientation).
+    SealedOff,
+    /// The start and the goal are joined at the vehicle radius but not at the inflated
+    /// clearance: every opening is narrower than `2·clearance_m + h` (`h` the cell size), so
+    /// the vehicle would have to give up its safety margin to pass.
+    TooNarrow {
+        /// The inflated clearance the route must keep, in metres.
+        clearance_m: f64,
+    },
+}
+
+impl fmt::Display for UnreachableCause {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            UnreachableCause::GoalOutsideBounds => {
+                f.write_str("the goal lies outside the map bounds")
+            }
+            UnreachableCause::GoalInsideObstacle { signed_distance_m }
+                if signed_distance_m < 0.0 =>
+            {
+                write!(
+                    f,
+                    "the goal lies {} m inside an obstacle",
+                    Readable(-signed_distance_m)
+                )
+            }
+            UnreachableCause::GoalInsideObstacle { signed_distance_m } => write!(
+                f,
+                "the goal lies {} m from an obstacle, closer than the vehicle radius",
+                Readable(signed_distance_m)
+            ),
+            UnreachableCause::SealedOff => f.write_str(
+                "the goal is sealed off from the start: no opening is as wide as the vehicle",
+            ),
+            UnreachableCause::TooNarrow { clearance_m } => write!(
+                f,
+                "every opening toward the goal is too narrow for the vehicle plus its margin \
+                 (a clearance of {} m from every wall)",
+                Readable(clearance_m)
+            ),
+        }
+    }
+}
 
 /// Which end of the route an error is about.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -37,6 +141,17 @@ pub enum RouteError {
         value: f64,
         /// The accepted range, in words.
         expected: String,
+    },
+    /// A point (start, goal, route vertex or query position) with a coordinate beyond the scale
+    /// policy of `trust_geometry` (`|x| ≤ 1e6` m, [`trust_geometry::scale::MAX_COORD_M`]).
+    #[error("{field} = {} is out of range: every coordinate must be within ±{} m", ReadablePoint(*.point), Readable(*.limit_m))]
+    PointOutOfScale {
+        /// Name of the argument (`"start"`, `"goal"`, `"points[3]"`, `"position"`).
+        field: String,
+        /// The offending point.
+        point: Vec3,
+        /// The largest accepted coordinate magnitude, in metres.
+        limit_m: f64,
     },
     /// A point (start, goal or query position) with a NaN or infinite coordinate.
     #[error("{field} must be finite, got [{}, {}, {}]", .point.x, .point.y, .point.z)]
@@ -83,9 +198,8 @@ pub enum RouteError {
     },
     /// No free grid cell within the snap radius of the start or goal.
     #[error(
-        "no free route cell within {bound_m} m of the {which} [{}, {}, {}] (inflated clearance \
-         {clearance_m} m)",
-        .point.x, .point.y, .point.z
+        "no free route cell within {} m of the {which} {} (inflated clearance {} m)",
+        Readable(*.bound_m), ReadablePoint(*.point), Readable(*.clearance_m)
     )]
     NoFreeCell {
         /// Which end.
@@ -97,16 +211,31 @@ pub enum RouteError {
         /// The inflated clearance the cells must keep, in metres.
         clearance_m: f64,
     },
-    /// The search exhausted every reachable free cell: the goal is unreachable at this clearance.
-    #[error(
-        "the goal is unreachable at clearance {clearance_m} m: the search exhausted all {expanded} \
-         reachable cells"
-    )]
+    /// The goal is unreachable at this clearance ([`crate::RouteProgress::Unreachable`] as an
+    /// error, from [`crate::RoutePlanner::plan`]).
+    #[error("{cause} (inflated clearance {} m, {expanded} cells expanded)", Readable(*.clearance_m))]
     Unreachable {
-        /// Cells expanded (every free cell reachable from the start).
+        /// Cells the start-side search expanded.
         expanded: usize,
         /// The inflated clearance, in metres.
         clearance_m: f64,
+        /// Why.
+        cause: UnreachableCause,
+    },
+    /// The grid found no route at the clearance, but its over-approximation of the free space
+    /// joins the start and the goal: a passage narrower than `2·clearance_m + cell_m` may keep
+    /// the clearance. No verdict.
+    #[error(
+        "no route at clearance {} m on a grid of {} m cells, but a passage the grid cannot resolve \
+         may keep it: no verdict",
+        Readable(*.clearance_m),
+        Readable(*.cell_m)
+    )]
+    Unresolved {
+        /// The inflated clearance, in metres.
+        clearance_m: f64,
+        /// The fine grid's cell size, in metres.
+        cell_m: f64,
     },
 }
 
@@ -123,14 +252,37 @@ pub(crate) fn check_range(field: &str, value: f64, lo: f64, hi: f64) -> Result<f
     }
 }
 
-/// `Ok(p)` if every coordinate of `p` is finite, else [`RouteError::NonFinitePoint`].
+/// `Ok(p)` if every coordinate of `p` is finite ([`RouteError::NonFinitePoint`] otherwise) and
+/// within `±MAX_COORD_M` ([`RouteError::PointOutOfScale`] otherwise).
 pub(crate) fn check_point(field: &str, p: &Vec3) -> Result<Vec3, RouteError> {
-    if p.iter().all(|c| c.is_finite()) {
-        Ok(*p)
-    } else {
+    if !p.iter().all(|c| c.is_finite()) {
         Err(RouteError::NonFinitePoint {
             field: field.to_owned(),
             point: *p,
         })
+    } else if p.amax() > MAX_COORD_M {
+        Err(RouteError::PointOutOfScale {
+            field: field.to_owned(),
+            point: *p,
+            limit_m: MAX_COORD_M,
+        })
+    } else {
+        Ok(*p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn readable_numbers_have_six_significant_digits_at_most() {
+        assert_eq!(Readable(0.30000000000000004).to_string(), "0.3");
+        assert_eq!(Readable(0.1 + 0.2).to_string(), "0.3");
+        assert_eq!(Readable(12.3456789).to_string(), "12.3457");
+        assert_eq!(Readable(250.0).to_string(), "250");
+        assert_eq!(Readable(-0.45).to_string(), "-0.45");
+        assert_eq!(Readable(1.0e-7).to_string(), "1.00000e-7");
+        assert_eq!(Readable(0.0).to_string(), "0");
     }
 }

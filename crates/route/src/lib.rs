@@ -103,15 +103,18 @@
 #![warn(missing_docs)]
 
 mod error;
+mod grid;
 mod params;
 mod planner;
 mod route;
 pub mod scenes;
+mod search;
 
 /// The public vector type: `nalgebra::Vector3<f64>` (as in `trust-geometry`).
 pub type Vec3 = nalgebra::Vector3<f64>;
 
-pub use error::{Endpoint, RouteError};
+pub use error::{Endpoint, Readable, RouteError, UnreachableCause};
 pub use params::{DEFAULT_HEURISTIC_WEIGHT, RouteParams};
 pub use planner::RoutePlanner;
 pub use route::{Blocked, GlobalRoute, Projection, RoutePoint};
+pub use search::{RouteProgress, RouteSearch, Unreachable};

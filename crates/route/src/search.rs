@@ -1,0 +1,1226 @@
+//! [`RouteSearch`]: the resumable, work-bounded search behind [`crate::RoutePlanner`].
+//!
+//! The search is a state machine over explicit cursors (the cell being expanded and the next of
+//! its 26 neighbours, the next snap candidate, the next shortcut test). Every costly query is
+//! charged to a [`Meter`] *before* it runs; when the budget is spent the query is not run and
+//! the cursor stays where it is, so the next [`RouteSearch::advance`] retries exactly that step.
+//! Cached signed distances make a retry free of charge. Hence the sequence of queries, and the
+//! result, do not depend on how the work is sliced.
+
+use std::collections::BinaryHeap;
+
+use trust_geometry::StaticMap;
+
+use crate::Vec3;
+use crate::error::{Endpoint, RouteError, UnreachableCause};
+use crate::grid::{
+    CLOSED, FLOOD_C, FLOOD_CR, FLOOD_R, Grid, Layer, Meter, Open, Paused, SEEN, neighbour_steps,
+    octile,
+};
+use crate::params::RouteParams;
+use crate::route::GlobalRoute;
+
+/// Most cells examined per side of the snap cube (the cube holds `(2k + 1)³` cells).
+const MAX_SNAP_HALF_WIDTH: i64 = 24;
+/// How much less than the end's own distance the segment to a snapped cell may keep, in metres
+/// (rounding of the distance queries).
+const SNAP_TOLERANCE_M: f64 = 1e-7;
+/// Most gradient steps taken to leave an obstacle that buries the goal.
+const MAX_ESCAPE_STEPS: usize = 16;
+
+/// What [`RouteSearch::advance`] reports.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum RouteProgress {
+    /// The budget ran out before an answer; call [`RouteSearch::advance`] again.
+    Pending,
+    /// A route from the start to the goal (see [`GlobalRoute`] for what it guarantees).
+    Found(GlobalRoute),
+    /// A verdict: the goal cannot be reached, why, and the best the vehicle can do instead.
+    Unreachable(Unreachable),
+    /// The search stopped without a verdict: a cap ([`RouteError::ExpansionCap`],
+    /// [`RouteError::TooManyCells`]), no free cell near the start
+    /// ([`RouteError::NoFreeCell`]), or no grid to search on ([`RouteError::InvalidParam`] for
+    /// a zero inflated clearance on a map without an ESDF).
+    Failed(RouteError),
+}
+
+/// The verdict that the goal cannot be reached ([`RouteProgress::Unreachable`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unreachable {
+    /// Why.
+    pub cause: UnreachableCause,
+    /// A route from the start to the reachable point nearest the goal that the start-side
+    /// search found before the verdict (its expanded cell nearest the goal, or the free point
+    /// next to a buried or outside goal when the search reached it), shortcut like any route;
+    /// [`GlobalRoute::goal_gap_m`] is its distance to the goal. `None` when the search expanded
+    /// no cell, or when no free point was found near a goal buried in an obstacle.
+    pub nearest: Option<GlobalRoute>,
+    /// Units of work the search did in all ([`RouteSearch::work_done`]).
+    pub work_done: usize,
+}
+
+/// A resumable route search started by [`crate::RoutePlanner::start_search`].
+///
+/// It owns all its state and does not borrow the map: pass the same map to every
+/// [`RouteSearch::advance`] (another map gives an unspecified, though memory-safe and
+/// panic-free, answer).
+///
+/// **Unit of work.** One unit is one of: a signed-distance evaluation of the map (a grid cell's
+/// centre, the start or goal, a gradient step out of an obstacle), one
+/// [`StaticMap::segment_clear`] query (the straight line, an edge the cell distances cannot
+/// prove clear, a snap's line of sight, a shortcut test), or one cell expansion (popping a cell
+/// of the A* or of a flood and looking at its neighbours, the neighbours' queries charged
+/// separately). Cached values are free. A unit's time depends on the map (see the crate docs
+/// for measured costs).
+///
+/// **Determinism.** The queries run in a fixed order that does not depend on the budgets: the
+/// same map, ends and radius give the same sequence of queries and the same answer whether the
+/// search runs in one [`RouteSearch::advance`] or in a thousand, and the same work total.
+#[derive(Debug, Clone)]
+pub struct RouteSearch {
+    params: RouteParams,
+    radius: f64,
+    clearance: f64,
+    start: Vec3,
+    goal: Vec3,
+    /// The goal clamped into the map bounds.
+    target: Vec3,
+    goal_in_bounds: bool,
+    work: usize,
+    done: Option<RouteProgress>,
+    sd_start: Option<f64>,
+    sd_target: Option<f64>,
+    straight_clear: Option<bool>,
+    built: bool,
+    layers: Vec<Layer>,
+    /// The layer the verdicts are proved on (the finest grid that fits `max_cells`).
+    fine: usize,
+    /// The coarse layer searched first, if any (cleared when its ends do not snap).
+    coarse: Option<usize>,
+    start_snap: Vec<SnapState>,
+    target_snap: Vec<SnapState>,
+    /// Gradient steps out of the obstacle burying the goal: the point reached and the count.
+    escape: Option<(Vec3, usize, bool)>,
+    escape_snap: Option<SnapState>,
+    astar: Option<Astar>,
+    /// Expansions of finished A* searches.
+    expanded_before: usize,
+    /// The nearest cell to the goal of a finished A* search: distance, grid, path.
+    nearest_before: Option<(f64, Grid, Vec<usize>)>,
+    flood: Option<Flood>,
+    flood_state: FloodState,
+    /// Whose turn: the goal-side flood's (true) or the A*'s.
+    flood_turn: bool,
+    finishing: Option<Finishing>,
+    coarse_route: Option<GlobalRoute>,
+    refining: bool,
+    rcheck: Option<RCheck>,
+    reached_target: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum FloodState {
+    NotStarted,
+    Running,
+    /// Met the start side: no verdict to come from it.
+    Stopped,
+    Exhausted,
+}
+
+#[derive(Debug, Clone)]
+enum SnapState {
+    NotStarted,
+    Running(SnapCursor),
+    Done(Option<usize>),
+}
+
+/// Candidate cells around an end, nearest first, and the next one to try.
+#[derive(Debug, Clone)]
+struct SnapCursor {
+    cands: Vec<usize>,
+    next: usize,
+    level: f64,
+    /// Line of sight required from the end to the cell, at this clearance (`None`: the end is
+    /// inside an obstacle, the nearest free cell is taken).
+    sight: Option<f64>,
+}
+
+impl SnapCursor {
+    fn new(grid: &Grid, p: &Vec3, bound: f64, level: f64, sight: Option<f64>) -> Self {
+        let c = grid.nearest_cell(p);
+        let k = ((bound / grid.h).ceil() as i64 + 1).clamp(1, MAX_SNAP_HALF_WIDTH);
+        let mut cands = Vec::new();
+        for dz in -k..=k {
+            for dy in -k..=k {
+                for dx in -k..=k {
+                    let q = [c[0] + dx, c[1] + dy, c[2] + dz];
+                    if let Some(i) = grid.index(q) {
+                        let d = (grid.center(q) - p).norm();
+                        if d <= bound {
+                            cands.push((d, i));
+                        }
+                    }
+                }
+            }
+        }
+        cands.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        Self {
+            cands: cands.into_iter().map(|(_, i)| i).collect(),
+            next: 0,
+            level,
+            sight,
+        }
+    }
+
+    fn run(
+        &mut self,
+        layer: &mut Layer,
+        map: &StaticMap,
+        p: &Vec3,
+        m: &mut Meter,
+    ) -> Result<Option<usize>, Paused> {
+        while let Some(&i) = self.cands.get(self.next) {
+            if layer.sd(map, i, m)? >= self.level {
+                match self.sight {
+                    None => return Ok(Some(i)),
+                    Some(s) => {
+                        m.charge()?;
+                        if map.segment_clear(p, &layer.grid.center_of(i), s) {
+                            return Ok(Some(i));
+                        }
+                    }
+                }
+            }
+            self.next += 1;
+        }
+        Ok(None)
+    }
+}
+
+/// Weighted A* from the start cell `s` to the target cell `t` on one layer.
+#[derive(Debug, Clone)]
+struct Astar {
+    layer: usize,
+    s: usize,
+    t: Option<usize>,
+    g: Vec<f64>,
+    parent: Vec<u32>,
+    open: BinaryHeap<Open>,
+    /// The cell being expanded, its cost and the next neighbour to look at.
+    cur: Option<(usize, f64, usize)>,
+    expanded: usize,
+    /// The expanded cell nearest the goal: distance and cell.
+    best: Option<(f64, usize)>,
+}
+
+enum AstarStep {
+    Expanded,
+    Reached,
+    Exhausted,
+    Cap,
+}
+
+impl Astar {
+    fn new(layer_ix: usize, layer: &mut Layer, s: usize, t: Option<usize>, weight: f64) -> Self {
+        let n = layer.grid.len();
+        let mut open = BinaryHeap::new();
+        layer.flags[s] |= SEEN;
+        let h = t.map_or(0.0, |t| {
+            weight * octile(layer.grid.coords(s), layer.grid.coords(t), layer.grid.h)
+        });
+        open.push(Open {
+            f: h,
+            g: 0.0,
+            cell: s as u32,
+        });
+        Self {
+            layer: layer_ix,
+            s,
+            t,
+            g: vec![0.0; n],
+            parent: vec![0; n],
+            open,
+            cur: None,
+            expanded: 0,
+            best: None,
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn step(
+        &mut self,
+        layer: &mut Layer,
+        map: &StaticMap,
+        m: &mut Meter,
+        level: f64,
+        weight: f64,
+        max_expansions: usize,
+        goal: &Vec3,
+    ) -> Result<AstarStep, Paused> {
+        let steps = neighbour_steps();
+        let h = layer.grid.h;
+        loop {
+            if let Some((i, gi, k)) = self.cur {
+                let Some(&(d, len)) = steps.get(k) else {
+                    self.cur = None;
+                    return Ok(AstarStep::Expanded);
+                };
+                let c = layer.grid.coords(i);
+                if let Some(j) = layer.grid.index([c[0] + d[0], c[1] + d[1], c[2] + d[2]])
+                    && layer.flags[j] & CLOSED == 0
+                    && layer.sd(map, j, m)? >= level
+                    && layer.edge_clear(map, i, j, level, m)?
+                {
+                    let gj = gi + len * h;
+                    if layer.flags[j] & SEEN == 0 || gj < self.g[j] {
+                        layer.flags[j] |= SEEN;
+                        self.g[j] = gj;
+                        self.parent[j] = i as u32 + 1;
+                        let hj = self.t.map_or(0.0, |t| {
+                            weight * octile(layer.grid.coords(j), layer.grid.coords(t), h)
+                        });
+                        self.open.push(Open {
+                            f: gj + hj,
+                            g: gj,
+                            cell: j as u32,
+                        });
+                    }
+                }
+                self.cur = Some((i, gi, k + 1));
+                continue;
+            }
+            let top = loop {
+                match self.open.peek() {
+                    None => return Ok(AstarStep::Exhausted),
+                    Some(o)
+                        if layer.flags[o.cell as usize] & CLOSED != 0
+                            || o.g > self.g[o.cell as usize] =>
+                    {
+                        self.open.pop();
+                    }
+                    Some(o) => break *o,
+                }
+            };
+            let i = top.cell as usize;
+            if Some(i) == self.t {
+                return Ok(AstarStep::Reached);
+            }
+            m.charge()?;
+            self.open.pop();
+            layer.flags[i] |= CLOSED;
+            self.expanded += 1;
+            if self.expanded > max_expansions {
+                return Ok(AstarStep::Cap);
+            }
+            let d = (layer.grid.center_of(i) - goal).norm();
+            if self.best.is_none_or(|(bd, _)| d < bd) {
+                self.best = Some((d, i));
+            }
+            self.cur = Some((i, top.g, 0));
+        }
+    }
+
+    /// The cells from the start to `end` (which the search reached).
+    fn path(&self, end: usize) -> Vec<usize> {
+        let mut path = vec![end];
+        let mut cur = end;
+        while cur != self.s {
+            cur = (self.parent[cur] - 1) as usize;
+            path.push(cur);
+        }
+        path.reverse();
+        path
+    }
+}
+
+/// A best-first flood over the cells at least `level` from the obstacles, from one cell toward
+/// another: it visits the whole component when the other cell is not in it, and heads for it
+/// (like a greedy search) when it is.
+#[derive(Debug, Clone)]
+struct Flood {
+    flag: u8,
+    level: f64,
+    /// Edges must be clear at `level` (a route); `false`: any two neighbouring cells at
+    /// `level` join (a relaxed flood, an over-approximation of the free space for a proof).
+    exact: bool,
+    target: usize,
+    open: BinaryHeap<Open>,
+    cur: Option<(usize, usize)>,
+}
+
+enum FloodStep {
+    Expanded,
+    Reached,
+    Met,
+    Exhausted,
+}
+
+impl Flood {
+    fn new(
+        layer: &mut Layer,
+        from: usize,
+        target: usize,
+        flag: u8,
+        level: f64,
+        exact: bool,
+    ) -> Self {
+        layer.flags[from] |= flag;
+        let mut open = BinaryHeap::new();
+        open.push(Open {
+            f: octile(layer.grid.coords(from), layer.grid.coords(target), 1.0),
+            g: 0.0,
+            cell: from as u32,
+        });
+        Self {
+            flag,
+            level,
+            exact,
+            target,
+            open,
+            cur: None,
+        }
+    }
+
+    /// One expansion. `met(i)`: cell `i` is known to be reachable from the other side.
+    fn step(
+        &mut self,
+        layer: &mut Layer,
+        map: &StaticMap,
+        m: &mut Meter,
+        met: impl Fn(&Layer, usize) -> bool,
+    ) -> Result<FloodStep, Paused> {
+        let steps = neighbour_steps();
+        loop {
+            if let Some((i, k)) = self.cur {
+                let Some(&(d, _)) = steps.get(k) else {
+                    self.cur = None;
+                    return Ok(FloodStep::Expanded);
+                };
+                let c = layer.grid.coords(i);
+                if let Some(j) = layer.grid.index([c[0] + d[0], c[1] + d[1], c[2] + d[2]])
+                    && layer.flags[j] & self.flag == 0
+                    && layer.sd(map, j, m)? >= self.level
+                    && (!self.exact || layer.edge_clear(map, i, j, self.level, m)?)
+                {
+                    layer.flags[j] |= self.flag;
+                    self.open.push(Open {
+                        f: octile(layer.grid.coords(j), layer.grid.coords(self.target), 1.0),
+                        g: 0.0,
+                        cell: j as u32,
+                    });
+                }
+                self.cur = Some((i, k + 1));
+                continue;
+            }
+            let Some(&top) = self.open.peek() else {
+                return Ok(FloodStep::Exhausted);
+            };
+            let i = top.cell as usize;
+            if i == self.target {
+                return Ok(FloodStep::Reached);
+            }
+            if met(layer, i) {
+                return Ok(FloodStep::Met);
+            }
+            m.charge()?;
+            self.open.pop();
+            self.cur = Some((i, 0));
+        }
+    }
+}
+
+/// What to do with a route once its shortcut is done.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum After {
+    /// The coarse search's route: refine it or answer with it.
+    Coarse,
+    /// The fine search's route: the answer.
+    Fine,
+    /// The refining fine search's route: the shorter of it and the coarse one.
+    Refined,
+    /// The route to the nearest point, for a verdict.
+    Nearest(UnreachableCause),
+}
+
+/// The greedy line-of-sight shortcut, resumable: from each kept point, jump to the farthest
+/// following point reachable by a straight segment clear at the clearance (stopping at the first
+/// that is not), or to the next point if none is.
+#[derive(Debug, Clone)]
+struct Finishing {
+    after: After,
+    points: Vec<Vec3>,
+    out: Vec<Vec3>,
+    anchor: usize,
+    j: usize,
+    cell_m: f64,
+    expanded: usize,
+    goal_included: bool,
+}
+
+impl Finishing {
+    fn run(&mut self, map: &StaticMap, clearance: f64, m: &mut Meter) -> Result<(), Paused> {
+        let last = self.points.len().saturating_sub(1);
+        while self.anchor < last {
+            if self.j < last {
+                m.charge()?;
+                if map.segment_clear(
+                    &self.points[self.anchor],
+                    &self.points[self.j + 1],
+                    clearance,
+                ) {
+                    self.j += 1;
+                    continue;
+                }
+            }
+            self.out.push(self.points[self.j]);
+            self.anchor = self.j;
+            self.j = self.anchor + 1;
+        }
+        Ok(())
+    }
+}
+
+/// The verdict's checks once a side is exhausted on the grid: is that side joined to the other
+/// in the over-approximation of the free space at the inflated clearance (then the grid only
+/// could not resolve a passage: no verdict), and if not, at the radius alone (`TooNarrow` if so,
+/// `SealedOff` if not)?
+#[derive(Debug, Clone)]
+struct RCheck {
+    /// The exhausted side.
+    side: Endpoint,
+    snap: Option<SnapCursor>,
+    from: Option<Option<usize>>,
+    /// The relaxed flood at the clearance, then (once it is exhausted) at the radius.
+    flood: Option<Flood>,
+    /// The relaxed flood at the clearance was exhausted: the goal is proved unreachable at it.
+    proved: bool,
+}
+
+/// Drops consecutive duplicates and interior points collinear with their neighbours.
+pub(crate) fn simplify(points: Vec<Vec3>) -> Vec<Vec3> {
+    let mut out: Vec<Vec3> = Vec::with_capacity(points.len());
+    for p in points {
+        if out
+            .last()
+            .is_some_and(|q| (p - q).norm() <= 1e-12 * (1.0 + p.amax()))
+        {
+            continue;
+        }
+        if out.len() >= 2 {
+            let a = out[out.len() - 2];
+            let b = out[out.len() - 1];
+            let (u, v) = (b - a, p - b);
+            if u.cross(&v).norm() <= 1e-9 * u.norm() * v.norm() && u.dot(&v) > 0.0 {
+                out.pop();
+            }
+        }
+        out.push(p);
+    }
+    out
+}
+
+impl RouteSearch {
+    /// A search from `start` to `goal` (both checked finite and in scale; `start` in bounds);
+    /// nothing is evaluated until [`RouteSearch::advance`].
+    pub(crate) fn new(
+        params: RouteParams,
+        map: &StaticMap,
+        start: Vec3,
+        goal: Vec3,
+        radius: f64,
+    ) -> Self {
+        let clearance = params.clearance_for(radius);
+        Self {
+            target: map.bounds().clamp(&goal),
+            goal_in_bounds: map.contains(&goal),
+            params,
+            radius,
+            clearance,
+            start,
+            goal,
+            work: 0,
+            done: None,
+            sd_start: None,
+            sd_target: None,
+            straight_clear: None,
+            built: false,
+            layers: Vec::new(),
+            fine: 0,
+            coarse: None,
+            start_snap: Vec::new(),
+            target_snap: Vec::new(),
+            escape: None,
+            escape_snap: None,
+            astar: None,
+            expanded_before: 0,
+            nearest_before: None,
+            flood: None,
+            flood_state: FloodState::NotStarted,
+            flood_turn: false,
+            finishing: None,
+            coarse_route: None,
+            refining: false,
+            rcheck: None,
+            reached_target: false,
+        }
+    }
+
+    /// Does at most `budget` units of work (see [`RouteSearch`] for the unit), then returns
+    /// [`RouteProgress::Pending`] or the answer. Once answered, every later call returns the
+    /// same answer at no cost.
+    pub fn advance(&mut self, map: &StaticMap, budget: usize) -> RouteProgress {
+        if let Some(done) = &self.done {
+            return done.clone();
+        }
+        let mut m = Meter {
+            work: self.work,
+            limit: self.work.saturating_add(budget),
+        };
+        let r = self.drive(map, &mut m);
+        self.work = m.work;
+        match r {
+            Ok(mut answer) => {
+                if let RouteProgress::Unreachable(u) = &mut answer {
+                    u.work_done = self.work;
+                }
+                self.done = Some(answer.clone());
+                answer
+            }
+            Err(Paused) => RouteProgress::Pending,
+        }
+    }
+
+    /// Units of work done so far.
+    pub fn work_done(&self) -> usize {
+        self.work
+    }
+
+    /// Cells expanded so far by the start-side searches.
+    pub fn expanded_count(&self) -> usize {
+        self.expanded_before + self.astar.as_ref().map_or(0, |a| a.expanded)
+    }
+
+    /// True once the search holds its answer.
+    pub fn is_done(&self) -> bool {
+        self.done.is_some()
+    }
+
+    /// The inflated clearance the route keeps, in metres.
+    pub fn clearance_m(&self) -> f64 {
+        self.clearance
+    }
+
+    /// True if the search's route ended at the free point next to a goal buried in an obstacle
+    /// (the [`Unreachable::nearest`] of a [`UnreachableCause::GoalInsideObstacle`] then reaches
+    /// as near the goal as the map allows).
+    pub(crate) fn reached_target(&self) -> bool {
+        self.reached_target
+    }
+
+    /// The snap bound for an end at signed distance `sd` on a grid of cells `h`.
+    fn snap_bound(&self, sd: f64, level: f64, h: f64) -> f64 {
+        let snap = self.params.snap_radius_factor * self.clearance;
+        if sd >= level { snap.max(4.0 * h) } else { snap }
+    }
+
+    fn snap_cursor(&self, grid: &Grid, p: &Vec3, sd: f64, level: f64) -> SnapCursor {
+        let sight = if sd >= level {
+            Some(level)
+        } else if sd > 0.0 {
+            Some((sd.min(level) - SNAP_TOLERANCE_M).max(0.0))
+        } else {
+            None
+        };
+        SnapCursor::new(grid, p, self.snap_bound(sd, level, grid.h), level, sight)
+    }
+
+    /// Runs the snap of `which` end on layer `ix` at the inflated clearance.
+    fn snap(
+        &mut self,
+        map: &StaticMap,
+        m: &mut Meter,
+        ix: usize,
+        which: Endpoint,
+    ) -> Result<Option<usize>, Paused> {
+        let (p, sd) = match which {
+            Endpoint::Start => (self.start, self.sd_start.unwrap_or(f64::NEG_INFINITY)),
+            Endpoint::Goal => (self.target, self.sd_target.unwrap_or(f64::NEG_INFINITY)),
+        };
+        let state = match which {
+            Endpoint::Start => &self.start_snap[ix],
+            Endpoint::Goal => &self.target_snap[ix],
+        };
+        let mut cursor = match state {
+            SnapState::Done(r) => return Ok(*r),
+            SnapState::Running(c) => c.clone(),
+            SnapState::NotStarted => {
+                self.snap_cursor(&self.layers[ix].grid, &p, sd, self.clearance)
+            }
+        };
+        let r = cursor.run(&mut self.layers[ix], map, &p, m);
+        let slot = match which {
+            Endpoint::Start => &mut self.start_snap[ix],
+            Endpoint::Goal => &mut self.target_snap[ix],
+        };
+        *slot = match r {
+            Ok(cell) => SnapState::Done(cell),
+            Err(Paused) => SnapState::Running(cursor),
+        };
+        r
+    }
+
+    /// The goal-side cause known from the ends alone.
+    fn goal_cause(&self, sd_target: f64) -> Option<UnreachableCause> {
+        if !self.goal_in_bounds {
+            Some(UnreachableCause::GoalOutsideBounds)
+        } else if sd_target < self.radius {
+            Some(UnreachableCause::GoalInsideObstacle {
+                signed_distance_m: sd_target,
+            })
+        } else {
+            None
+        }
+    }
+
+    /// Builds the grids; `Err` with the answer when there is none to search on.
+    fn build(&mut self, map: &StaticMap) -> Result<(), RouteError> {
+        let p = &self.params;
+        let c = self.clearance;
+        let esdf_half = map.esdf().map_or(0.0, |e| 0.5 * e.resolution());
+        let h0 = (c / p.cells_per_clearance).max(esdf_half);
+        if h0 <= 0.0 {
+            // A zero radius and margin on a map without an ESDF: no length to derive a grid from.
+            return Err(RouteError::InvalidParam {
+                field: "radius_m".to_owned(),
+                value: self.radius,
+                expected: "a positive inflated clearance (radius or margin > 0) for a grid search"
+                    .to_owned(),
+            });
+        }
+        let fine = Grid::new(map.bounds(), h0, p.max_cells, h0 * p.max_coarsening);
+        let coarse = (p.coarse_factor > 1.0).then(|| {
+            let h = h0 * p.coarse_factor;
+            Grid::new(map.bounds(), h, p.max_cells, h * p.max_coarsening)
+        });
+        match (fine, coarse) {
+            (Ok(f), Some(Ok(cg))) => {
+                // Refinement after a coarse route only on an unrefined fine grid small enough.
+                self.layers = vec![Layer::new(f, map), Layer::new(cg, map)];
+                self.coarse = Some(1);
+            }
+            (Ok(f), _) => self.layers = vec![Layer::new(f, map)],
+            (Err(_), Some(Ok(cg))) => self.layers = vec![Layer::new(cg, map)],
+            (Err(e), _) => return Err(e),
+        }
+        self.fine = 0;
+        self.start_snap = vec![SnapState::NotStarted; self.layers.len()];
+        self.target_snap = vec![SnapState::NotStarted; self.layers.len()];
+        self.built = true;
+        Ok(())
+    }
+
+    fn h0(&self, map: &StaticMap) -> f64 {
+        let esdf_half = map.esdf().map_or(0.0, |e| 0.5 * e.resolution());
+        (self.clearance / self.params.cells_per_clearance).max(esdf_half)
+    }
+
+    /// True if a coarse route is to be refined on the fine grid.
+    fn refine_allowed(&self, map: &StaticMap) -> bool {
+        let p = &self.params;
+        let g = &self.layers[self.fine].grid;
+        self.coarse.is_some()
+            && g.h == self.h0(map)
+            && g.len() <= p.refine_max_cells.min(p.max_cells)
+    }
+
+    /// The whole search as a function of its memoised state: returns the answer, or `Paused`.
+    fn drive(&mut self, map: &StaticMap, m: &mut Meter) -> Result<RouteProgress, Paused> {
+        let c = self.clearance;
+        let sd_start = match self.sd_start {
+            Some(v) => v,
+            None => {
+                m.charge()?;
+                *self.sd_start.insert(map.signed_distance(&self.start))
+            }
+        };
+        let sd_target = match self.sd_target {
+            Some(v) => v,
+            None => {
+                m.charge()?;
+                *self.sd_target.insert(map.signed_distance(&self.target))
+            }
+        };
+        let cause = self.goal_cause(sd_target);
+        if cause.is_none() && sd_start >= c && sd_target >= c {
+            let clear = match self.straight_clear {
+                Some(v) => v,
+                None => {
+                    m.charge()?;
+                    *self
+                        .straight_clear
+                        .insert(map.segment_clear(&self.start, &self.goal, c))
+                }
+            };
+            if clear {
+                let points = simplify(vec![self.start, self.goal]);
+                return Ok(RouteProgress::Found(GlobalRoute::new(
+                    points, c, None, 0, false, 0.0,
+                )));
+            }
+        }
+        if !self.built
+            && let Err(e) = self.build(map)
+        {
+            return Ok(RouteProgress::Failed(e));
+        }
+        let fine = self.fine;
+        let Some(start_cell) = self.snap(map, m, fine, Endpoint::Start)? else {
+            let h = self.layers[fine].grid.h;
+            return Ok(RouteProgress::Failed(RouteError::NoFreeCell {
+                which: Endpoint::Start,
+                point: self.start,
+                bound_m: self.snap_bound(sd_start, c, h),
+                clearance_m: c,
+            }));
+        };
+        let mut target_cell = self.snap(map, m, fine, Endpoint::Goal)?;
+        if target_cell.is_none() && cause.is_some() {
+            target_cell = self.escape(map, m)?;
+            if target_cell.is_none() {
+                return Ok(RouteProgress::Unreachable(Unreachable {
+                    cause: cause.unwrap_or(UnreachableCause::SealedOff),
+                    nearest: None,
+                    work_done: 0,
+                }));
+            }
+        }
+        if let Some(ix) = self.coarse {
+            let s = self.snap(map, m, ix, Endpoint::Start)?;
+            let t = if target_cell.is_some() {
+                self.snap(map, m, ix, Endpoint::Goal)?
+            } else {
+                None
+            };
+            if s.is_none() || t.is_none() {
+                self.coarse = None;
+            }
+        }
+        if self.flood_state == FloodState::NotStarted {
+            self.flood_state = match target_cell {
+                Some(t) => {
+                    let layer = &mut self.layers[fine];
+                    self.flood = Some(Flood::new(layer, t, start_cell, FLOOD_C, c, true));
+                    FloodState::Running
+                }
+                None => FloodState::Exhausted,
+            };
+        }
+        loop {
+            if let Some(f) = &mut self.finishing {
+                f.run(map, c, m)?;
+                let f = self.finishing.take().expect("finishing");
+                if let Some(answer) = self.finished(map, f, cause) {
+                    return Ok(answer);
+                }
+                continue;
+            }
+            if self.rcheck.is_some() {
+                let Some(verdict) = self.rcheck(map, m, start_cell, target_cell)? else {
+                    let layer = &self.layers[fine];
+                    return Ok(RouteProgress::Failed(RouteError::Unresolved {
+                        clearance_m: c,
+                        cell_m: layer.grid.h,
+                    }));
+                };
+                if let Some(answer) = self.verdict(cause.unwrap_or(verdict)) {
+                    return Ok(answer);
+                }
+                continue;
+            }
+            if self.flood_state == FloodState::Exhausted {
+                if let Some(cause) = cause {
+                    if let Some(answer) = self.verdict(cause) {
+                        return Ok(answer);
+                    }
+                    continue;
+                }
+                self.rcheck = Some(RCheck {
+                    side: Endpoint::Goal,
+                    snap: None,
+                    from: None,
+                    flood: None,
+                    proved: false,
+                });
+                continue;
+            }
+            if self.astar.is_none() {
+                let (ix, s, t) = match self.coarse {
+                    Some(ix) if !self.refining => (
+                        ix,
+                        self.snap(map, m, ix, Endpoint::Start)?.unwrap_or(0),
+                        self.snap(map, m, ix, Endpoint::Goal)?,
+                    ),
+                    _ => (fine, start_cell, target_cell),
+                };
+                let w = self.params.heuristic_weight;
+                self.astar = Some(Astar::new(ix, &mut self.layers[ix], s, t, w));
+            }
+            if self.flood_state == FloodState::Running && self.flood_turn {
+                let coarse = self.coarse.filter(|_| !self.refining);
+                let (fine_layer, rest) = self.layers.split_at_mut(fine + 1);
+                let fine_layer = &mut fine_layer[fine];
+                let coarse_layer = coarse.map(|ix| &rest[ix - fine - 1]);
+                let flood = self.flood.as_mut().expect("flood");
+                let step = flood.step(fine_layer, map, m, |layer, i| {
+                    if layer.flags[i] & CLOSED != 0 {
+                        return true;
+                    }
+                    coarse_layer.is_some_and(|cl| {
+                        let q = cl.grid.nearest_cell(&layer.grid.center_of(i));
+                        cl.grid.index(q).is_some_and(|j| cl.flags[j] & CLOSED != 0)
+                    })
+                })?;
+                match step {
+                    FloodStep::Expanded => {}
+                    FloodStep::Reached | FloodStep::Met => self.flood_state = FloodState::Stopped,
+                    FloodStep::Exhausted => self.flood_state = FloodState::Exhausted,
+                }
+                self.flood_turn = false;
+                continue;
+            }
+            let astar = self.astar.as_mut().expect("astar");
+            let ix = astar.layer;
+            let step = astar.step(
+                &mut self.layers[ix],
+                map,
+                m,
+                c,
+                self.params.heuristic_weight,
+                self.params.max_expansions,
+                &self.goal,
+            )?;
+            match step {
+                AstarStep::Expanded => self.flood_turn = true,
+                AstarStep::Reached => {
+                    let astar = self.astar.take().expect("astar");
+                    let t = astar.t.expect("reached target");
+                    let after = if Some(ix) == self.coarse && !self.refining {
+                        After::Coarse
+                    } else if self.refining {
+                        After::Refined
+                    } else {
+                        After::Fine
+                    };
+                    self.flood_state = match self.flood_state {
+                        FloodState::Running => FloodState::Stopped,
+                        s => s,
+                    };
+                    self.reached_target = cause.is_some();
+                    let grid = self.layers[ix].grid;
+                    let expanded = astar.expanded;
+                    self.finishing = Some(self.finishing_for(
+                        after,
+                        &grid,
+                        &astar.path(t),
+                        expanded,
+                        cause.is_none() && sd_target >= c,
+                    ));
+                }
+                AstarStep::Exhausted if Some(ix) == self.coarse && !self.refining => {
+                    // The coarse grid closes passages: its exhaustion is no verdict.
+                    let astar = self.astar.take().expect("astar");
+                    self.keep_nearest(&astar);
+                    self.coarse = None;
+                }
+                AstarStep::Exhausted | AstarStep::Cap if self.refining => {
+                    let astar = self.astar.take().expect("astar");
+                    self.expanded_before += astar.expanded;
+                    let coarse = self.coarse_route.take().expect("coarse route");
+                    return Ok(self.wrap(coarse, cause));
+                }
+                AstarStep::Exhausted => {
+                    if let Some(cause) = cause {
+                        if let Some(answer) = self.verdict(cause) {
+                            return Ok(answer);
+                        }
+                        continue;
+                    }
+                    self.rcheck = Some(RCheck {
+                        side: Endpoint::Start,
+                        snap: None,
+                        from: None,
+                        flood: None,
+                        proved: false,
+                    });
+                }
+                AstarStep::Cap => {
+                    return Ok(RouteProgress::Failed(RouteError::ExpansionCap {
+                        cap: self.params.max_expansions,
+                    }));
+                }
+            }
+        }
+    }
+
+    /// Leaves an obstacle that buries the goal along the distance gradient, then takes the
+    /// nearest free cell of the fine grid.
+    fn escape(&mut self, map: &StaticMap, m: &mut Meter) -> Result<Option<usize>, Paused> {
+        let c = self.clearance;
+        let fine = self.fine;
+        let h = self.layers[fine].grid.h;
+        loop {
+            let (p, n, out) = self.escape.unwrap_or((self.target, 0, false));
+            if out || n >= MAX_ESCAPE_STEPS {
+                break;
+            }
+            m.charge()?;
+            let (d, g) = map.distance_and_gradient(&p);
+            let next = if d >= c || g.norm() == 0.0 || !d.is_finite() {
+                (p, n + 1, true)
+            } else {
+                let q = map.bounds().clamp(&(p + g.normalize() * (c + h - d)));
+                (q, n + 1, false)
+            };
+            self.escape = Some(next);
+        }
+        let (p, _, _) = self.escape.unwrap_or((self.target, 0, true));
+        let mut cursor = match self.escape_snap.take() {
+            Some(SnapState::Done(r)) => {
+                self.escape_snap = Some(SnapState::Done(r));
+                return Ok(r);
+            }
+            Some(SnapState::Running(c)) => c,
+            _ => SnapCursor::new(&self.layers[fine].grid, &p, 4.0 * h, c, None),
+        };
+        let r = cursor.run(&mut self.layers[fine], map, &p, m);
+        self.escape_snap = Some(match r {
+            Ok(cell) => SnapState::Done(cell),
+            Err(Paused) => SnapState::Running(cursor),
+        });
+        r
+    }
+
+    /// Keeps the nearest cell to the goal of a finished A* if it beats the one kept.
+    fn keep_nearest(&mut self, astar: &Astar) {
+        self.expanded_before += astar.expanded;
+        if let Some((d, cell)) = astar.best
+            && self
+                .nearest_before
+                .as_ref()
+                .is_none_or(|(bd, _, _)| d < *bd)
+        {
+            let grid = self.layers[astar.layer].grid;
+            self.nearest_before = Some((d, grid, astar.path(cell)));
+        }
+    }
+
+    fn finishing_for(
+        &self,
+        after: After,
+        grid: &Grid,
+        cells: &[usize],
+        expanded: usize,
+        goal_included: bool,
+    ) -> Finishing {
+        let mut points = Vec::with_capacity(cells.len() + 2);
+        points.push(self.start);
+        points.extend(cells.iter().map(|&i| grid.center_of(i)));
+        if goal_included {
+            points.push(self.goal);
+        }
+        let points = simplify(points);
+        let (out, anchor, j) = if self.params.shortcut {
+            (vec![points[0]], 0, 1)
+        } else {
+            (points.clone(), points.len(), points.len())
+        };
+        Finishing {
+            after,
+            points,
+            out,
+            anchor,
+            j,
+            cell_m: grid.h,
+            expanded,
+            goal_included,
+        }
+    }
+
+    /// The route of a finished shortcut, and the answer if it is one.
+    fn finished(
+        &mut self,
+        map: &StaticMap,
+        f: Finishing,
+        cause: Option<UnreachableCause>,
+    ) -> Option<RouteProgress> {
+        let points = simplify(f.out);
+        let end = points.last().copied().unwrap_or(self.start);
+        let gap = if f.goal_included {
+            0.0
+        } else {
+            (end - self.goal).norm()
+        };
+        let inside = self.sd_start.is_none_or(|d| d < self.clearance);
+        let route = GlobalRoute::new(
+            points,
+            self.clearance,
+            Some(f.cell_m),
+            f.expanded,
+            inside,
+            gap,
+        );
+        match f.after {
+            After::Coarse if self.refine_allowed(map) => {
+                self.coarse_route = Some(route);
+                self.refining = true;
+                None
+            }
+            After::Coarse | After::Fine => {
+                let mut route = route;
+                route.add_expanded(self.expanded_before);
+                Some(self.wrap(route, cause))
+            }
+            After::Refined => {
+                let coarse = self.coarse_route.take().expect("coarse route");
+                let (mut keep, other) = if route.length() < coarse.length() {
+                    (route, coarse)
+                } else {
+                    (coarse, route)
+                };
+                keep.add_expanded(other.expanded_count() + self.expanded_before);
+                Some(self.wrap(keep, cause))
+            }
+            After::Nearest(cause) => Some(RouteProgress::Unreachable(Unreachable {
+                cause,
+                nearest: Some(route),
+                work_done: 0,
+            })),
+        }
+    }
+
+    fn wrap(&self, route: GlobalRoute, cause: Option<UnreachableCause>) -> RouteProgress {
+        match cause {
+            None => RouteProgress::Found(route),
+            Some(cause) => RouteProgress::Unreachable(Unreachable {
+                cause,
+                nearest: Some(route),
+                work_done: 0,
+            }),
+        }
+    }
+
+    /// Starts the route to the nearest cell for a verdict (`None`: the caller's loop runs its
+    /// shortcut), or the answer at once when the search expanded nothing.
+    fn verdict(&mut self, cause: UnreachableCause) -> Option<RouteProgress> {
+        if let Some(astar) = self.astar.take() {
+            self.keep_nearest(&astar);
+        }
+        match self.nearest_before.take() {
+            Some((_, grid, cells)) => {
+                self.finishing = Some(self.finishing_for(
+                    After::Nearest(cause),
+                    &grid,
+                    &cells,
+                    self.expanded_before,
+                    false,
+                ));
+                None
+            }
+            None => Some(RouteProgress::Unreachable(Unreachable {
+                cause,
+                nearest: None,
+                work_done: 0,
+            })),
+        }
+    }
+
+    /// The checks of a verdict once a side is exhausted on the grid ([`RCheck`]): `None` when
+    /// the over-approximation at the clearance joins the two sides (no verdict), else
+    /// `TooNarrow` or `SealedOff`. The relaxed floods take every cell whose centre is at least
+    /// `level − L·h·√3/2` from the obstacles (`L` the map's slope bound) and join neighbours
+    /// without an edge check: every point at least `level` from the obstacles lies in such a
+    /// cell's cube, and a path through free space crosses from cube to neighbouring cube, so an
+    /// exhausted relaxed flood proves that no path keeps `level` at any resolution.
+    fn rcheck(
+        &mut self,
+        map: &StaticMap,
+        m: &mut Meter,
+        start_cell: usize,
+        target_cell: Option<usize>,
+    ) -> Result<Option<UnreachableCause>, Paused> {
+        let c = self.clearance;
+        let r = self.radius;
+        let fine = self.fine;
+        let grid = self.layers[fine].grid;
+        let slack = self.layers[fine].lipschitz * grid.h * 3.0_f64.sqrt() / 2.0;
+        let narrow = UnreachableCause::TooNarrow { clearance_m: c };
+        let mut rc = self.rcheck.take().expect("rcheck");
+        let res = (|| {
+            let (from, to) = match rc.side {
+                Endpoint::Start => (Some(start_cell), target_cell),
+                Endpoint::Goal => {
+                    let from = match (target_cell, rc.from) {
+                        (Some(t), _) => Some(t),
+                        (None, Some(f)) => f,
+                        (None, None) => {
+                            let sd = self.sd_target.unwrap_or(f64::NEG_INFINITY);
+                            let mut cur = match rc.snap.take() {
+                                Some(cur) => cur,
+                                None => self.snap_cursor(&grid, &self.target, sd, r),
+                            };
+                            let res = cur.run(&mut self.layers[fine], map, &self.target, m);
+                            match res {
+                                Ok(f) => {
+                                    rc.from = Some(f);
+                                    f
+                                }
+                                Err(Paused) => {
+                                    rc.snap = Some(cur);
+                                    return Err(Paused);
+                                }
+                            }
+                        }
+                    };
+                    (from, Some(start_cell))
+                }
+            };
+            let (Some(from), Some(to)) = (from, to) else {
+                return Ok(Some(UnreachableCause::SealedOff));
+            };
+            let layer = &mut self.layers[fine];
+            if !rc.proved {
+                let flood = rc
+                    .flood
+                    .get_or_insert_with(|| Flood::new(layer, from, to, FLOOD_CR, c - slack, false));
+                loop {
+                    match flood.step(layer, map, m, |_, _| false)? {
+                        FloodStep::Expanded => {}
+                        // A passage the grid cannot resolve may keep the clearance.
+                        FloodStep::Reached | FloodStep::Met => return Ok(None),
+                        FloodStep::Exhausted => break,
+                    }
+                }
+                rc.proved = true;
+                rc.flood = None;
+            }
+            if r >= c {
+                return Ok(Some(UnreachableCause::SealedOff));
+            }
+            let flood = rc
+                .flood
+                .get_or_insert_with(|| Flood::new(layer, from, to, FLOOD_R, r - slack, false));
+            loop {
+                match flood.step(layer, map, m, |_, _| false)? {
+                    FloodStep::Expanded => {}
+                    FloodStep::Reached | FloodStep::Met => return Ok(Some(narrow)),
+                    FloodStep::Exhausted => return Ok(Some(UnreachableCause::SealedOff)),
+                }
+            }
+        })();
+        if res.is_err() {
+            self.rcheck = Some(rc);
+        }
+        res
+    }
+}
