@@ -4,16 +4,73 @@
 //!
 //! It deliberately shares no geometry code with the simulator: the distance functions below are
 //! written out again from their closed forms, so a bug in `trust-geometry` cannot hide itself.
-//! `trust-sim audit LOG` runs it from the command line.
+//! `trust-sim audit LOG` runs it from the command line ([`audit_file`], streaming: an hour's log
+//! is audited in the memory of one line plus the static points).
+//!
+//! # What it checks, in order
+//!
+//! 1. **Values within the audit's policy** before any arithmetic, so no norm can overflow and no
+//!    tolerance can become infinite: every coordinate (positions, obstacle centres, bounds,
+//!    shapes, points) at most [`MAX_COORDINATE_M`] in magnitude, every velocity component at
+//!    most [`MAX_SPEED_M_S`], every acceleration component at most [`MAX_ACCEL_M_S2`], times
+//!    within [`MAX_TIME_S`], sizes finite and non-negative. (Times strictly increasing with steps
+//!    ≤ 0.02 s are the reader's check, [`crate::LogReader`].) A state outside the policy is a
+//!    finding and is left out of the figures (its norms are never taken).
+//! 2. **Consistency of consecutive states** (a teleport, a forged velocity): the position step
+//!    must match the trapezoid of the logged velocities, `|Δp − ½(v₀ + v₁)·dt| ≤`
+//!    [`POSITION_STEP_TOLERANCE_M`], and the velocity step the trapezoid of the logged
+//!    accelerations, `|Δv − ½(a₀ + a₁)·dt| ≤` [`VELOCITY_STEP_TOLERANCE_M_S`]. The simulator's
+//!    logs stay within 2·10⁻⁵ m and 1.2·10⁻³ m/s (quickstart, E4, pedestrians, either vehicle
+//!    model), so the tolerances leave a wide margin; a state moved by more than 1 cm, or given a
+//!    velocity off by more than 5 cm/s, is flagged (at the step into it and the step out of it).
+//! 3. **The outcome against the recomputed figures**, with absolute tolerances: clearances within
+//!    [`CLEARANCE_TOLERANCE_M`], maxima within [`MAXIMA_TOLERANCE`] of the (policy-bounded, so
+//!    finite) recomputed value, path length within 10⁻³ of it (at least 1 mm), times within 1 µs.
+//!    Without geometry of a kind the recomputed clearance is `+∞` and the log must hold at least
+//!    [`NO_GEOMETRY_CLEARANCE_M`].
+//! 4. Optionally ([`AuditOptions::cycles`], `trust-sim audit --cycles`), **the cycle records
+//!    against the contract**: every cycle has `t`, `wall_ms`, `main` (a number or `null`),
+//!    `branches` and `events` (a missing field other than `main` is already the reader's parse
+//!    error); `wall_ms` is finite and ≥ 0; `t` lies within the flight (first to last state).
+//!
+//! Findings are listed at most [`MAX_LISTED_FINDINGS`] per field, then counted ("… and 17 more");
+//! numbers in them are [`readable`].
+//!
+//! Static point clouds are indexed by a k-d tree ([`PointTree`]), so a state costs `O(log m)`
+//! for `m` points whatever the distance to the nearest one.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
-use crate::{Header, ObstacleKind, RunLog, StateRecord, StaticShape, Status};
+use serde::Deserialize;
+
+use crate::files::{read_points, readable, resolve_points_file};
+use crate::{
+    CycleRecord, Header, LogError, LogReader, ObstacleKind, Outcome, PointTree, Record, RunLog,
+    StateRecord, StaticShape, Status,
+};
 
 /// Clearance tolerance of the contract (m).
 pub const CLEARANCE_TOLERANCE_M: f64 = 0.02;
 /// Relative tolerance of the contract on maxima.
 pub const MAXIMA_TOLERANCE: f64 = 0.01;
+/// Largest magnitude of a coordinate the audit accepts (m): 1000 km.
+pub const MAX_COORDINATE_M: f64 = 1e6;
+/// Largest magnitude of a velocity component the audit accepts (m/s).
+pub const MAX_SPEED_M_S: f64 = 1e4;
+/// Largest magnitude of an acceleration component the audit accepts (m/s²).
+pub const MAX_ACCEL_M_S2: f64 = 1e5;
+/// Largest magnitude of a time the audit accepts (s): about 115 days.
+pub const MAX_TIME_S: f64 = 1e7;
+/// Largest gap between a position step and the trapezoid of the logged velocities (m).
+pub const POSITION_STEP_TOLERANCE_M: f64 = 0.01;
+/// Largest gap between a velocity step and the trapezoid of the logged accelerations (m/s).
+pub const VELOCITY_STEP_TOLERANCE_M_S: f64 = 0.05;
+/// Without geometry of a kind, the logged clearance must be at least this (m; the simulator
+/// writes `1e9`).
+pub const NO_GEOMETRY_CLEARANCE_M: f64 = 1e6;
+/// Findings listed per field; the rest are counted.
+pub const MAX_LISTED_FINDINGS: usize = 20;
 
 /// What the states say.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,15 +96,30 @@ pub struct Recomputed {
     pub flight_time_s: f64,
 }
 
-/// A disagreement between the outcome record and the states.
+/// A disagreement between the log and what the audit recomputes or requires.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Finding {
-    /// The outcome field.
+    /// The outcome field (`max_speed`), or the check (`state.v`, `state.teleport`, `header`,
+    /// `cycle.wall_ms`).
     pub field: &'static str,
-    /// What the outcome says.
+    /// What the log says.
     pub logged: String,
-    /// What the states say.
+    /// What the states say, or what the policy requires.
     pub recomputed: String,
+}
+
+impl std::fmt::Display for Finding {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.field.contains('.') || self.field == "header" {
+            write!(f, "{}: {} — {}", self.field, self.logged, self.recomputed)
+        } else {
+            write!(
+                f,
+                "{}: logged {}, states say {}",
+                self.field, self.logged, self.recomputed
+            )
+        }
+    }
 }
 
 /// The audit of one log.
@@ -57,6 +129,12 @@ pub struct Audit {
     pub recomputed: Recomputed,
     /// Disagreements (empty: the log is consistent).
     pub findings: Vec<Finding>,
+    /// The outcome's status as logged.
+    pub logged_status: Status,
+    /// State records audited.
+    pub state_count: usize,
+    /// Cycle records read.
+    pub cycle_count: usize,
 }
 
 impl Audit {
@@ -64,6 +142,13 @@ impl Audit {
     pub fn passed(&self) -> bool {
         self.findings.is_empty()
     }
+}
+
+/// What to check beyond the outcome.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct AuditOptions {
+    /// Also check the cycle records against the contract (module docs, step 4).
+    pub cycles: bool,
 }
 
 fn norm(v: &[f64; 3]) -> f64 {
@@ -112,94 +197,59 @@ fn static_distance(p: &[f64; 3], shape: &StaticShape) -> f64 {
     }
 }
 
-/// Points of a static cloud in a uniform grid of cell `cell`, for nearest-point queries.
-struct PointGrid {
-    cell: f64,
-    cells: std::collections::BTreeMap<(i64, i64, i64), Vec<[f64; 3]>>,
+/// The true geometry of a log, for clearances: its header's shapes and obstacles and its static
+/// points (indexed).
+#[derive(Debug, Clone)]
+pub struct TrueGeometry {
+    header: Header,
+    points: Option<PointTree>,
 }
 
-impl PointGrid {
-    fn new(points: Vec<[f64; 3]>, cell: f64) -> Self {
-        let mut cells: std::collections::BTreeMap<(i64, i64, i64), Vec<[f64; 3]>> =
-            std::collections::BTreeMap::new();
-        for p in points {
-            cells.entry(Self::key(&p, cell)).or_default().push(p);
-        }
-        PointGrid { cell, cells }
+impl TrueGeometry {
+    /// The geometry of a log with `header`, read from a file in `log_dir` (which resolves its
+    /// `static_points_file` under [`crate::files`]' policy).
+    ///
+    /// # Errors
+    /// A message naming the points file (and the line) if it is refused or cannot be read.
+    pub fn new(header: &Header, log_dir: &Path) -> Result<Self, String> {
+        let points = match &header.static_points_file {
+            Some(f) => Some(PointTree::new(read_points(&resolve_points_file(
+                log_dir, f,
+            )?)?)),
+            None => None,
+        };
+        Ok(TrueGeometry {
+            header: header.clone(),
+            points,
+        })
     }
 
-    fn key(p: &[f64; 3], cell: f64) -> (i64, i64, i64) {
-        let k = |x: f64| (x / cell).floor() as i64;
-        (k(p[0]), k(p[1]), k(p[2]))
-    }
-
-    /// Distance to the nearest point, searching shells of cells outward until no closer point can
-    /// exist; `+∞` if none lies within `max_reach`.
-    fn nearest(&self, p: &[f64; 3], max_reach: f64) -> f64 {
-        let (x, y, z) = Self::key(p, self.cell);
-        let mut best = f64::INFINITY;
-        let shells = (max_reach / self.cell).ceil() as i64 + 1;
-        for n in 0..=shells {
-            // Every point in shell n is at least (n − 1)·cell away.
-            if best <= (n - 1) as f64 * self.cell {
-                break;
-            }
-            for i in -n..=n {
-                for j in -n..=n {
-                    for k in -n..=n {
-                        if i.abs().max(j.abs()).max(k.abs()) != n {
-                            continue;
-                        }
-                        if let Some(pts) = self.cells.get(&(x + i, y + j, z + k)) {
-                            for q in pts {
-                                best = best.min(dist(p, q));
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        if best <= max_reach {
-            best
-        } else {
-            f64::INFINITY
-        }
+    /// The static and dynamic clearances at state `s` (m, vehicle radius subtracted; `+∞`
+    /// without geometry of that kind), and the nearest moving obstacle's id.
+    pub fn clearances(&self, s: &StateRecord) -> (f64, f64, usize) {
+        clearance_at(&self.header, self.points.as_ref(), s)
     }
 }
 
-/// Reads a points file (`x y z` per line; blank lines and `#` comments ignored).
-fn read_points(path: &Path) -> Result<Vec<[f64; 3]>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut points = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let xs: Vec<f64> = line
-            .split_whitespace()
-            .map(str::parse)
-            .collect::<Result<_, _>>()
-            .map_err(|e| format!("{}:{}: {e}", path.display(), i + 1))?;
-        if xs.len() != 3 {
-            return Err(format!("{}:{}: expected `x y z`", path.display(), i + 1));
-        }
-        points.push([xs[0], xs[1], xs[2]]);
-    }
-    Ok(points)
+/// Reads the `x y z` points of a log's `static_points_file` ([`crate::files::read_points`]).
+///
+/// # Errors
+/// A message naming the file and line.
+pub fn read_static_points(path: &Path) -> Result<Vec<[f64; 3]>, String> {
+    read_points(path)
 }
 
 /// The static and dynamic clearances of the vehicle in state `s` (minus its radius), and the
 /// nearest moving obstacle's id.
-fn clearance_at(h: &Header, grid: Option<&PointGrid>, s: &StateRecord) -> (f64, f64, usize) {
+fn clearance_at(h: &Header, points: Option<&PointTree>, s: &StateRecord) -> (f64, f64, usize) {
     let radius = h.vehicle.radius;
     let mut static_c = h
         .static_shapes
         .iter()
         .map(|shape| static_distance(&s.p, shape) - radius)
         .fold(f64::INFINITY, f64::min);
-    if let Some(g) = grid {
-        static_c = static_c.min(g.nearest(&s.p, 100.0) - radius);
+    if let Some(t) = points {
+        static_c = static_c.min(t.nearest_distance(&s.p) - radius);
     }
     let (mut dynamic_c, mut nearest) = (f64::INFINITY, 0);
     for (info, c) in h.obstacles.iter().zip(&s.obstacles) {
@@ -226,64 +276,297 @@ fn clearance_at(h: &Header, grid: Option<&PointGrid>, s: &StateRecord) -> (f64, 
 
 /// The clearances at every state of `log`, `[static, dynamic]` (m, vehicle radius subtracted;
 /// `+∞` without geometry of that kind), with the audit's own distance formulas; `log_dir`
-/// resolves `static_points_file`. The flight replay draws them as traces.
+/// resolves `static_points_file`.
 ///
 /// # Errors
-/// A message if the points file cannot be read.
+/// A message if the points file is refused or cannot be read.
 pub fn state_clearances(log: &RunLog, log_dir: &Path) -> Result<Vec<[f64; 2]>, String> {
-    let grid = match &log.header.static_points_file {
-        Some(f) => Some(PointGrid::new(read_points(&log_dir.join(f))?, 1.0)),
-        None => None,
-    };
+    let g = TrueGeometry::new(&log.header, log_dir)?;
     Ok(log
         .states
         .iter()
         .map(|s| {
-            let (st, dy, _) = clearance_at(&log.header, grid.as_ref(), s);
+            let (st, dy, _) = g.clearances(s);
             [st, dy]
         })
         .collect())
 }
 
-/// Reads the `x y z` points of a log's `static_points_file` (blank lines and `#` comments
-/// ignored).
-///
-/// # Errors
-/// A message naming the file and line.
-pub fn read_static_points(path: &Path) -> Result<Vec<[f64; 3]>, String> {
-    read_points(path)
+fn vec3(v: &[f64; 3]) -> String {
+    format!(
+        "[{}, {}, {}]",
+        readable(v[0]),
+        readable(v[1]),
+        readable(v[2])
+    )
 }
 
-/// Recomputes the outcome of `log`; `log_dir` resolves `static_points_file`.
-///
-/// # Errors
-/// A message if the points file cannot be read.
-pub fn recompute(log: &RunLog, log_dir: &Path) -> Result<Recomputed, String> {
-    let h: &Header = &log.header;
-    let grid = match &h.static_points_file {
-        Some(f) => Some(PointGrid::new(read_points(&log_dir.join(f))?, 1.0)),
-        None => None,
-    };
-    let mut r = Recomputed {
-        status: Status::TimedOut,
-        with: None,
-        collision_t: None,
-        min_clearance_static_m: f64::INFINITY,
-        min_clearance_dynamic_m: f64::INFINITY,
-        max_speed: 0.0,
-        max_accel: 0.0,
-        path_length_m: 0.0,
-        flight_time_s: 0.0,
-    };
-    let mut previous: Option<&StateRecord> = None;
-    for s in &log.states {
-        let (static_c, dynamic_c, nearest) = clearance_at(h, grid.as_ref(), s);
+fn within(xs: &[f64], bound: f64) -> bool {
+    xs.iter().all(|x| x.is_finite() && x.abs() <= bound)
+}
+
+/// Why the header is outside the audit's policy, if it is.
+fn header_problem(h: &Header) -> Option<String> {
+    let c = MAX_COORDINATE_M;
+    let size = |x: f64| x.is_finite() && (0.0..=c).contains(&x);
+    if !within(&h.bounds.min, c) || !within(&h.bounds.max, c) {
+        return Some(format!(
+            "bounds {} to {}",
+            vec3(&h.bounds.min),
+            vec3(&h.bounds.max)
+        ));
+    }
+    if !within(&h.start, c) || !within(&h.goal, c) {
+        return Some(format!(
+            "start {} or goal {}",
+            vec3(&h.start),
+            vec3(&h.goal)
+        ));
+    }
+    if !size(h.goal_tolerance) || !size(h.vehicle.radius) {
+        return Some(format!(
+            "goal_tolerance {} or vehicle radius {}",
+            readable(h.goal_tolerance),
+            readable(h.vehicle.radius)
+        ));
+    }
+    for (i, shape) in h.static_shapes.iter().enumerate() {
+        let ok = match *shape {
+            StaticShape::Sphere { center, radius } => within(&center, c) && size(radius),
+            StaticShape::Cylinder {
+                center,
+                radius,
+                z_min,
+                z_max,
+            } => within(&center, c) && size(radius) && within(&[z_min, z_max], c),
+            StaticShape::Box { min, max } => within(&min, c) && within(&max, c),
+        };
+        if !ok {
+            return Some(format!("static shape {i}"));
+        }
+    }
+    for o in &h.obstacles {
+        let ok = size(o.radius)
+            && o.half_height.is_none_or(size)
+            && o.half_extents.is_none_or(|e| e.iter().all(|&x| size(x)));
+        if !ok {
+            return Some(format!("the size of obstacle {}", o.id));
+        }
+    }
+    None
+}
+
+/// Why state `s` is outside the audit's policy, if it is: the check's name and what is wrong.
+fn state_problem(s: &StateRecord) -> Option<(&'static str, String)> {
+    if !(s.t.is_finite() && s.t.abs() <= MAX_TIME_S) {
+        return Some(("state.t", format!("t = {}", readable(s.t))));
+    }
+    if !within(&s.p, MAX_COORDINATE_M) {
+        return Some(("state.p", format!("p = {}", vec3(&s.p))));
+    }
+    if !within(&s.v, MAX_SPEED_M_S) {
+        return Some(("state.v", format!("v = {}", vec3(&s.v))));
+    }
+    if !within(&s.a, MAX_ACCEL_M_S2) {
+        return Some(("state.a", format!("a = {}", vec3(&s.a))));
+    }
+    if let Some(i) = s
+        .obstacles
+        .iter()
+        .position(|o| !within(o, MAX_COORDINATE_M))
+    {
+        return Some((
+            "state.obstacles",
+            format!("obstacle {i} at {}", vec3(&s.obstacles[i])),
+        ));
+    }
+    None
+}
+
+fn policy_of(field: &str) -> String {
+    match field {
+        "state.t" => format!("a time within ±{} s", readable(MAX_TIME_S)),
+        "state.v" => format!(
+            "velocity components within ±{} m/s (the audit's policy)",
+            readable(MAX_SPEED_M_S)
+        ),
+        "state.a" => format!(
+            "acceleration components within ±{} m/s² (the audit's policy)",
+            readable(MAX_ACCEL_M_S2)
+        ),
+        _ => format!(
+            "coordinates within ±{} m (the audit's policy)",
+            readable(MAX_COORDINATE_M)
+        ),
+    }
+}
+
+/// The keys of a cycle line whose absence the record type cannot tell (`main` reads as `None`
+/// when absent).
+#[derive(Deserialize)]
+struct CycleKeys {
+    #[serde(default, deserialize_with = "present")]
+    main: Option<()>,
+}
+
+fn present<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<()>, D::Error> {
+    serde::de::IgnoredAny::deserialize(d)?;
+    Ok(Some(()))
+}
+
+/// The last in-policy state, for the consistency checks.
+#[derive(Debug, Clone, Copy)]
+struct Previous {
+    index: usize,
+    t: f64,
+    p: [f64; 3],
+    v: [f64; 3],
+    a: [f64; 3],
+}
+
+/// The audit, fed one record at a time (so that a log can be streamed).
+struct Auditor<'a> {
+    header: &'a Header,
+    geometry: TrueGeometry,
+    options: AuditOptions,
+    r: Recomputed,
+    findings: Vec<Finding>,
+    counts: BTreeMap<&'static str, usize>,
+    previous: Option<Previous>,
+    first_t: Option<f64>,
+    last: Option<(f64, [f64; 3])>,
+    state_count: usize,
+    cycle_count: usize,
+    /// Cycles later than the last state read so far: (index, t); checked at the end.
+    late_cycles: Vec<(usize, f64)>,
+    late_cycle_count: usize,
+}
+
+impl<'a> Auditor<'a> {
+    fn new(header: &'a Header, log_dir: &Path, options: AuditOptions) -> Result<Self, String> {
+        let mut a = Auditor {
+            header,
+            geometry: TrueGeometry {
+                header: header.clone(),
+                points: None,
+            },
+            options,
+            r: Recomputed {
+                status: Status::TimedOut,
+                with: None,
+                collision_t: None,
+                min_clearance_static_m: f64::INFINITY,
+                min_clearance_dynamic_m: f64::INFINITY,
+                max_speed: 0.0,
+                max_accel: 0.0,
+                path_length_m: 0.0,
+                flight_time_s: 0.0,
+            },
+            findings: Vec::new(),
+            counts: BTreeMap::new(),
+            previous: None,
+            first_t: None,
+            last: None,
+            state_count: 0,
+            cycle_count: 0,
+            late_cycles: Vec::new(),
+            late_cycle_count: 0,
+        };
+        if let Some(problem) = header_problem(header) {
+            a.flag(
+                "header",
+                problem,
+                format!(
+                    "finite sizes ≥ 0 and coordinates within ±{} m (the audit's policy)",
+                    readable(MAX_COORDINATE_M)
+                ),
+            );
+        } else {
+            a.geometry = TrueGeometry::new(header, log_dir)?;
+        }
+        Ok(a)
+    }
+
+    fn flag(&mut self, field: &'static str, logged: String, recomputed: String) {
+        let n = self.counts.entry(field).or_insert(0);
+        *n += 1;
+        if *n <= MAX_LISTED_FINDINGS {
+            self.findings.push(Finding {
+                field,
+                logged,
+                recomputed,
+            });
+        }
+    }
+
+    fn state(&mut self, s: &StateRecord) {
+        let index = self.state_count;
+        self.state_count += 1;
+        let at = |s: &StateRecord| format!("state {index} (t = {} s)", readable(s.t));
+        if self.first_t.is_none() {
+            self.first_t = Some(s.t);
+        }
+        if let Some((field, problem)) = state_problem(s) {
+            self.flag(field, format!("{}: {problem}", at(s)), policy_of(field));
+            // Left out of the figures; the next state is not compared with it.
+            self.previous = None;
+            self.last = Some((s.t, [f64::NAN; 3]));
+            return;
+        }
+        if let Some(prev) = self.previous {
+            let dt = s.t - prev.t;
+            let step = |x: &[f64; 3], x0: &[f64; 3], d: &[f64; 3], d0: &[f64; 3]| {
+                norm(&[
+                    x[0] - x0[0] - 0.5 * (d[0] + d0[0]) * dt,
+                    x[1] - x0[1] - 0.5 * (d[1] + d0[1]) * dt,
+                    x[2] - x0[2] - 0.5 * (d[2] + d0[2]) * dt,
+                ])
+            };
+            let at = format!("{} after state {}", at(s), prev.index);
+            let gap_p = step(&s.p, &prev.p, &s.v, &prev.v);
+            if gap_p > POSITION_STEP_TOLERANCE_M {
+                self.flag(
+                    "state.teleport",
+                    format!(
+                        "{at}: moved {} m from {}, {} m off the logged velocities over {} s",
+                        readable(dist(&s.p, &prev.p)),
+                        vec3(&prev.p),
+                        readable(gap_p),
+                        readable(dt)
+                    ),
+                    format!(
+                        "|Δp − ½(v₀ + v₁)·dt| ≤ {} m",
+                        readable(POSITION_STEP_TOLERANCE_M)
+                    ),
+                );
+            }
+            let gap_v = step(&s.v, &prev.v, &s.a, &prev.a);
+            if gap_v > VELOCITY_STEP_TOLERANCE_M_S {
+                self.flag(
+                    "state.velocity_step",
+                    format!(
+                        "{at}: v = {} after {}, {} m/s off the logged accelerations",
+                        vec3(&s.v),
+                        vec3(&prev.v),
+                        readable(gap_v)
+                    ),
+                    format!(
+                        "|Δv − ½(a₀ + a₁)·dt| ≤ {} m/s",
+                        readable(VELOCITY_STEP_TOLERANCE_M_S)
+                    ),
+                );
+            }
+        }
+        let r = &mut self.r;
+        let (static_c, dynamic_c, nearest) = self.geometry.clearances(s);
         r.min_clearance_static_m = r.min_clearance_static_m.min(static_c);
         r.min_clearance_dynamic_m = r.min_clearance_dynamic_m.min(dynamic_c);
         r.max_speed = r.max_speed.max(norm(&s.v));
         r.max_accel = r.max_accel.max(norm(&s.a));
-        if let Some(prev) = previous {
-            r.path_length_m += dist(&prev.p, &s.p);
+        if let Some((_, p)) = self.last
+            && p.iter().all(|x| x.is_finite())
+        {
+            r.path_length_m += dist(&p, &s.p);
         }
         if r.collision_t.is_none() && (static_c < 0.0 || dynamic_c < 0.0) {
             r.collision_t = Some(s.t);
@@ -293,133 +576,278 @@ pub fn recompute(log: &RunLog, log_dir: &Path) -> Result<Recomputed, String> {
                 format!("obstacle:{nearest}")
             });
         }
-        previous = Some(s);
+        self.previous = Some(Previous {
+            index,
+            t: s.t,
+            p: s.p,
+            v: s.v,
+            a: s.a,
+        });
+        self.last = Some((s.t, s.p));
     }
-    let (first, last) = (&log.states[0], &log.states[log.states.len() - 1]);
-    r.flight_time_s = last.t - first.t;
-    r.status = if r.collision_t.is_some() {
-        Status::Collided
-    } else if dist(&last.p, &h.goal) <= h.goal_tolerance {
-        Status::Arrived
-    } else {
-        Status::TimedOut
-    };
-    Ok(r)
-}
 
-fn close(a: f64, b: f64, abs: f64) -> bool {
-    (a == b) || (a - b).abs() <= abs
-}
-
-/// Audits `log` (read from a file in `log_dir`): recomputes the outcome and lists every
-/// disagreement with the outcome record. An `invalid` outcome is accepted as is (the run did not
-/// fly as specified) but its figures are still compared.
-///
-/// # Errors
-/// A message if the points file cannot be read.
-pub fn audit(log: &RunLog, log_dir: &Path) -> Result<Audit, String> {
-    let r = recompute(log, log_dir)?;
-    let o = &log.outcome;
-    let mut findings = Vec::new();
-    let mut check = |field: &'static str, ok: bool, logged: String, recomputed: String| {
-        if !ok {
-            findings.push(Finding {
-                field,
-                logged,
-                recomputed,
-            });
+    /// A cycle record; `line` is its text when read from a file (to see which keys it has).
+    fn cycle(&mut self, c: &CycleRecord, line: Option<&str>) {
+        let index = self.cycle_count;
+        self.cycle_count += 1;
+        if !self.options.cycles {
+            return;
         }
-    };
-    if o.status == Status::Unreachable {
-        // The planner's verdict is not recomputable from the states; what is: the flight ended
-        // neither in a collision nor at the goal.
-        check(
-            "status",
-            r.status == Status::TimedOut,
-            o.status.as_str().into(),
-            format!(
-                "{} (unreachable needs no collision and no arrival)",
-                r.status.as_str()
-            ),
-        );
-    } else if o.status != Status::Invalid {
-        check(
-            "status",
-            o.status == r.status,
-            o.status.as_str().into(),
-            r.status.as_str().into(),
-        );
-        if r.status == Status::Collided {
-            check(
-                "with",
-                o.with == r.with,
-                format!("{:?}", o.with),
-                format!("{:?}", r.with),
+        let at = format!("cycle {index} (t = {} s)", readable(c.t));
+        if let Some(text) = line
+            && serde_json::from_str::<CycleKeys>(text).is_ok_and(|k| k.main.is_none())
+        {
+            self.flag(
+                "cycle.main",
+                format!("{at}: no `main`"),
+                "`main`: the main branch id, or null while braking".into(),
             );
         }
+        if !(c.wall_ms.is_finite() && c.wall_ms >= 0.0) {
+            self.flag(
+                "cycle.wall_ms",
+                format!("{at}: wall_ms = {}", readable(c.wall_ms)),
+                "a finite wall time ≥ 0 ms".into(),
+            );
+        }
+        let first = self.first_t.unwrap_or(f64::INFINITY);
+        if !(c.t.is_finite() && c.t >= first - 1e-9) {
+            self.flag(
+                "cycle.t",
+                format!("{at}: before the first state (t = {})", readable(first)),
+                "a time within the flight".into(),
+            );
+        } else if c.t > self.last.map_or(f64::NEG_INFINITY, |l| l.0) + 1e-9 {
+            // Judged at the end, against the last state.
+            self.late_cycle_count += 1;
+            if self.late_cycles.len() < MAX_LISTED_FINDINGS {
+                self.late_cycles.push((index, c.t));
+            }
+        }
     }
-    let last_t = log.states[log.states.len() - 1].t;
-    check(
-        "t",
-        close(o.t, last_t, 1e-6),
-        o.t.to_string(),
-        format!("{last_t} (last state)"),
-    );
-    check(
-        "flight_time_s",
-        close(o.flight_time_s, r.flight_time_s, 1e-6),
-        o.flight_time_s.to_string(),
-        r.flight_time_s.to_string(),
-    );
-    check(
-        "path_length_m",
-        close(
-            o.path_length_m,
-            r.path_length_m,
-            1e-3 * r.path_length_m.max(1.0),
-        ),
-        o.path_length_m.to_string(),
-        r.path_length_m.to_string(),
-    );
-    for (field, logged, recomputed) in [
-        (
-            "min_clearance_static_m",
-            o.min_clearance_static_m,
-            r.min_clearance_static_m,
-        ),
-        (
-            "min_clearance_dynamic_m",
-            o.min_clearance_dynamic_m,
-            r.min_clearance_dynamic_m,
-        ),
-    ] {
-        // Without geometry the recomputed minimum is +∞; the log holds a large finite stand-in.
-        let ok = if recomputed.is_infinite() {
-            logged >= 1e6
-        } else {
-            close(logged, recomputed, CLEARANCE_TOLERANCE_M)
+
+    fn finish(mut self, o: &Outcome) -> Audit {
+        let (first_t, (last_t, last_p)) = match (self.first_t, self.last) {
+            (Some(f), Some(l)) => (f, l),
+            _ => (0.0, (0.0, [f64::NAN; 3])),
         };
-        check(field, ok, logged.to_string(), recomputed.to_string());
+        if self.options.cycles {
+            let late: Vec<(usize, f64)> = std::mem::take(&mut self.late_cycles)
+                .into_iter()
+                .filter(|&(_, t)| t > last_t + 1e-9)
+                .collect();
+            let listed = late.len();
+            for (index, t) in late {
+                self.flag(
+                    "cycle.t",
+                    format!(
+                        "cycle {index} (t = {} s): after the last state (t = {})",
+                        readable(t),
+                        readable(last_t)
+                    ),
+                    "a time within the flight".into(),
+                );
+            }
+            if listed == MAX_LISTED_FINDINGS && self.late_cycle_count > listed {
+                // Some of the uncounted ones may be late too; say so rather than guess.
+                self.flag(
+                    "cycle.t",
+                    format!(
+                        "{} more cycles read before the states that reach them",
+                        self.late_cycle_count - listed
+                    ),
+                    "not checked one by one".into(),
+                );
+            }
+        }
+        let mut r = self.r.clone();
+        r.flight_time_s = last_t - first_t;
+        r.status = if r.collision_t.is_some() {
+            Status::Collided
+        } else if last_p.iter().all(|x| x.is_finite())
+            && dist(&last_p, &self.header.goal) <= self.header.goal_tolerance
+        {
+            Status::Arrived
+        } else {
+            Status::TimedOut
+        };
+        self.compare(o, &r, last_t);
+        let mut findings = std::mem::take(&mut self.findings);
+        for (field, n) in &self.counts {
+            if *n > MAX_LISTED_FINDINGS {
+                findings.push(Finding {
+                    field,
+                    logged: format!("… and {} more", n - MAX_LISTED_FINDINGS),
+                    recomputed: "as above".into(),
+                });
+            }
+        }
+        Audit {
+            recomputed: r,
+            findings,
+            logged_status: o.status,
+            state_count: self.state_count,
+            cycle_count: self.cycle_count,
+        }
     }
-    for (field, logged, recomputed) in [
-        ("max_speed", o.max_speed, r.max_speed),
-        ("max_accel", o.max_accel, r.max_accel),
-    ] {
+
+    fn compare(&mut self, o: &Outcome, r: &Recomputed, last_t: f64) {
+        let mut check = |field: &'static str, ok: bool, logged: f64, recomputed: String| {
+            if !ok {
+                self.flag(field, readable(logged), recomputed);
+            }
+        };
+        // Every recomputed figure is finite (or +∞ for a clearance without geometry): the
+        // policy bounds every value that enters it, so every tolerance below is finite.
+        let close =
+            |a: f64, b: f64, tol: f64| a.is_finite() && b.is_finite() && (a - b).abs() <= tol;
         check(
-            field,
-            close(
-                logged,
-                recomputed,
-                MAXIMA_TOLERANCE * recomputed.abs().max(1e-9),
-            ),
-            logged.to_string(),
-            recomputed.to_string(),
+            "t",
+            close(o.t, last_t, 1e-6),
+            o.t,
+            format!("{} (last state)", readable(last_t)),
         );
+        check(
+            "flight_time_s",
+            close(o.flight_time_s, r.flight_time_s, 1e-6),
+            o.flight_time_s,
+            readable(r.flight_time_s),
+        );
+        check(
+            "path_length_m",
+            close(
+                o.path_length_m,
+                r.path_length_m,
+                1e-3 * r.path_length_m.max(1.0),
+            ),
+            o.path_length_m,
+            readable(r.path_length_m),
+        );
+        for (field, logged, recomputed) in [
+            (
+                "min_clearance_static_m",
+                o.min_clearance_static_m,
+                r.min_clearance_static_m,
+            ),
+            (
+                "min_clearance_dynamic_m",
+                o.min_clearance_dynamic_m,
+                r.min_clearance_dynamic_m,
+            ),
+        ] {
+            let ok = if recomputed == f64::INFINITY {
+                logged.is_finite() && logged >= NO_GEOMETRY_CLEARANCE_M
+            } else {
+                close(logged, recomputed, CLEARANCE_TOLERANCE_M)
+            };
+            check(field, ok, logged, readable(recomputed));
+        }
+        for (field, logged, recomputed) in [
+            ("max_speed", o.max_speed, r.max_speed),
+            ("max_accel", o.max_accel, r.max_accel),
+        ] {
+            check(
+                field,
+                close(
+                    logged,
+                    recomputed,
+                    MAXIMA_TOLERANCE * recomputed.abs() + 1e-9,
+                ),
+                logged,
+                readable(recomputed),
+            );
+        }
+        if o.status == Status::Unreachable {
+            // The planner's verdict is not recomputable from the states; what is: the flight
+            // ended neither in a collision nor at the goal.
+            if r.status != Status::TimedOut {
+                self.flag(
+                    "status",
+                    o.status.as_str().into(),
+                    format!(
+                        "{} (unreachable needs no collision and no arrival)",
+                        r.status.as_str()
+                    ),
+                );
+            }
+        } else if o.status != Status::Invalid {
+            if o.status != r.status {
+                self.flag("status", o.status.as_str().into(), r.status.as_str().into());
+            }
+            if r.status == Status::Collided && o.with != r.with {
+                self.flag("with", format!("{:?}", o.with), format!("{:?}", r.with));
+            }
+        }
     }
-    Ok(Audit {
-        recomputed: r,
-        findings,
-    })
+}
+
+/// Recomputes the outcome of `log`; `log_dir` resolves `static_points_file`.
+///
+/// # Errors
+/// A message if the points file is refused or cannot be read.
+pub fn recompute(log: &RunLog, log_dir: &Path) -> Result<Recomputed, String> {
+    Ok(audit(log, log_dir)?.recomputed)
+}
+
+/// Audits `log` (read from a file in `log_dir`): checks the values against the policy, the
+/// consecutive states against each other, and the outcome record against the recomputed figures
+/// (module docs), listing every disagreement. An `invalid` outcome is accepted as is (the run did
+/// not fly as specified) but its figures are still compared; an `unreachable` one needs a flight
+/// that ended neither in a collision nor at the goal.
+///
+/// # Errors
+/// A message if the points file is refused or cannot be read.
+pub fn audit(log: &RunLog, log_dir: &Path) -> Result<Audit, String> {
+    audit_with(log, log_dir, AuditOptions::default())
+}
+
+/// [`audit`] with options ([`AuditOptions::cycles`]: a log in memory has no line text, so a
+/// missing `main` cannot be told from `null` here; [`audit_file`] can).
+///
+/// # Errors
+/// As [`audit`].
+pub fn audit_with(log: &RunLog, log_dir: &Path, options: AuditOptions) -> Result<Audit, String> {
+    let mut a = Auditor::new(&log.header, log_dir, options)?;
+    // States and cycles in the log's order: a cycle after the state at its time.
+    let mut cycles = log.cycles.iter().peekable();
+    for s in &log.states {
+        while let Some(c) = cycles.next_if(|c| c.t < s.t) {
+            a.cycle(c, None);
+        }
+        a.state(s);
+    }
+    for c in cycles {
+        a.cycle(c, None);
+    }
+    Ok(a.finish(&log.outcome))
+}
+
+/// Audits the run log at `path`, streaming it ([`LogReader`]): memory is one line plus the
+/// static points, whatever the length of the flight.
+///
+/// # Errors
+/// [`LogError`] for a log that cannot be read or breaks the contract's structure, and
+/// [`LogError::Points`] for a points file that is refused or cannot be read.
+pub fn audit_file(path: &Path, options: AuditOptions) -> Result<Audit, LogError> {
+    let mut reader = LogReader::open(path)?;
+    let header = reader.header().clone();
+    let log_dir = path.parent().unwrap_or(Path::new("."));
+    let mut a =
+        Auditor::new(&header, log_dir, options).map_err(|message| LogError::Points { message })?;
+    let mut outcome = None;
+    while let Some(record) = reader.next_record()? {
+        match record {
+            Record::State(s) => a.state(&s),
+            Record::Cycle(c) => a.cycle(&c, Some(reader.line())),
+            Record::Outcome(o) => outcome = Some(o),
+            Record::Header(_) => {}
+        }
+    }
+    let outcome = outcome.ok_or_else(|| LogError::Structure {
+        path: path.to_path_buf(),
+        message: "no outcome (the run did not finish)".into(),
+    })?;
+    Ok(a.finish(&outcome))
 }
 
 #[cfg(test)]
@@ -492,10 +920,22 @@ mod tests {
         // its radius.
         let log = RunLog {
             header,
-            states: vec![clear, state(0.02, [6.3, 5.0, 1.0], 5.1)],
+            // The vehicle moves 1.3 m in 0.02 s, and its logged velocity says so (the audit
+            // checks that positions follow the velocities).
+            states: vec![
+                StateRecord {
+                    v: [0.0, -65.0, 0.0],
+                    ..clear
+                },
+                StateRecord {
+                    v: [0.0, -65.0, 0.0],
+                    ..state(0.02, [6.3, 5.0, 1.0], 5.1)
+                },
+            ],
             cycles: Vec::new(),
             outcome: crate::Outcome {
                 path_length_m: 1.3,
+                max_speed: 65.0,
                 ..outcome(Status::Collided, Some("obstacle:0"), 0.02, -0.1)
             },
         };
@@ -503,16 +943,5 @@ mod tests {
         assert!(a.passed(), "{:?}", a.findings);
         assert_eq!(a.recomputed.with.as_deref(), Some("obstacle:0"));
         assert!((a.recomputed.min_clearance_dynamic_m + 0.1).abs() < 1e-12);
-    }
-
-    #[test]
-    fn point_grid_finds_the_nearest_point() {
-        let g = PointGrid::new(
-            vec![[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [10.0, 0.0, 0.0]],
-            1.0,
-        );
-        assert!((g.nearest(&[2.5, 0.0, 0.0], 5.0) - 0.5).abs() < 1e-12);
-        assert!((g.nearest(&[6.4, 0.3, 0.0], 50.0) - 0.3f64.hypot(3.4)).abs() < 1e-12);
-        assert_eq!(g.nearest(&[6.5, 0.0, 40.0], 2.0), f64::INFINITY);
     }
 }

@@ -6,33 +6,38 @@
 //! contract's fields are never dropped or renamed; this module adds fields (marked "added" in their
 //! docs) and nothing else.
 //!
-//! [`LogWriter`] writes a log line by line (buffered); [`RunLog::read`] reads one back and checks its
-//! structure. Numbers are written in the shortest form that reads back to the same `f64`, and the
-//! writer refuses non-finite numbers (a non-finite value is a bug, not data).
+//! # Code map
 //!
-//! # Changelog
-//!
-//! - Issue 19: [`CycleRecord::route`], [`CycleRecord::route_ms`],
-//!   [`CycleRecord::fallback_shortfall_m`] (optional, absent when not applicable).
-//! - Moved out of `trust-sim` (issue 17): `trust_sim::runlog` is this crate's root and
-//!   `trust_sim::audit` is [`audit`]; the run-log errors are [`LogError`]s, no longer wrapped in
-//!   `SimError`.
-//! - Added (issue 20): [`CycleRecord::branch_samples`] ([`BranchSamples`]) and
-//!   [`CycleRecord::forecasts`] ([`ForecastRecord`], [`ForecastShape`]), optional and absent
-//!   unless branch logging is on, so older logs read as before.
-//! - Issue 20: a moving obstacle may be a box — [`ObstacleKind::Box`] with
-//!   [`ObstacleInfo::half_extents`] (an addition; the audit measures the box).
-//! - [`StaticShape`] is also the scenario file's static shape (`trust_world::scenario::StaticShape`,
-//!   which replaced `ShapeSpec`); its serialized form in the log is unchanged.
+//! - The record types ([`Header`], [`StateRecord`], [`CycleRecord`], [`Outcome`], [`Record`]) and
+//!   [`LogWriter`], which writes a log line by line (buffered) in the shortest form that reads
+//!   back to the same `f64`, refusing non-finite numbers (a non-finite value is a bug, not data).
+//! - [`reader`]: [`LogReader`] streams a log record by record and checks its structure; a
+//!   one-hour log is read in the memory of one line. [`RunLog::read`] collects it whole (for the
+//!   logs of tests and studies; tools that may meet long logs stream).
+//! - [`files`]: the policy for reading files named by a log or its user — only regular files,
+//!   a size cap per kind of file enforced while reading, the points file's path kept inside the
+//!   log's folder, no file contents in messages beyond the offending line — and [`readable`]
+//!   numbers in messages.
+//! - [`kdtree`]: [`PointTree`], the nearest-point index of a static point cloud (why a k-d tree:
+//!   its module docs).
+//! - [`audit`]: the independent re-check of a log's outcome from its header and states, with its
+//!   value policy and consistency checks.
 #![warn(missing_docs)]
 
 pub mod audit;
+pub mod files;
+pub mod kdtree;
+pub mod reader;
 
 use std::fs::File;
-use std::io::{BufRead, BufReader, BufWriter, Write};
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
+
+pub use files::readable;
+pub use kdtree::PointTree;
+pub use reader::LogReader;
 
 /// The schema tag of this version.
 pub const SCHEMA: &str = "trust-sim-log/1";
@@ -472,6 +477,30 @@ pub enum LogError {
         /// What is wrong.
         message: String,
     },
+    /// A file to read is not a regular file (a folder, a device such as `/dev/zero`, a pipe).
+    #[error("{}: not a regular file; {what} must be one", path.display())]
+    NotAFile {
+        /// The file.
+        path: PathBuf,
+        /// What it was read as ("a run log", "a static points file").
+        what: &'static str,
+    },
+    /// A file to read is larger than its cap ([`files`]).
+    #[error("{}: larger than the cap on {what} ({limit})", path.display())]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// What it was read as.
+        what: &'static str,
+        /// The cap exceeded (`"536870912 bytes"`, `"line 7: 67108864 bytes a line"`).
+        limit: String,
+    },
+    /// The log's static points file is refused or cannot be read (the message names it).
+    #[error("static points of the log: {message}")]
+    Points {
+        /// What is wrong, with the file and line.
+        message: String,
+    },
     /// A record to write holds a non-finite number.
     #[error("refusing to write a non-finite number in a `{record}` record: {detail}")]
     NonFinite {
@@ -630,97 +659,35 @@ pub struct RunLog {
 }
 
 impl RunLog {
-    /// Reads a log and checks the contract's structure: a header first (with the right schema,
-    /// every box obstacle with positive `half_extents`), an outcome last, exactly one of each, state times strictly increasing with steps ≤ 0.02 s,
-    /// every state listing one position per header obstacle.
+    /// Reads a whole log ([`LogReader`], which checks the contract's structure: a header first
+    /// with the right schema and every box obstacle with positive `half_extents`, an outcome
+    /// last, exactly one of each, state times strictly increasing with steps ≤ 0.02 s, every
+    /// state listing one position per header obstacle). It holds every record: a one-hour log of
+    /// 100 obstacles takes about half a GB; stream long logs with [`LogReader`] instead.
     ///
     /// # Errors
     /// [`LogError`] naming the file and, for a bad line, its number.
     pub fn read(path: &Path) -> Result<RunLog, LogError> {
-        let io = |source| LogError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        let file = File::open(path).map_err(io)?;
-        let mut header = None;
-        let mut outcome = None;
+        let mut reader = LogReader::open(path)?;
         let mut states = Vec::new();
         let mut cycles = Vec::new();
-        for (i, line) in BufReader::new(file).lines().enumerate() {
-            let line = line.map_err(io)?;
-            if line.trim().is_empty() {
-                continue;
-            }
-            let parse = |message: String| LogError::Parse {
-                path: path.to_path_buf(),
-                line: i + 1,
-                message,
-            };
-            let record: Record = serde_json::from_str(&line).map_err(|e| parse(e.to_string()))?;
-            if outcome.is_some() {
-                return Err(parse("a record after the outcome".into()));
-            }
-            if !matches!(record, Record::Header(_)) && header.is_none() {
-                return Err(parse("the first line must be the header".into()));
-            }
+        let mut outcome = None;
+        while let Some(record) = reader.next_record()? {
             match record {
-                Record::Header(h) => {
-                    if header.is_some() || i > 0 {
-                        return Err(parse("the header must be the first line, once".into()));
-                    }
-                    if h.schema != SCHEMA {
-                        return Err(parse(format!("schema `{}`, expected `{SCHEMA}`", h.schema)));
-                    }
-                    for o in &h.obstacles {
-                        let sized = o
-                            .half_extents
-                            .is_some_and(|e| e.iter().all(|x| x.is_finite() && *x > 0.0));
-                        if o.shape == ObstacleKind::Box && !sized {
-                            return Err(parse(format!(
-                                "obstacle {}: a box needs `half_extents` [hx, hy, hz] > 0, \
-                                 got {:?}",
-                                o.id, o.half_extents
-                            )));
-                        }
-                    }
-                    header = Some(h);
-                }
-                Record::State(s) => {
-                    let expected = header.as_ref().map_or(0, |h| h.obstacles.len());
-                    if s.obstacles.len() != expected {
-                        return Err(parse(format!(
-                            "{} obstacle positions, the header lists {expected}",
-                            s.obstacles.len()
-                        )));
-                    }
-                    if let Some(prev) = states.last().map(|p: &StateRecord| p.t)
-                        && !(s.t > prev && s.t - prev <= 0.02 + 1e-9)
-                    {
-                        return Err(parse(format!(
-                            "state time {} after {prev}: times must increase by at most 0.02 s",
-                            s.t
-                        )));
-                    }
-                    states.push(s);
-                }
+                Record::State(s) => states.push(s),
                 Record::Cycle(c) => cycles.push(c),
                 Record::Outcome(o) => outcome = Some(o),
+                Record::Header(_) => {}
             }
         }
-        let structure = |message: &str| LogError::Structure {
-            path: path.to_path_buf(),
-            message: message.to_string(),
-        };
-        let header = header.ok_or_else(|| structure("no header"))?;
-        let outcome = outcome.ok_or_else(|| structure("no outcome (the run did not finish)"))?;
-        if states.is_empty() {
-            return Err(structure("no state records"));
-        }
         Ok(RunLog {
-            header,
+            header: reader.header().clone(),
             states,
             cycles,
-            outcome,
+            outcome: outcome.ok_or_else(|| LogError::Structure {
+                path: path.to_path_buf(),
+                message: "no outcome (the run did not finish)".into(),
+            })?,
         })
     }
 }
