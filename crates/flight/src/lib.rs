@@ -40,7 +40,7 @@ use trust_runlog::{
 };
 use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle, VehicleState};
 use trust_world::World;
-use trust_world::planner::{self, AnyManager, ResolvedPlanner};
+use trust_world::planner::{self, AnyManager, FrontendSpec, ResolvedPlanner};
 use trust_world::scenario::VehicleModel;
 use trust_world::sensing::Sensing;
 use trust_world::traffic::{MovingShape, Traffic};
@@ -98,7 +98,8 @@ pub struct RunSummary {
     /// The longest cycle's wall time (ms).
     #[serde(default)]
     pub cycle_ms_max: f64,
-    /// Cycles whose wall time exceeded the manager's cycle budget (`cycle_budget_ms`).
+    /// Cycles that exceeded the manager's cycle budget (`cycle_budget_ms`): their wall time, or in
+    /// the real-time mode the time charged (wall time times `cpu_scale`).
     #[serde(default)]
     pub over_budget_count: usize,
     /// Cycles that made the planner skip replanning ticks (real-time latency mode only).
@@ -313,14 +314,13 @@ pub fn fly(
     let wall_start = Instant::now();
     let scenario = world.scenario();
     let params = LoopParams::new(world, planner);
-    // In real time the planner's wall-clock budgets back its work budgets.
+    // In real time the planner's wall-clock budgets back its work budgets, on the emulated
+    // computer's clock: `cpu_scale` times slower, so its budgets are `cpu_scale` times shorter
+    // on this one.
     let real_time = matches!(params.clock, Clock::RealTime { .. });
-    let planner = &{
-        let mut p = planner.clone();
-        if real_time {
-            p.reproducible = false;
-        }
-        p
+    let planner = &match params.clock {
+        Clock::RealTime { cpu_scale } => real_time_planner(planner, cpu_scale),
+        Clock::Fixed { .. } => planner.clone(),
     };
     let Setup {
         traffic,
@@ -394,7 +394,7 @@ pub fn fly(
             next_plan_snapshot: 0.0,
         },
         (
-            CycleStats::new(params.cycle_budget_ms),
+            CycleStats::new(params.cycle_budget_ms, real_time),
             GivenForecasts {
                 given: ForecastHistory::new(),
                 remember_s: 2.0 * planner.manager.horizon_s,
@@ -567,10 +567,29 @@ impl FlightObserver for Logger {
     }
 }
 
+/// `planner` as flown in real time on a computer `cpu_scale` times slower than this one: its
+/// wall-clock budgets on (not reproducible) and divided by `cpu_scale`, so that they hold on the
+/// emulated computer's clock.
+pub fn real_time_planner(planner: &ResolvedPlanner, cpu_scale: f64) -> ResolvedPlanner {
+    let mut p = planner.clone();
+    p.reproducible = false;
+    p.manager.enforce_budget = true;
+    p.manager.cycle_budget_ms /= cpu_scale;
+    match &mut p.frontend {
+        FrontendSpec::DevPrm(x) => x.budget_ms /= cpu_scale,
+        FrontendSpec::VPrm(x) => x.budget_ms /= cpu_scale,
+        FrontendSpec::SparseAStar(x) => x.budget_ms /= cpu_scale,
+        FrontendSpec::StraightLine(_) => {}
+    }
+    p
+}
+
 /// The cycles' statistics for the summary (an observer).
 #[derive(Debug, Clone, Default)]
 struct CycleStats {
     budget_ms: f64,
+    /// Over budget is judged on the charged time (real time) rather than the wall time.
+    real_time: bool,
     walls_ms: Vec<f64>,
     solve_ms: f64,
     cpu_ms: f64,
@@ -585,9 +604,10 @@ struct CycleStats {
 }
 
 impl CycleStats {
-    fn new(budget_ms: f64) -> Self {
+    fn new(budget_ms: f64, real_time: bool) -> Self {
         CycleStats {
             budget_ms,
+            real_time,
             ..CycleStats::default()
         }
     }
@@ -598,7 +618,12 @@ impl FlightObserver for CycleStats {
         let report = cycle.report;
         let timing = &report.timing;
         self.walls_ms.push(timing.wall_ms);
-        self.over_budget += usize::from(timing.wall_ms > self.budget_ms);
+        let spent_ms = if self.real_time {
+            cycle.charged_s * 1e3
+        } else {
+            timing.wall_ms
+        };
+        self.over_budget += usize::from(spent_ms > self.budget_ms);
         self.overruns += usize::from(cycle.overrun_ticks > 0);
         self.skipped_ticks += cycle.overrun_ticks;
         self.solve_ms += timing.backend_ms;
@@ -669,7 +694,14 @@ fn cycle_record(
     let planned = report
         .events
         .iter()
-        .any(|e| matches!(e, Event::Rerouted { .. } | Event::RouteFailed { .. }));
+        .any(|e| {
+            matches!(
+                e,
+                Event::Rerouted { .. } | Event::RouteFailed { .. } | Event::GoalUnreachable { .. }
+            )
+        })
+        // A slice of a search still under way.
+        || report.timing.route_ms > 0.0;
     CycleRecord {
         t: report.t,
         wall_ms: time(report.timing.wall_ms),

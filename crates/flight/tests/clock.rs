@@ -72,10 +72,11 @@ impl FlightObserver for Counts {
 /// Steps `s` for `seconds` of simulated time with the loop's own step function.
 fn step_for(s: &Scenario, seconds: f64) -> (Counts, Option<Ending>) {
     let world = World::build(s).expect("world");
-    let planner = {
-        let mut p = s.resolve_planner();
-        p.reproducible = !s.sim.latency.is_real_time();
-        p
+    let planner = match Clock::from_latency(s.sim.latency, 0.05) {
+        Clock::RealTime { cpu_scale } => {
+            trust_flight::real_time_planner(&s.resolve_planner(), cpu_scale)
+        }
+        Clock::Fixed { .. } => s.resolve_planner(),
     };
     let params = LoopParams::new(&world, &planner);
     let setup = trust_flight::set_up(&world, &planner).expect("setup");
@@ -115,7 +116,8 @@ fn with_a_fixed_latency_every_tick_plans() {
 #[test]
 fn a_planner_a_hundred_times_slower_skips_ticks_and_says_so() {
     // At cpu_scale 100 every cycle that takes more than 1 ms is charged more than the 0.1 s
-    // period: the next cycle waits for the first tick after it.
+    // period: the next cycle waits for the first tick after it. (Its budgets are 100 times
+    // shorter on this machine's clock: 0.5 ms.)
     let (counts, _) = step_for(&quickstart(Latency::real_time(100.0), 30.0), 2.0);
     assert!(counts.cycles < 20, "{} cycles in 2 s", counts.cycles);
     assert!(counts.overrun_ticks > 0);

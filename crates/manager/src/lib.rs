@@ -93,11 +93,13 @@ pub use brake::{
     brake_along, brake_straight, braking_tail, dash_maneuvers, escape_maneuvers, hermite_quintic,
 };
 pub use manager::{Branch, MainDecision, Manager, choose_main};
-pub use params::{GROWTH_FRACTION, ManagerParams, ReanchorParams, SafetyParams};
+pub use params::{
+    GROWTH_FRACTION, ManagerParams, ReanchorParams, SOLVE_DEADLINE_FRACTION, SafetyParams,
+};
 pub use progress::{ProgressMonitor, ProgressParams, StallRule};
 pub use report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, GoalUnreachable,
     LimitExcess, Origin, STUB_FRACTION, StepReport,
 };
-pub use routing::Router;
+pub use routing::{RECHECK_S, ROUTE_WORK_PER_CYCLE, Router};
 pub use safety::{Hit, SafetyVerdict, Violation, assess_trajectory, check_trajectory};

@@ -12,6 +12,7 @@ use trust_core::{
 
 use crate::ManagerParams;
 use crate::brake::{brake_along, brake_straight, dash_maneuvers, escape_maneuvers};
+use crate::params::SOLVE_DEADLINE_FRACTION;
 use crate::progress::ProgressMonitor;
 use crate::report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
@@ -20,9 +21,9 @@ use crate::report::{
 use crate::safety::{
     SafetyVerdict, assess_trajectory, check_trajectory, forecasts_near, window_bounds,
 };
-use trust_route::{GlobalRoute, RoutePoint};
+use trust_route::{GlobalRoute, RoutePoint, RouteProgress, RouteSearch};
 
-use crate::routing::{RouteReason, Router, plan_route};
+use crate::routing::{RouteReason, Router, rerouted, route_failed};
 
 /// One kept trajectory branch.
 #[derive(Debug, Clone, PartialEq)]
@@ -223,6 +224,8 @@ pub struct Manager<F, B, H> {
     routed_at: f64,
     /// The standing verdict that the goal cannot be reached ([`crate::GoalUnreachable`]).
     unreachable: Option<crate::GoalUnreachable>,
+    /// The route search under way, and why it started.
+    route_search: Option<(RouteReason, RouteSearch)>,
 }
 
 impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
@@ -267,6 +270,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             routed_goal: None,
             routed_at: f64::NEG_INFINITY,
             unreachable: None,
+            route_search: None,
             cycle_count: 0,
         })
     }
@@ -312,6 +316,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     pub fn set_router(&mut self, router: Option<Router>) {
         self.router = router;
         self.routed_goal = None;
+        self.route_search = None;
+        self.unreachable = None;
     }
 
     /// The route planner, if any ([`Manager::set_router`]).
@@ -414,6 +420,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         self.cycle_count = 0;
         self.progress.reset();
         self.routed_goal = None;
+        self.route_search = None;
+        self.unreachable = None;
         self.branches.clear();
         self.main = None;
         self.committed = None;
@@ -438,6 +446,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     ) -> Result<StepReport, PlanError> {
         let mut spans = Spans::start();
         check_step_input(now, measured, goal, scene)?;
+        let real_goal = *goal;
         // The forecasts the cycle plans against: their growth stopped after
         // `forecast_growth_s`, and their mirror images at the walls.
         let growth_s = self.params.forecast_growth();
@@ -459,8 +468,23 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             ..*scene
         };
         let scene = &planned;
-        let mut cycle = self.begin_cycle(now, measured, goal, spans.started);
-        self.update_route(&mut cycle, measured, scene, &mut spans);
+        // With a standing verdict that the goal cannot be reached, the cycle plans toward the
+        // reachable point nearest it (a held stop); the route keeps being re-checked.
+        let target = self.target(goal);
+        let mut cycle = self.begin_cycle(now, measured, &target, spans.started);
+        self.update_route(&mut cycle, measured, &real_goal, scene, &mut spans);
+        // A vehicle at rest waits where it is for its first route toward a new goal (a few
+        // cycles): flown toward the goal meanwhile it would head into the trap the route is
+        // for. It still plans (to hold its place), so it still gets out of a moving obstacle's
+        // way.
+        let target = if self.awaiting_first_route(measured) {
+            cycle.events.push(Event::AwaitingRoute);
+            measured.p
+        } else {
+            target
+        };
+        cycle.goal = target;
+        let goal = &target;
 
         // Algorithm 1, lines 5–8: FwdMarch of the main branch and BwdReplan of the sub-branches,
         // in parallel with FwdExplore.
@@ -504,38 +528,121 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         })
     }
 
-    /// Plans the global route with the router ([`Manager::set_router`]) when there is none
-    /// toward this goal yet, when the progress monitor has just declared a stall, and every
-    /// horizon while the stall lasts; the progress monitor is carried over to the new route's
-    /// arc length.
+    /// Whether the vehicle is at rest and its first route toward the goal is being searched.
+    fn awaiting_first_route(&self, measured: &State) -> bool {
+        self.route.is_none()
+            && matches!(self.route_search, Some((RouteReason::First, _)))
+            && measured.v.norm() <= REST_SPEED_FRACTION * self.limits.v_max
+    }
+
+    /// Where the cycle plans to: `goal`, or while the goal is held unreachable
+    /// ([`crate::GoalUnreachable`]) the reachable point nearest it.
+    fn target(&self, goal: &Vec3) -> Vec3 {
+        match &self.unreachable {
+            Some(u) if self.routed_goal.is_some_and(|g| (g - goal).norm() <= 1e-9) => {
+                u.held_at.map_or(*goal, |p| Vec3::new(p[0], p[1], p[2]))
+            }
+            _ => *goal,
+        }
+    }
+
+    /// The global route ([`crate::routing`]): a search starts when there is no route toward
+    /// this goal yet, when the progress monitor has just declared a stall, every horizon while
+    /// the stall lasts, and every re-check period while the goal is held unreachable; a search
+    /// under way gets the router's slice of work per cycle and the vehicle flies the previous
+    /// route (or toward the goal) meanwhile. Its answer is a new route (the progress monitor is
+    /// carried over to its arc length), a verdict that the goal cannot be reached (the route
+    /// then leads to the reachable point nearest it), or a failure (the previous route stays).
     fn update_route(
         &mut self,
         cycle: &mut Cycle,
         measured: &State,
+        goal: &Vec3,
         scene: &Scene<'_>,
         spans: &mut Spans,
     ) {
         let Some(router) = &self.router else {
             return;
         };
-        let goal = cycle.goal;
+        let goal = *goal;
+        let new_goal = self.routed_goal.is_none_or(|g| (g - goal).norm() > 1e-9);
+        let searching = self.route_search.is_some();
         // While the stall lasts the route is planned again every horizon (a route that failed,
-        // or one that leads into a dead end, is not kept for the rest of the flight).
-        let again = cycle.stalled && measured.t - self.routed_at >= self.params.horizon_s;
-        let reason = if self.routed_goal.is_none_or(|g| (g - goal).norm() > 1e-9) {
-            RouteReason::First
+        // or one that leads into a dead end, is not kept for the rest of the flight); a verdict
+        // is re-checked every re-check period (the map and the obstacles change).
+        let since = measured.t - self.routed_at;
+        let again = cycle.stalled && since >= self.params.horizon_s;
+        let recheck = self.unreachable.is_some() && since >= router.recheck_s();
+        let reason = if new_goal {
+            Some(RouteReason::First)
+        } else if searching {
+            None
         } else if cycle.newly_stalled || again {
-            RouteReason::Stalled
+            Some(RouteReason::Stalled)
+        } else if recheck {
+            Some(RouteReason::Recheck)
         } else {
+            None
+        };
+        if let Some(reason) = reason {
+            if new_goal {
+                self.unreachable = None;
+            }
+            self.routed_goal = Some(goal);
+            self.routed_at = measured.t;
+            match router.start(scene.map, &measured.p, &goal) {
+                Ok(search) => self.route_search = Some((reason, search)),
+                Err(e) => {
+                    self.route_search = None;
+                    cycle.events.push(route_failed(reason, &e));
+                    return;
+                }
+            }
+        }
+        let Some((reason, search)) = self.route_search.as_mut() else {
             return;
         };
-        let (route, event) = spans.time(Span::Route, || {
-            plan_route(router, scene.map, &measured.p, &goal, reason)
+        let reason = *reason;
+        let progress = spans.time(Span::Route, || {
+            search.advance(scene.map, router.work_per_cycle())
         });
-        cycle.events.push(event);
-        self.routed_goal = Some(goal);
-        self.routed_at = measured.t;
-        if let Some(route) = route {
+        let answer = match progress {
+            RouteProgress::Pending => return,
+            answer => answer,
+        };
+        self.route_search = None;
+        let new_route = match answer {
+            RouteProgress::Found(route) => {
+                self.unreachable = None;
+                cycle.events.push(rerouted(reason, &route));
+                Some(route)
+            }
+            RouteProgress::Unreachable(verdict) => {
+                let held_at = verdict
+                    .nearest
+                    .as_ref()
+                    .and_then(|r| r.points().last().copied());
+                let since_t = self.unreachable.as_ref().map_or(measured.t, |u| u.since_t);
+                let cause = verdict.cause.to_string();
+                cycle.events.push(Event::GoalUnreachable {
+                    cause: cause.clone(),
+                    held_at: held_at.map(|p| [p.x, p.y, p.z]),
+                });
+                self.unreachable = Some(crate::GoalUnreachable {
+                    cause,
+                    held_at: held_at.map(|p| [p.x, p.y, p.z]),
+                    since_t,
+                });
+                verdict.nearest
+            }
+            RouteProgress::Failed(e) => {
+                cycle.events.push(route_failed(reason, &e));
+                None
+            }
+            // A future kind of answer: keep the previous route.
+            _ => None,
+        };
+        if let Some(route) = new_route {
             let before = self.progress_at(&measured.p, &goal);
             self.route = Some(route);
             let after = self.progress_at(&measured.p, &goal);
@@ -573,10 +680,12 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             newly_stalled,
             reanchored,
             weights: self.params.ranking_weights(&self.limits),
-            deadline: self
-                .params
-                .enforce_budget
-                .then(|| started + Duration::from_secs_f64(self.params.cycle_budget_ms * 1e-3)),
+            deadline: self.params.enforce_budget.then(|| {
+                started
+                    + Duration::from_secs_f64(
+                        SOLVE_DEADLINE_FRACTION * self.params.cycle_budget_ms * 1e-3,
+                    )
+            }),
             explore,
             events,
             rejected: Vec::new(),
@@ -1250,6 +1359,10 @@ fn check_step_input(
     scene.check_in_bounds("goal", goal)?;
     scene.check_static_free("goal", goal, 0.0)
 }
+
+/// A vehicle slower than this fraction of `v_max` is at rest for
+/// [`Manager::awaiting_first_route`] (2 %: a hover's tracking jitter, not a flight).
+const REST_SPEED_FRACTION: f64 = 0.02;
 
 /// What one cycle carries from step to step of [`Manager::step`].
 struct Cycle {

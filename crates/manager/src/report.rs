@@ -189,6 +189,9 @@ pub enum Event {
         /// The route planner's error message.
         error: String,
     },
+    /// The vehicle is at rest and its first route toward the goal is still being searched: it
+    /// holds its place meanwhile ([`crate::routing`]).
+    AwaitingRoute,
     /// The route planner proved the goal cannot be reached ([`GoalUnreachable`]); the manager
     /// holds a stop at the reachable point nearest the goal and re-checks.
     GoalUnreachable {
@@ -248,6 +251,7 @@ impl Event {
             Event::Rerouted { .. } => "rerouted",
             Event::RouteFailed { .. } => "route_failed",
             Event::GoalUnreachable { .. } => "goal_unreachable",
+            Event::AwaitingRoute => "awaiting_route",
         }
     }
 }

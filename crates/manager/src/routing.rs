@@ -1,29 +1,34 @@
-//! The manager's own global route (issue 19, beyond the paper): planned on the known static map
-//! before the first cycle toward a goal, and again when the progress monitor declares a stall.
+//! The manager's own global route (beyond the paper): searched on the known static map toward a
+//! goal, and again when the progress monitor declares a stall or, while the goal is held
+//! unreachable, every re-check period.
 //!
-//! [`Router`] pairs a [`RoutePlanner`] with the vehicle radius it inflates the map by. Given to
-//! the manager with [`crate::Manager::set_router`], it makes the manager plan its route itself:
+//! [`Router`] pairs a [`RoutePlanner`] with the vehicle radius it inflates the map by and the
+//! work it may do per cycle. Given to the manager with [`crate::Manager::set_router`], it makes
+//! the manager route itself, from the measured position (a vehicle pushed off its route by
+//! traffic gets a route from where it is):
 //!
-//! * on the first cycle toward a goal (and whenever the goal moves), from the measured position;
-//! * when the progress monitor reports [`crate::Event::Stalled`], from the measured position —
-//!   a vehicle pushed off its route by traffic gets a route from where it is, not a projection
-//!   onto a corridor it left.
+//! * a search ([`trust_route::RouteSearch`]) starts on the first cycle toward a goal (and
+//!   whenever the goal moves), on a stall, and on a re-check;
+//! * each cycle it does at most [`Router::work_per_cycle`] units of work (deterministic: the
+//!   answer does not depend on the slicing), so no cycle waits for a search; meanwhile the
+//!   vehicle flies the previous route, or toward the goal without one;
+//! * its answer is reported as [`crate::Event::Rerouted`] (why, length, vertices),
+//!   [`crate::Event::GoalUnreachable`] (the cause; the manager then plans toward the reachable
+//!   point nearest the goal and holds a stop there, [`crate::StepReport::goal_unreachable`]) or
+//!   [`crate::Event::RouteFailed`] (a cap, no free cell: the previous route stays).
 //!
-//! Each plan is reported as [`crate::Event::Rerouted`] (why, length, vertices) or, when
-//! the route planner fails (unreachable goal, a cap), [`crate::Event::RouteFailed`] with the
-//! typed error's message; the manager then keeps the previous route, or flies without one (the
-//! paper's setting: every query aims at the final goal). The planning time is the cycle's
-//! `route_ms` ([`crate::CycleTiming::route_ms`]).
+//! The work's time is the cycle's `route_ms` ([`crate::CycleTiming::route_ms`]).
 
 use trust_core::{PlanError, Vec3};
 use trust_geometry::StaticMap;
-use trust_route::{GlobalRoute, RouteError, RouteParams, RoutePlanner};
+use trust_route::{GlobalRoute, RouteError, RouteParams, RoutePlanner, RouteSearch};
 
 /// A route planner and the vehicle radius it plans for ([`crate::Manager::set_router`]).
 #[derive(Debug, Clone)]
 pub struct Router {
     planner: RoutePlanner,
     radius_m: f64,
+    work_per_cycle: usize,
 }
 
 impl Router {
@@ -48,7 +53,11 @@ impl Router {
             } => PlanError::invalid(&field, value, &expected),
             other => PlanError::invalid("route", other.to_string(), "valid route parameters"),
         })?;
-        Ok(Self { planner, radius_m })
+        Ok(Self {
+            planner,
+            radius_m,
+            work_per_cycle: ROUTE_WORK_PER_CYCLE,
+        })
     }
 
     /// The route planner's parameters.
@@ -61,7 +70,7 @@ impl Router {
         self.radius_m
     }
 
-    /// Plans a route from `start` to `goal` on `map`.
+    /// Plans a route from `start` to `goal` on `map` in one call (no work bound).
     ///
     /// # Errors
     /// The route planner's typed [`RouteError`].
@@ -73,7 +82,47 @@ impl Router {
     ) -> Result<GlobalRoute, RouteError> {
         self.planner.plan(map, start, goal, self.radius_m)
     }
+
+    /// Starts a resumable search from `start` to `goal` on `map` ([`RoutePlanner::start_search`]).
+    ///
+    /// # Errors
+    /// The route planner's typed [`RouteError`] for invalid input.
+    pub fn start(
+        &self,
+        map: &StaticMap,
+        start: &Vec3,
+        goal: &Vec3,
+    ) -> Result<RouteSearch, RouteError> {
+        self.planner.start_search(map, start, goal, self.radius_m)
+    }
+
+    /// Units of route-search work per planning cycle ([`trust_route::RouteSearch::advance`]).
+    pub fn work_per_cycle(&self) -> usize {
+        self.work_per_cycle
+    }
+
+    /// Sets [`Router::work_per_cycle`] (at least 1).
+    pub fn with_work_per_cycle(mut self, work: usize) -> Self {
+        self.work_per_cycle = work.max(1);
+        self
+    }
+
+    /// How often a verdict that the goal cannot be reached is re-checked (s).
+    pub fn recheck_s(&self) -> f64 {
+        RECHECK_S
+    }
 }
+
+/// Default [`Router::work_per_cycle`]: 16 000 units (distance queries, line-of-sight
+/// queries and expansions): a few milliseconds on analytic shapes and less on a voxel ESDF
+/// (`trust_route`'s crate docs give the measured cost of a unit), so the route's slice stays a
+/// small part of the 50 ms cycle budget, while a goal sealed in a room-sized box gets its
+/// verdict within a few cycles.
+pub const ROUTE_WORK_PER_CYCLE: usize = 16_000;
+
+/// How often a standing verdict that the goal cannot be reached is re-checked (s): a new search
+/// from the vehicle's position, in case the map or the obstacles changed.
+pub const RECHECK_S: f64 = 2.0;
 
 /// Why the manager planned a route ([`crate::Event::Rerouted`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -82,6 +131,8 @@ pub(crate) enum RouteReason {
     First,
     /// The progress monitor declared a stall.
     Stalled,
+    /// The goal is held unreachable: the verdict is checked again.
+    Recheck,
 }
 
 impl RouteReason {
@@ -89,33 +140,24 @@ impl RouteReason {
         match self {
             RouteReason::First => "first",
             RouteReason::Stalled => "stalled",
+            RouteReason::Recheck => "recheck",
         }
     }
 }
 
-/// Plans with `router` and reports the result as an event; the new route on success.
-pub(crate) fn plan_route(
-    router: &Router,
-    map: &StaticMap,
-    from: &Vec3,
-    goal: &Vec3,
-    reason: RouteReason,
-) -> (Option<GlobalRoute>, crate::Event) {
-    match router.plan(map, from, goal) {
-        Ok(route) => {
-            let event = crate::Event::Rerouted {
-                reason: reason.as_str().to_owned(),
-                length_m: route.length(),
-                vertex_count: route.points().len(),
-            };
-            (Some(route), event)
-        }
-        Err(e) => (
-            None,
-            crate::Event::RouteFailed {
-                reason: reason.as_str().to_owned(),
-                error: e.to_string(),
-            },
-        ),
+/// The event for a new route.
+pub(crate) fn rerouted(reason: RouteReason, route: &GlobalRoute) -> crate::Event {
+    crate::Event::Rerouted {
+        reason: reason.as_str().to_owned(),
+        length_m: route.length(),
+        vertex_count: route.points().len(),
+    }
+}
+
+/// The event for a search that stopped without an answer.
+pub(crate) fn route_failed(reason: RouteReason, error: &RouteError) -> crate::Event {
+    crate::Event::RouteFailed {
+        reason: reason.as_str().to_owned(),
+        error: error.to_string(),
     }
 }

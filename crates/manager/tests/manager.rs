@@ -1211,8 +1211,9 @@ fn with_a_route_a_wide_wall_ahead_is_flown_around_to_the_goal() {
     // It never touched the wall (the safety check passed every committed plan).
     assert!(reports.iter().all(|r| r.fallback.is_none()));
 
-    // The same with the manager planning its own route (a router): it plans on the first cycle,
-    // says so, and arrives as well.
+    // The same with the manager planning its own route (a router): the search starts on the
+    // first cycle and gets a slice of work per cycle; the vehicle holds its place until the
+    // route is found (`awaiting_route`), says so, and arrives as well.
     let mut m = planner(ManagerParams::trust());
     m.set_router(Some(
         trust_manager::Router::new(trust_route::RouteParams::default(), 0.3).unwrap(),
@@ -1220,17 +1221,29 @@ fn with_a_route_a_wide_wall_ahead_is_flown_around_to_the_goal() {
     let reports = fly(&mut m, &map, goal, State::at_rest(0.0, start), 150, |_| {
         Vec::new()
     });
+    let routed = reports
+        .iter()
+        .position(|r| r.events.iter().any(|e| matches!(e, Event::Rerouted { .. })))
+        .expect("a route");
+    assert!(routed < 10, "the first route took {routed} cycles");
     assert!(
         matches!(
-            reports[0].events.first(),
+            reports[routed].events.iter().find(|e| matches!(e, Event::Rerouted { .. })),
             Some(Event::Rerouted { reason, vertex_count, .. }) if reason == "first" && *vertex_count >= 3
         ),
         "{:?}",
-        reports[0].events
+        reports[routed].events
     );
-    assert!(reports[0].timing.route_ms > 0.0);
+    for r in &reports[..routed] {
+        assert!(r.event_tags().contains(&"awaiting_route"), "{:?}", r.events);
+        assert!(
+            (r.replan_start.p - start).norm() < 1e-3,
+            "it held its place"
+        );
+    }
+    assert!(reports[..=routed].iter().all(|r| r.timing.route_ms > 0.0));
     assert!(
-        reports[1..]
+        reports[routed + 1..]
             .iter()
             .all(|r| !r.events.iter().any(|e| matches!(e, Event::Rerouted { .. }))),
         "no re-plan without a stall"
@@ -1244,6 +1257,85 @@ fn with_a_route_a_wide_wall_ahead_is_flown_around_to_the_goal() {
     // A bad radius is a typed error naming the field.
     let e = trust_manager::Router::new(trust_route::RouteParams::default(), f64::NAN).unwrap_err();
     assert!(e.to_string().contains("route.radius_m"), "{e}");
+}
+
+/// Issue 31: a goal sealed inside a closed box. The route search proves it in a few cycles, the
+/// manager reports the verdict with its cause, plans toward the reachable point nearest the goal
+/// (outside the box) and keeps re-checking; the vehicle never enters the box's walls.
+#[test]
+fn a_sealed_goal_is_reported_unreachable_and_a_stop_is_held_outside() {
+    let bounds = Aabb::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(40.0, 20.0, 10.0)).unwrap();
+    let (lo, hi, t) = (Vec3::new(24.0, 8.0, 2.0), Vec3::new(28.0, 12.0, 5.0), 0.4);
+    let slab = |a: Vec3, b: Vec3| Shape::AaBox(AaBox::new(a, b).unwrap());
+    let walls = vec![
+        slab(
+            Vec3::new(lo.x - t, lo.y - t, lo.z - t),
+            Vec3::new(hi.x + t, hi.y + t, lo.z),
+        ),
+        slab(
+            Vec3::new(lo.x - t, lo.y - t, hi.z),
+            Vec3::new(hi.x + t, hi.y + t, hi.z + t),
+        ),
+        slab(
+            Vec3::new(lo.x - t, lo.y - t, lo.z),
+            Vec3::new(lo.x, hi.y + t, hi.z),
+        ),
+        slab(
+            Vec3::new(hi.x, lo.y - t, lo.z),
+            Vec3::new(hi.x + t, hi.y + t, hi.z),
+        ),
+        slab(Vec3::new(lo.x, lo.y - t, lo.z), Vec3::new(hi.x, lo.y, hi.z)),
+        slab(Vec3::new(lo.x, hi.y, lo.z), Vec3::new(hi.x, hi.y + t, hi.z)),
+    ];
+    let map = StaticMap::from_shapes(bounds, walls).unwrap();
+    let (start, goal) = (Vec3::new(3.0, 10.0, 3.5), Vec3::new(26.0, 10.0, 3.5));
+    let mut m = planner(ManagerParams::trust());
+    m.set_router(Some(
+        trust_manager::Router::new(trust_route::RouteParams::default(), 0.3).unwrap(),
+    ));
+    let reports = fly(&mut m, &map, goal, State::at_rest(0.0, start), 60, |_| {
+        Vec::new()
+    });
+    let verdict = reports
+        .iter()
+        .position(|r| r.goal_unreachable().is_some())
+        .expect("a verdict");
+    assert!(verdict < 10, "the verdict took {verdict} cycles");
+    let u = reports[verdict].goal_unreachable().unwrap();
+    assert!(u.cause.contains("sealed"), "{}", u.cause);
+    let held = u.held_at.expect("a reachable point nearest the goal");
+    let held = Vec3::new(held[0], held[1], held[2]);
+    assert!(map.signed_distance(&held) >= 0.3, "{held}");
+    assert!((held - goal).norm() < 4.0, "held at {held}, goal {goal}");
+    // The verdict stands (re-checked every 2 s, `since_t` kept) and the vehicle heads for the
+    // held point, never into the walls.
+    assert!(
+        reports[verdict..]
+            .iter()
+            .all(|r| r.goal_unreachable().is_some())
+    );
+    let since = reports.last().unwrap().goal_unreachable().unwrap().since_t;
+    assert_eq!(since, u.since_t);
+    assert!(since <= reports[verdict].t);
+    let end = reports.last().unwrap().replan_start.p;
+    assert!((end - held).norm() < (start - held).norm() - 5.0, "{end}");
+    let closest = reports
+        .iter()
+        .map(|r| map.signed_distance(&r.replan_start.p))
+        .fold(f64::INFINITY, f64::min);
+    // The library's default safety clearance is 0 (a point vehicle): never inside a wall.
+    assert!(closest > 0.0, "{closest} m from the walls (held at {held})");
+    assert!(
+        reports
+            .iter()
+            .filter(|r| r
+                .events
+                .iter()
+                .any(|e| matches!(e, Event::GoalUnreachable { .. })))
+            .count()
+            >= 2,
+        "re-checked"
+    );
 }
 
 /// A backend that always answers with a 0.04 s hover at the start: what UTF-MINCO returned when
