@@ -62,13 +62,12 @@ pub enum UnreachableCause {
         /// The goal's signed distance to the nearest obstacle, in metres (negative inside).
         signed_distance_m: f64,
     },
-    /// No opening joins the start and the goal even at the vehicle radius alone (no margin).
-    /// Proved on a grid of cell `h` (the fine grid, see the crate docs): every opening is
-    /// narrower than `2·radius + h` (for a slot between parallel faces, in any orientation).
+    /// No path keeps the inflated clearance (proved, see the crate docs), and the grid finds
+    /// none at the vehicle radius alone either: any remaining opening is narrower than about
+    /// `2·radius + h` (`h` the fine grid's cell size).
     SealedOff,
-    /// The start and the goal are joined at the vehicle radius but not at the inflated
-    /// clearance: every opening is narrower than `2·clearance_m + h` (`h` the cell size), so
-    /// the vehicle would have to give up its safety margin to pass.
+    /// No path keeps the inflated clearance (proved, see the crate docs), but one keeps the
+    /// vehicle radius: the vehicle would have to give up its safety margin to pass.
     TooNarrow {
         /// The inflated clearance the route must keep, in metres.
         clearance_m: f64,

@@ -50,7 +50,7 @@ pub(crate) struct Grid {
 
 impl Grid {
     /// The finest grid of cell size at least `h0` with at most `max_cells` cells, centred in
-    /// `bounds`; [`RouteError::TooManyCells`] if that needs cells larger than `max_h`.
+    /// `bounds` with its outer centres at most `h/2` inside them; [`RouteError::TooManyCells`] if that needs cells larger than `max_h`.
     pub(crate) fn new(
         bounds: &Aabb,
         h0: f64,
@@ -59,8 +59,10 @@ impl Grid {
     ) -> Result<Self, RouteError> {
         let ext = bounds.extent();
         let count = |h: f64| -> [usize; 3] {
-            // Capped far above any admissible count so the product stays in u128.
-            let n = |e: f64| (e / h).floor().clamp(1.0, 1.0e12) as usize;
+            // Enough cells that the outer centres lie within h/2 of the bounds (every point of
+            // the bounds within h·√3/2 of a centre); capped far above any admissible count so
+            // the product stays in u128.
+            let n = |e: f64| (e / h).ceil().clamp(1.0, 1.0e12) as usize;
             [n(ext.x), n(ext.y), n(ext.z)]
         };
         let cells = |d: [usize; 3]| d.iter().map(|&n| n as u128).product::<u128>();

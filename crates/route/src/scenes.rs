@@ -1,7 +1,9 @@
 //! Standard maps for benchmarks, examples and tests of the route planner: an E4-size world
 //! (250 × 75 × 20 m of blocks, walls and pillars, optionally a 30 m wall across the straight line)
 //! and a Crazyflie-scale room (8 × 6 × 3 m with four 5 cm pillars and a wall across most of the
-//! middle). Deterministic for a seed.
+//! middle); the tail cases (a goal sealed in a closed box 35 m from the start, in a room and in
+//! an E4 world; a full wall with one slot); a point cloud of a map's shapes, for the same world
+//! as a voxel ESDF. Deterministic for a seed.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -17,6 +19,12 @@ pub const E4_START_GOAL: [[f64; 3]; 2] = [[2.0, 37.5, 5.0], [248.0, 37.5, 5.0]];
 /// # Errors
 /// None in practice (every shape is valid); the map constructor's error is passed on.
 pub fn e4_like(seed: u64, wall: bool) -> Result<StaticMap, GeometryError> {
+    let bounds = Aabb::new(Vec3::zeros(), Vec3::new(250.0, 75.0, 20.0))?;
+    StaticMap::from_shapes(bounds, e4_shapes(seed, wall)?)
+}
+
+/// The shapes of [`e4_like`].
+fn e4_shapes(seed: u64, wall: bool) -> Result<Vec<Shape>, GeometryError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut shapes: Vec<Shape> = Vec::new();
     let x = |rng: &mut ChaCha8Rng| rng.random_range(12.0..238.0);
@@ -47,8 +55,106 @@ pub fn e4_like(seed: u64, wall: bool) -> Result<StaticMap, GeometryError> {
         let c = Vec3::new(27.0, 37.5, 10.0);
         shapes.push(AaBox::from_center_half_extents(c, Vec3::new(0.5, 15.0, 10.0))?.into());
     }
+    Ok(shapes)
+}
+
+/// The six 0.3 m walls of a closed box of outer half-size `half` around `centre`.
+///
+/// # Errors
+/// None for a positive `half` above 0.3 m; the box constructor's error is passed on.
+pub fn closed_box(centre: Vec3, half: f64) -> Result<Vec<Shape>, GeometryError> {
+    let t = 0.3;
+    let (lo, hi) = (centre - Vec3::repeat(half), centre + Vec3::repeat(half));
+    let mut out = Vec::new();
+    for a in 0..3 {
+        for far in [false, true] {
+            let (mut min, mut max) = (lo, hi);
+            if far {
+                min[a] = hi[a] - t;
+            } else {
+                max[a] = lo[a] + t;
+            }
+            out.push(AaBox::new(min, max)?.into());
+        }
+    }
+    Ok(out)
+}
+
+/// A 60 × 20 × 10 m room with the goal sealed in a closed 4 m box 35 m from the start:
+/// the map, the start and the goal.
+///
+/// # Errors
+/// None in practice; the map constructor's error is passed on.
+pub fn sealed_goal_room() -> Result<(StaticMap, Vec3, Vec3), GeometryError> {
+    let (start, goal) = (Vec3::new(5.0, 10.0, 5.0), Vec3::new(40.0, 10.0, 5.0));
+    let bounds = Aabb::new(Vec3::zeros(), Vec3::new(60.0, 20.0, 10.0))?;
+    Ok((
+        StaticMap::from_shapes(bounds, closed_box(goal, 2.0)?)?,
+        start,
+        goal,
+    ))
+}
+
+/// The [`e4_like`] world (no wall) with the goal sealed in a closed 4 m box 35 m from the E4
+/// start: the map, the start and the goal.
+///
+/// # Errors
+/// None in practice; the map constructor's error is passed on.
+pub fn sealed_goal_e4(seed: u64) -> Result<(StaticMap, Vec3, Vec3), GeometryError> {
+    let start = Vec3::from(E4_START_GOAL[0]);
+    let goal = start + Vec3::new(35.0, 0.0, 0.0);
+    let mut shapes = e4_shapes(seed, false)?;
+    shapes.extend(closed_box(goal, 2.0)?);
     let bounds = Aabb::new(Vec3::zeros(), Vec3::new(250.0, 75.0, 20.0))?;
-    StaticMap::from_shapes(bounds, shapes)
+    Ok((StaticMap::from_shapes(bounds, shapes)?, start, goal))
+}
+
+/// A 60 × 20 × 10 m room cut at x = 30 m by a 1 m full wall with one vertical slot of `width`
+/// (from y = 10 m): the map, the start and the goal on either side.
+///
+/// # Errors
+/// An error for a non-positive `width`; the map constructor's error is passed on.
+pub fn slot_wall(width: f64) -> Result<(StaticMap, Vec3, Vec3), GeometryError> {
+    let bounds = Aabb::new(Vec3::zeros(), Vec3::new(60.0, 20.0, 10.0))?;
+    let shapes: Vec<Shape> = vec![
+        AaBox::new(Vec3::new(29.5, -1.0, -1.0), Vec3::new(30.5, 10.0, 11.0))?.into(),
+        AaBox::new(
+            Vec3::new(29.5, 10.0 + width, -1.0),
+            Vec3::new(30.5, 21.0, 11.0),
+        )?
+        .into(),
+    ];
+    Ok((
+        StaticMap::from_shapes(bounds, shapes)?,
+        Vec3::new(2.0, 5.0, 3.0),
+        Vec3::new(58.0, 5.0, 3.0),
+    ))
+}
+
+/// The points of a lattice of spacing `spacing` (offset by half a spacing) inside `map`'s
+/// bounds that lie inside one of its shapes: a point cloud of the map, for the same world as a
+/// voxel ESDF (`StaticMap::with_point_cloud`).
+pub fn shape_cloud(map: &StaticMap, spacing: f64) -> Vec<Vec3> {
+    let b = map.bounds();
+    let mut out = Vec::new();
+    for shape in map.shapes() {
+        let a = shape.aabb();
+        let lo = Vec3::from_fn(|i, _| a.min[i].max(b.min[i]));
+        let hi = Vec3::from_fn(|i, _| a.max[i].min(b.max[i]));
+        let n = |i: usize| ((hi[i] - lo[i]) / spacing).floor().max(0.0) as usize + 1;
+        for k in 0..n(2) {
+            for j in 0..n(1) {
+                for i in 0..n(0) {
+                    let p =
+                        lo + Vec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * spacing;
+                    if b.contains(&p) && shape.signed_distance(&p) <= 0.0 {
+                        out.push(p);
+                    }
+                }
+            }
+        }
+    }
+    out
 }
 
 /// An 8 × 6 × 3 m room with four 5 cm pillars and a wall across most of the middle (x = 4 m,

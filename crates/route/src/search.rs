@@ -341,9 +341,12 @@ impl Astar {
 struct Flood {
     flag: u8,
     level: f64,
-    /// Edges must be clear at `level` (a route); `false`: any two neighbouring cells at
-    /// `level` join (a relaxed flood, an over-approximation of the free space for a proof).
+    /// Edges must be clear at `level` (a route); `false`: any two neighbouring cells within
+    /// [`Flood::slack`] of `level` join (a relaxed flood, an over-approximation of the free
+    /// space for a proof).
     exact: bool,
+    /// For a relaxed flood: the distance from the bounds to the outer cell centres per axis.
+    margins: [f64; 3],
     target: usize,
     open: BinaryHeap<Open>,
     cur: Option<(usize, usize)>,
@@ -376,10 +379,33 @@ impl Flood {
             flag,
             level,
             exact,
+            margins: [0.0; 3],
             target,
             open,
             cur: None,
         }
+    }
+
+    /// How far below `level` cell `i`'s centre may be: 0 for an exact flood; for a relaxed one
+    /// the largest distance from a point of the bounds in the cell's Voronoi cube to its
+    /// centre: `h·√3/2`, more for the outer cells (the bounds lie up to `h` beyond them).
+    fn slack(&self, grid: &Grid, i: usize) -> f64 {
+        if self.exact {
+            return 0.0;
+        }
+        let c = grid.coords(i);
+        (0..3)
+            .map(|a| {
+                let outer = c[a] == 0 || c[a] as usize + 1 == grid.dims[a];
+                let w = if outer {
+                    self.margins[a].max(0.5 * grid.h)
+                } else {
+                    0.5 * grid.h
+                };
+                w * w
+            })
+            .sum::<f64>()
+            .sqrt()
     }
 
     /// One expansion. `met(i)`: cell `i` is known to be reachable from the other side.
@@ -400,7 +426,7 @@ impl Flood {
                 let c = layer.grid.coords(i);
                 if let Some(j) = layer.grid.index([c[0] + d[0], c[1] + d[1], c[2] + d[2]])
                     && layer.flags[j] & self.flag == 0
-                    && layer.sd(map, j, m)? >= self.level
+                    && layer.sd(map, j, m)? >= self.level - self.slack(&layer.grid, j)
                     && (!self.exact || layer.edge_clear(map, i, j, self.level, m)?)
                 {
                     layer.flags[j] |= self.flag;
@@ -1137,11 +1163,14 @@ impl RouteSearch {
 
     /// The checks of a verdict once a side is exhausted on the grid ([`RCheck`]): `None` when
     /// the over-approximation at the clearance joins the two sides (no verdict), else
-    /// `TooNarrow` or `SealedOff`. The relaxed floods take every cell whose centre is at least
-    /// `level − L·h·√3/2` from the obstacles (`L` the map's slope bound) and join neighbours
-    /// without an edge check: every point at least `level` from the obstacles lies in such a
-    /// cell's cube, and a path through free space crosses from cube to neighbouring cube, so an
-    /// exhausted relaxed flood proves that no path keeps `level` at any resolution.
+    /// `TooNarrow` or `SealedOff`. The relaxed flood takes every cell whose centre is at least
+    /// `c − h·√3/2` from the obstacles (a little more slack at the bounds) and joins neighbours
+    /// without an edge check: every point at least `c` from the obstacles lies in such a cell's
+    /// Voronoi cube, and a path through free space crosses from cube to neighbouring cube, so an
+    /// exhausted relaxed flood proves that no path keeps `c` at any resolution. The cause then
+    /// comes from an exact flood at the radius: `TooNarrow` if it joins the sides (a route
+    /// without the margin exists), `SealedOff` if not (no route at the radius that the grid
+    /// resolves).
     fn rcheck(
         &mut self,
         map: &StaticMap,
@@ -1153,7 +1182,7 @@ impl RouteSearch {
         let r = self.radius;
         let fine = self.fine;
         let grid = self.layers[fine].grid;
-        let slack = self.layers[fine].lipschitz * grid.h * 3.0_f64.sqrt() / 2.0;
+        let margins: [f64; 3] = std::array::from_fn(|a| grid.origin[a] - map.bounds().min[a]);
         let narrow = UnreachableCause::TooNarrow { clearance_m: c };
         let mut rc = self.rcheck.take().expect("rcheck");
         let res = (|| {
@@ -1190,9 +1219,10 @@ impl RouteSearch {
             };
             let layer = &mut self.layers[fine];
             if !rc.proved {
-                let flood = rc
-                    .flood
-                    .get_or_insert_with(|| Flood::new(layer, from, to, FLOOD_CR, c - slack, false));
+                let flood = rc.flood.get_or_insert_with(|| Flood {
+                    margins,
+                    ..Flood::new(layer, from, to, FLOOD_CR, c, false)
+                });
                 loop {
                     match flood.step(layer, map, m, |_, _| false)? {
                         FloodStep::Expanded => {}
@@ -1209,7 +1239,7 @@ impl RouteSearch {
             }
             let flood = rc
                 .flood
-                .get_or_insert_with(|| Flood::new(layer, from, to, FLOOD_R, r - slack, false));
+                .get_or_insert_with(|| Flood::new(layer, from, to, FLOOD_R, r, true));
             loop {
                 match flood.step(layer, map, m, |_, _| false)? {
                     FloodStep::Expanded => {}

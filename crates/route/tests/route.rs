@@ -739,10 +739,32 @@ fn slots_as_wide_as_the_docs_promise_are_open_and_narrower_ones_too_narrow() {
         assert!(matches!(e, RouteError::Unresolved { .. }), "{e}");
         assert!(e.to_string().contains("clearance 0.3 m"), "{e}");
     }
-    // Narrow enough for the proof at the clearance, not at the radius: too narrow.
+    // Narrow enough for the proof at the clearance, too narrow for the vehicle: sealed off.
     for at in [1.0, 1.05, 1.1] {
         let (map, s, g) = slot_world(SlotAxis::Y, 0.3, at);
         let e = planner().plan(&map, &s, &g, r).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                RouteError::Unreachable {
+                    cause: UnreachableCause::SealedOff,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
+    // Wide enough for the vehicle (2r + h = 0.55 m), not for a clearance of c = 0.6 m (margin
+    // twice the radius, h = 0.15 m): the proof at c holds below 2(c − h·√3/2) = 0.94 m.
+    let wide_margin = RoutePlanner::new(RouteParams {
+        margin_radius_factor: 2.0,
+        cells_per_clearance: 4.0,
+        ..RouteParams::default()
+    })
+    .unwrap();
+    for at in [1.0, 1.05, 1.1] {
+        let (map, s, g) = slot_world(SlotAxis::Y, 0.7, at);
+        let e = wide_margin.plan(&map, &s, &g, r).unwrap_err();
         assert!(
             matches!(
                 e,
@@ -753,12 +775,8 @@ fn slots_as_wide_as_the_docs_promise_are_open_and_narrower_ones_too_narrow() {
             ),
             "{e}"
         );
-        assert!(e.to_string().contains("clearance of 0.3 m"), "{e}");
+        assert!(e.to_string().contains("clearance of 0.6 m"), "{e}");
     }
-    // Narrower than 2(r − h·√3/2) = 0.14 m: sealed off.
-    let (map, s, g) = slot_world(SlotAxis::Y, 0.1, 1.0);
-    let (p, _) = run_sliced(&map, s, g, r, usize::MAX);
-    assert_eq!(unreachable(&p).cause, UnreachableCause::SealedOff);
 }
 
 /// A 0.6 m slot between two 1 m walls (x from 5 to 6, y from 4.7 to 5.3) in a 12 × 10 × 3 m
