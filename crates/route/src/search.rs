@@ -341,9 +341,9 @@ impl Astar {
 struct Flood {
     flag: u8,
     level: f64,
-    /// Edges must be clear at `level` (a route); `false`: any two neighbouring cells within
-    /// [`Flood::slack`] of `level` join (a relaxed flood, an over-approximation of the free
-    /// space for a proof).
+    /// Edges must be clear at `level` (a route); `false`: face neighbours within
+    /// [`Flood::slack`] of `level` whose shared face may hold a point at `level` join (a relaxed
+    /// flood, an over-approximation of the free space for a proof).
     exact: bool,
     /// For a relaxed flood: the distance from the bounds to the outer cell centres per axis.
     margins: [f64; 3],
@@ -424,10 +424,20 @@ impl Flood {
                     return Ok(FloodStep::Expanded);
                 };
                 let c = layer.grid.coords(i);
-                if let Some(j) = layer.grid.index([c[0] + d[0], c[1] + d[1], c[2] + d[2]])
+                let face = d.iter().filter(|&&v| v != 0).count() == 1;
+                if (self.exact || face)
+                    && let Some(j) = layer.grid.index([c[0] + d[0], c[1] + d[1], c[2] + d[2]])
                     && layer.flags[j] & self.flag == 0
                     && layer.sd(map, j, m)? >= self.level - self.slack(&layer.grid, j)
-                    && (!self.exact || layer.edge_clear(map, i, j, self.level, m)?)
+                    && (if self.exact {
+                        layer.edge_clear(map, i, j, self.level, m)?
+                    } else {
+                        // A path crossing between the two cubes crosses their shared face,
+                        // a square of half-diagonal h/√2 around the midpoint of the centres.
+                        m.charge()?;
+                        let mid = 0.5 * (layer.grid.center_of(i) + layer.grid.center_of(j));
+                        map.signed_distance(&mid) >= self.level - layer.grid.h / 2.0_f64.sqrt()
+                    })
                 {
                     layer.flags[j] |= self.flag;
                     self.open.push(Open {
@@ -1164,10 +1174,12 @@ impl RouteSearch {
     /// The checks of a verdict once a side is exhausted on the grid ([`RCheck`]): `None` when
     /// the over-approximation at the clearance joins the two sides (no verdict), else
     /// `TooNarrow` or `SealedOff`. The relaxed flood takes every cell whose centre is at least
-    /// `c − h·√3/2` from the obstacles (a little more slack at the bounds) and joins neighbours
-    /// without an edge check: every point at least `c` from the obstacles lies in such a cell's
-    /// Voronoi cube, and a path through free space crosses from cube to neighbouring cube, so an
-    /// exhausted relaxed flood proves that no path keeps `c` at any resolution. The cause then
+    /// `c − h·√3/2` from the obstacles and joins two face neighbours when the centre of their
+    /// shared face is at least `c − h/√2` from the obstacles: every point at least `c` from
+    /// the obstacles lies in such a cell's Voronoi cube, and a path through free space passes
+    /// from cube to cube through shared faces (1-Lipschitz distance: a face point at `c` puts
+    /// the face centre within `h/√2` of it), so an exhausted relaxed flood proves that no path
+    /// keeps `c`, at any resolution (up to the rounding of the distance queries). The cause then
     /// comes from an exact flood at the radius: `TooNarrow` if it joins the sides (a route
     /// without the margin exists), `SealedOff` if not (no route at the radius that the grid
     /// resolves).
