@@ -4,7 +4,7 @@
 //! trust-sim run SCENARIO.toml [--planner NAME] [--seed S] [--out DIR] [--vehicle quadrotor|perfect]
 //!                             [--real-time [CPU_SCALE]]
 //! trust-sim validate SCENARIO.toml...
-//! trust-sim audit RUN.jsonl...
+//! trust-sim audit RUN.jsonl... [--cycles]
 //! trust-sim replay RUN.jsonl [--out DIR] [--gif-width PX] [--gif-frames N]
 //! trust-sim export RUN.jsonl --mcap FILE
 //! trust-sim ablate [--scenario FILE] [--trials N] [--seed S] [--planners a,b] [--variant V]
@@ -29,8 +29,6 @@ use trust_experiments::flight_plots::write_flight_plots;
 use trust_experiments::study::{RunStudyOptions, Shard, StudyConfig, merge, run_study};
 use trust_experiments::suite::{SuiteConfig, SuiteOptions, expand_paths, run_suite};
 use trust_flight::{RunOptions, fly, header};
-use trust_runlog::RunLog;
-use trust_runlog::audit::audit;
 use trust_world::World;
 use trust_world::planner::PlannerPreset;
 use trust_world::scenario::{Latency, MAX_CPU_SCALE, Scenario, VehicleModel};
@@ -219,6 +217,10 @@ enum Cmd {
         /// Run logs (JSON Lines).
         #[arg(required = true)]
         logs: Vec<PathBuf>,
+        /// Also check the cycle records against the contract (t, wall_ms ≥ 0, main, branches,
+        /// events; t within the flight).
+        #[arg(long)]
+        cycles: bool,
     },
     /// Export a run log for other tools: `--mcap FILE` writes an MCAP file that Foxglove (or
     /// Lichtblick) replays in 3-D and `ros2 bag` reads (pose and path as ROS 2 messages).
@@ -483,29 +485,31 @@ fn run_cli() -> Result<ExitCode> {
                 ExitCode::FAILURE
             })
         }
-        Cmd::Audit { logs } => {
+        Cmd::Audit { logs, cycles } => {
             let mut bad = 0;
             for path in &logs {
-                let log = RunLog::read(path)?;
-                let dir = path.parent().unwrap_or(Path::new("."));
-                let a = audit(&log, dir).map_err(anyhow::Error::msg)?;
+                // Streamed: an hour's log is audited in the memory of one line.
+                let a = trust_runlog::audit::audit_file(
+                    path,
+                    trust_runlog::audit::AuditOptions { cycles },
+                )?;
                 if a.passed() {
                     out!(
-                        "{}: ok ({}, {} states)",
+                        "{}: ok ({}, {} states{})",
                         path.display(),
-                        log.outcome.status.as_str(),
-                        log.states.len()
+                        a.logged_status.as_str(),
+                        a.state_count,
+                        if cycles {
+                            format!(", {} cycles", a.cycle_count)
+                        } else {
+                            String::new()
+                        }
                     );
                 } else {
                     bad += 1;
                     out!("{}: {} disagreement(s)", path.display(), a.findings.len());
                     for f in &a.findings {
-                        out!(
-                            "  {}: logged {}, states say {}",
-                            f.field,
-                            f.logged,
-                            f.recomputed
-                        );
+                        out!("  {f}");
                     }
                 }
             }
