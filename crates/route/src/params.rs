@@ -49,16 +49,17 @@ pub struct RouteParams {
     /// `snap_radius_factor · c`. Range `[0, 100]`; default 4.
     pub snap_radius_factor: f64,
     /// Coarse to fine: the search first runs on cells `coarse_factor` times larger than `h₀`
-    /// and only falls back to `h₀` when that grid finds no route (a passage narrower than its
-    /// inflated cells). Range `[1, 64]`, `1` searches the fine grid only; default 4: a coarse
-    /// route is as safe (a coarse cell is free only farther from the obstacles) and the search
+    /// and only falls back to `h₀` when that grid finds no route (a slot narrower than `2c`
+    /// plus its cell). Range `[1, 64]`, `1` searches the fine grid only; default 4: a coarse
+    /// route is as safe (its edges are checked at `c` like the fine ones) and the search
     /// touches 4³ = 64 times fewer cells — on the suite's shaft climb (a 40 × 40 m slab with one
     /// 4 × 4 m shaft, the search fills the whole space below the slab) the first cycle took 3.3 s,
     /// now 18 ms, 15 ms of it the route (`route_ms` of `trust-sim run scenarios/suite/shaft_climb.toml`).
     pub coarse_factor: f64,
     /// After a coarse route is found, a fine grid (at `h₀`) of at most this many cells is
-    /// searched too, and the shorter of the two routes is kept. The coarse grid closes passages
-    /// narrower than about `2(c + coarse_factor·h₀·√3/2)` (1.8 m for a 0.22 m vehicle): in a
+    /// searched too, and the shorter of the two routes is kept. The coarse grid may close passages
+    /// narrower than `2c + coarse_factor·h₀` (then `2(c + coarse_factor·h₀·√3/2)`, 1.8 m for a
+    /// 0.22 m vehicle): in a
     /// 12 × 10 × 3 m store with 2.4 m aisles the coarse route went round the shelves, 11.7 m for
     /// 9.3 m, and the flight took 3.4 × d/v_max. Small grids are cheap to search (every room of
     /// the suite, the variants and two holdout sets: ≤ 2 ms), large ones are not (a 40 × 40 m
