@@ -113,12 +113,12 @@ impl Router {
     }
 }
 
-/// Default [`Router::work_per_cycle`]: 16 000 units (distance queries, line-of-sight
-/// queries and expansions): a few milliseconds on analytic shapes and less on a voxel ESDF
-/// (`trust_route`'s crate docs give the measured cost of a unit), so the route's slice stays a
-/// small part of the 50 ms cycle budget, while a goal sealed in a room-sized box gets its
-/// verdict within a few cycles.
-pub const ROUTE_WORK_PER_CYCLE: usize = 16_000;
+/// Default [`Router::work_per_cycle`]: 8 000 units (distance queries, line-of-sight queries and
+/// expansions). A unit costs 1–3 µs (`cargo run --release -p trust-route --example
+/// route_timing`), so a slice takes about 8–25 ms of the 50 ms cycle budget; the suite's U-trap
+/// route (about 60 000 units) arrives in 8 cycles, a goal sealed in a room-sized box gets its
+/// verdict in 1–3.
+pub const ROUTE_WORK_PER_CYCLE: usize = 8_000;
 
 /// How often a standing verdict that the goal cannot be reached is re-checked (s): a new search
 /// from the vehicle's position, in case the map or the obstacles changed.
