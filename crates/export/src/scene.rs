@@ -77,14 +77,14 @@ fn cylinder(center: [f64; 3], radius: f64, height: f64, c: Value) -> Value {
            "bottom_scale": 1.0, "top_scale": 1.0, "color": c})
 }
 
-/// A line primitive: `kind` 0 = strip, 2 = list.
+/// A line primitive: `kind` 0 = strip, 2 = list; points rounded to the millimetre.
 fn line(kind: u8, points: &[[f64; 3]], thickness: f64, c: Value) -> Value {
     json!({
         "type": kind,
         "pose": pose([0.0; 3], 0.0),
         "thickness": thickness,
         "scale_invariant": true,
-        "points": points.iter().map(|p| vec3(*p)).collect::<Vec<_>>(),
+        "points": points.iter().map(|p| vec3([mm(p[0]), mm(p[1]), mm(p[2])])).collect::<Vec<_>>(),
         "color": c,
         "colors": [],
         "indices": [],
@@ -107,35 +107,44 @@ pub(crate) fn frame_transform(s: &StateRecord, yaw: f64) -> Value {
     })
 }
 
-/// `/scene/obstacles`: every moving obstacle at its true centre with its true shape.
+/// A coordinate rounded to the millimetre (obstacles, paths and branches are the bulk of the
+/// file; a millimetre is far below what a viewer draws).
+fn mm(x: f64) -> f64 {
+    (x * 1e3).round() / 1e3
+}
+
+/// `/scene/obstacles`: every moving obstacle at its true centre with its true shape (both to the
+/// millimetre); one entity per shape kind, its primitives in id order.
 pub(crate) fn obstacles_update(h: &Header, s: &StateRecord) -> Value {
     let red = || color(0.9, 0.25, 0.2, 0.8);
-    let entities = h
-        .obstacles
-        .iter()
-        .zip(&s.obstacles)
-        .map(|(o, c)| {
-            let id = format!("obstacle:{}", o.id);
-            match o.shape {
-                ObstacleKind::Sphere => {
-                    entity(s.t, &id, &[("spheres", vec![sphere(*c, o.radius, red())])])
-                }
-                ObstacleKind::Cylinder => {
-                    let height = 2.0 * o.half_height.unwrap_or(0.0);
-                    entity(
-                        s.t,
-                        &id,
-                        &[("cylinders", vec![cylinder(*c, o.radius, height, red())])],
-                    )
-                }
-                ObstacleKind::Box => {
-                    let e = o.half_extents.unwrap_or([0.0; 3]);
-                    let size = [2.0 * e[0], 2.0 * e[1], 2.0 * e[2]];
-                    entity(s.t, &id, &[("cubes", vec![cube(*c, size, red())])])
-                }
+    let (mut spheres, mut cylinders, mut cubes) = (Vec::new(), Vec::new(), Vec::new());
+    for (o, c) in h.obstacles.iter().zip(&s.obstacles) {
+        let c = [mm(c[0]), mm(c[1]), mm(c[2])];
+        match o.shape {
+            ObstacleKind::Sphere => spheres.push(sphere(c, mm(o.radius), red())),
+            ObstacleKind::Cylinder => {
+                let height = 2.0 * o.half_height.unwrap_or(0.0);
+                cylinders.push(cylinder(c, mm(o.radius), mm(height), red()));
             }
-        })
-        .collect();
+            ObstacleKind::Box => {
+                let e = o.half_extents.unwrap_or([0.0; 3]);
+                cubes.push(cube(
+                    c,
+                    [mm(2.0 * e[0]), mm(2.0 * e[1]), mm(2.0 * e[2])],
+                    red(),
+                ));
+            }
+        }
+    }
+    let entities = [
+        ("obstacles:spheres", "spheres", spheres),
+        ("obstacles:cylinders", "cylinders", cylinders),
+        ("obstacles:boxes", "cubes", cubes),
+    ]
+    .into_iter()
+    .filter(|(_, _, items)| !items.is_empty())
+    .map(|(id, list, items)| entity(s.t, id, &[(list, items)]))
+    .collect();
     update(entities)
 }
 
@@ -219,17 +228,25 @@ pub(crate) fn map_update(h: &Header, t: f64) -> Value {
     ])
 }
 
-/// `/scene/path`: the flown path so far.
-pub(crate) fn path_update(t: f64, path: &[(&StateRecord, f64)]) -> Value {
-    let points: Vec<[f64; 3]> = path.iter().map(|(s, _)| s.p).collect();
-    update(vec![entity(
-        t,
-        "flown_path",
-        &[(
-            "lines",
-            vec![line(0, &points, 3.0, color(0.1, 0.35, 0.9, 1.0))],
-        )],
-    )])
+/// `/scene/path`: segment `n` of the flown path (a new entity, kept by the viewer) and the whole
+/// path so far, coarse (entity `flown_path`, replaced).
+pub(crate) fn path_update(t: f64, n: u64, segment: &[[f64; 3]], coarse: &[[f64; 3]]) -> Value {
+    let blue = || color(0.1, 0.35, 0.9, 1.0);
+    update(vec![
+        entity(
+            t,
+            &format!("path:{n}"),
+            &[("lines", vec![line(0, segment, 3.0, blue())])],
+        ),
+        entity(
+            t,
+            "flown_path",
+            &[(
+                "lines",
+                vec![line(0, coarse, 2.0, color(0.1, 0.35, 0.9, 0.5))],
+            )],
+        ),
+    ])
 }
 
 /// `/scene/branches`: the cycle's branches, main first in a strong colour, the others faint.

@@ -185,14 +185,15 @@ fn the_export_reads_back_with_the_mcap_reader() {
     .collect();
     assert_eq!(r.channels, expected);
 
-    // 101 states; paths at t = 0, 0.5, 1, 1.5, 2 s; one map; 20 cycles of branches.
+    // 101 states; obstacles every 0.1 s; scene paths at t = 0, 0.5, 1, 1.5, 2 s, ROS paths at
+    // 0 s and at the end; one map; 20 cycles of branches.
     let counts: BTreeMap<String, u64> = [
         ("/vehicle/pose", 101),
         ("/tf", 101),
-        ("/scene/obstacles", 101),
+        ("/scene/obstacles", 21),
         ("/ros/vehicle/pose", 101),
         ("/scene/path", 5),
-        ("/ros/vehicle/path", 5),
+        ("/ros/vehicle/path", 2),
         ("/scene/map", 1),
         ("/scene/branches", 20),
     ]
@@ -224,8 +225,10 @@ fn the_export_reads_back_with_the_mcap_reader() {
     assert_eq!(&cdr[..4], &[0, 1, 0, 0]);
     let f = |i: usize| f64::from_le_bytes(cdr[28 + 8 * i..36 + 8 * i].try_into().unwrap());
     assert_eq!([f(0), f(1), f(2)], [2.0, 1.5, 1.0]);
+    // One entity per shape kind.
     let obstacles = json(&at("/scene/obstacles", 0));
     let e = &obstacles["entities"];
+    assert_eq!(e[0]["id"], "obstacles:spheres");
     assert_eq!(e[0]["spheres"][0]["size"]["x"], 0.6);
     assert_eq!(e[1]["cylinders"][0]["size"]["z"], 1.8);
     assert_eq!(e[2]["cubes"][0]["size"]["x"], 1.0);
@@ -240,11 +243,19 @@ fn the_export_reads_back_with_the_mcap_reader() {
             .len(),
         24
     );
+    // The last scene path: the segment since 1.5 s (one point per 0.1 s, joined to the previous
+    // segment) and the whole path, coarse (every 0.1 s while it is this short).
     let last_path = json(&at("/scene/path", 2_000_000_000));
-    let points = last_path["entities"][0]["lines"][0]["points"]
-        .as_array()
-        .unwrap();
-    assert_eq!(points.len(), 21, "one point per 0.1 s over 2 s");
+    let line = |k: usize| {
+        last_path["entities"][k]["lines"][0]["points"]
+            .as_array()
+            .unwrap()
+            .len()
+    };
+    assert_eq!(last_path["entities"][0]["id"], "path:4");
+    assert_eq!(line(0), 6, "1.5, 1.6, …, 2.0 s");
+    assert_eq!(last_path["entities"][1]["id"], "flown_path");
+    assert_eq!(line(1), 21, "one point per 0.1 s over 2 s");
     let branches = json(&at("/scene/branches", 500_000_000));
     assert_eq!(
         branches["entities"][0]["lines"].as_array().unwrap().len(),
@@ -376,4 +387,86 @@ fn the_ros2_definitions_name_their_dependencies() {
         assert_eq!(s["type"], "object");
     }
     assert!(trust_export::foxglove_schema("foxglove.Grid").is_none());
+}
+
+/// A flight of `n` states at 50 Hz with `obstacle_count` spheres, written as a run log.
+fn long_log(path: &Path, n: usize, obstacle_count: usize) {
+    let mut l = log();
+    l.header.obstacles = (0..obstacle_count)
+        .map(|id| ObstacleInfo {
+            id,
+            shape: ObstacleKind::Sphere,
+            radius: 0.3,
+            half_height: None,
+            half_extents: None,
+        })
+        .collect();
+    let mut w = LogWriter::create(path).unwrap();
+    w.write(&Record::Header(l.header.clone())).unwrap();
+    let mut last = None;
+    for k in 0..n {
+        let t = k as f64 * 0.02;
+        let s = StateRecord {
+            t,
+            p: [
+                5.0 + 4.0 * (0.01 * t).cos(),
+                4.0 + 3.0 * (0.01 * t).sin(),
+                1.0,
+            ],
+            v: [-0.04 * (0.01 * t).sin(), 0.03 * (0.01 * t).cos(), 0.0],
+            a: [0.0; 3],
+            obstacles: (0..obstacle_count)
+                .map(|i| [i as f64 * 0.1, 3.0 + (t + i as f64).sin(), 1.0])
+                .collect(),
+        };
+        w.write(&Record::State(s.clone())).unwrap();
+        last = Some(s);
+    }
+    let last = last.unwrap();
+    w.write(&Record::Outcome(trust_runlog::Outcome {
+        t: last.t,
+        flight_time_s: last.t,
+        ..l.outcome.clone()
+    }))
+    .unwrap();
+    w.finish().unwrap();
+}
+
+#[test]
+fn an_mcap_grows_linearly_with_the_flight() {
+    // The path messages used to repeat the whole path: 7 500 states gave 30 MB, 30 000 gave
+    // 417 MB (quadratic: 4 times the bytes per state for 4 times the states). Now the bytes per
+    // state stay nearly flat (the paths' coarse copies fill up to their caps, then stay).
+    let d = dir("linear");
+    let mut per_state = Vec::new();
+    for n in [3_000, 12_000] {
+        let log_path = d.join(format!("run{n}.jsonl"));
+        long_log(&log_path, n, 2);
+        let mcap = d.join(format!("run{n}.mcap"));
+        export_file(&log_path, &mcap).unwrap();
+        per_state.push(std::fs::metadata(&mcap).unwrap().len() as f64 / n as f64);
+    }
+    assert!(
+        per_state[1] < 1.25 * per_state[0],
+        "bytes per state {per_state:?}"
+    );
+    // A one-hour flight at this rate (2 obstacles): far below 1 GB.
+    assert!(per_state[1] * 180_000.0 < 0.3e9, "{per_state:?}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn an_export_error_removes_the_partial_file() {
+    let d = dir("partial");
+    let log_path = d.join("run.jsonl");
+    long_log(&log_path, 100, 1);
+    let text = std::fs::read_to_string(&log_path).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines[50] = "{\"type\":\"state\",\"t\":-1}";
+    std::fs::write(&log_path, lines.join("\n")).unwrap();
+    let mcap = d.join("run.mcap");
+    let e = export_file(&log_path, &mcap).unwrap_err();
+    assert!(e.to_string().contains("run.jsonl:51:"), "{e}");
+    assert!(!mcap.exists());
+    std::fs::remove_dir_all(&d).ok();
 }
