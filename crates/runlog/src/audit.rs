@@ -212,18 +212,32 @@ impl TrueGeometry {
     /// # Errors
     /// A message naming the points file (and the line) if it is refused or cannot be read.
     pub fn new(header: &Header, log_dir: &Path) -> Result<Self, String> {
-        let points = match &header.static_points_file {
-            Some(f) => Some(PointTree::new(read_points(&resolve_points_file(
-                log_dir, f,
-            )?)?)),
-            None => None,
-        };
-        Ok(TrueGeometry {
-            header: header.clone(),
-            points,
-        })
+        Ok(Self::with_points(header, read_log_points(header, log_dir)?))
     }
 
+    /// The geometry of a log with `header` and the static `points` its points file holds
+    /// (read with [`read_log_points`]).
+    pub fn with_points(header: &Header, points: Option<Vec<[f64; 3]>>) -> Self {
+        TrueGeometry {
+            header: header.clone(),
+            points: points.map(PointTree::new),
+        }
+    }
+}
+
+/// The static points of a log with `header` in `log_dir`: its `static_points_file` resolved
+/// under [`crate::files`]' policy and read ([`read_points`]); `None` when it names none.
+///
+/// # Errors
+/// A message naming the points file (and the line) if it is refused or cannot be read.
+pub fn read_log_points(header: &Header, log_dir: &Path) -> Result<Option<Vec<[f64; 3]>>, String> {
+    match &header.static_points_file {
+        Some(f) => Ok(Some(read_points(&resolve_points_file(log_dir, f)?)?)),
+        None => Ok(None),
+    }
+}
+
+impl TrueGeometry {
     /// The static and dynamic clearances at state `s` (m, vehicle radius subtracted; `+∞`
     /// without geometry of that kind), and the nearest moving obstacle's id.
     pub fn clearances(&self, s: &StateRecord) -> (f64, f64, usize) {
@@ -829,7 +843,7 @@ pub fn audit_with(log: &RunLog, log_dir: &Path, options: AuditOptions) -> Result
 /// [`LogError`] for a log that cannot be read or breaks the contract's structure, and
 /// [`LogError::Points`] for a points file that is refused or cannot be read.
 pub fn audit_file(path: &Path, options: AuditOptions) -> Result<Audit, LogError> {
-    let mut reader = LogReader::open(path)?;
+    let mut reader = LogReader::open(path)?.light_cycles();
     let header = reader.header().clone();
     let log_dir = path.parent().unwrap_or(Path::new("."));
     let mut a =
