@@ -20,9 +20,9 @@
 //! # Size: what each panel shows
 //!
 //! No message repeats the whole path at full resolution, so the file grows linearly with the
-//! flight: a synthetic one-hour flight (180 000 states, 100 moving obstacles, branches every
-//! 0.1 s) exports to well under 1 GB (`cargo run --release -p trust-export --example
-//! hour_export` measures it). What a viewer shows:
+//! flight: a synthetic one-hour flight (180 000 states, 100 moving obstacles, two branches every
+//! 0.1 s; `cargo run --release -p trust-runlog --example hour_log -- hour.jsonl`) exports to
+//! 663 MB. What a viewer shows:
 //!
 //! - Foxglove's **3D panel** on `/scene/path` keeps every entity it has received (lifetime 0),
 //!   so while playing forward it draws the whole path at 0.1 s resolution, segment by segment;

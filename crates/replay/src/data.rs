@@ -3,8 +3,11 @@
 use std::path::Path;
 
 use serde_json::{Map, Value, json};
-use trust_runlog::audit::{read_static_points, state_clearances};
-use trust_runlog::{BranchSamples, ForecastRecord, ForecastShape, RunLog};
+use trust_runlog::audit::{TrueGeometry, read_log_points};
+use trust_runlog::{
+    BranchSamples, CycleRecord, ForecastRecord, ForecastShape, Header, LogError, LogReader,
+    Outcome, Record, RunLog, StateRecord,
+};
 
 use crate::{ReplayError, ReplayParams};
 
@@ -35,6 +38,14 @@ pub(crate) fn check_params(params: &ReplayParams) -> Result<(), ReplayError> {
     if !(0..=9).contains(&params.decimals) {
         return invalid("decimals", params.decimals.to_string(), "0 to 9");
     }
+    for (field, value) in [
+        ("max_states", params.max_states),
+        ("max_cycles", params.max_cycles),
+    ] {
+        if value < 2 {
+            return invalid(field, value.to_string(), "≥ 2");
+        }
+    }
     Ok(())
 }
 
@@ -58,24 +69,6 @@ fn round(v: &mut Value, scale: f64) {
         Value::Object(m) => m.values_mut().for_each(|x| round(x, scale)),
         _ => {}
     }
-}
-
-/// Indices of the states kept in the page: the first, then each at least `step` after the
-/// previous kept one, and the last.
-pub(crate) fn kept_states(log: &RunLog, step: f64) -> Vec<usize> {
-    let mut kept = Vec::new();
-    let mut next = f64::NEG_INFINITY;
-    for (i, s) in log.states.iter().enumerate() {
-        if s.t + 1e-9 >= next {
-            kept.push(i);
-            next = s.t + step;
-        }
-    }
-    let last = log.states.len() - 1;
-    if kept.last() != Some(&last) {
-        kept.push(last);
-    }
-    kept
 }
 
 /// The Ramer–Douglas–Peucker simplification of a polyline: the fewest vertices (first and last
@@ -181,110 +174,354 @@ fn num(x: f64) -> Value {
     serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number)
 }
 
-/// The page's data: `header` and `outcome` as logged (so optional fields added later, such as a
-/// global `route`, pass through), the thinned static `points`, the kept `states` (time, position,
-/// speed, `[static, dynamic]` clearance, obstacle centres) and per cycle its time, main branch,
-/// events, branches (main first, simplified to `[x, y, z]` polylines), the forecasts near the
-/// vehicle or a branch (compact arrays, see [`compact_forecast`]) and the route when logged.
+/// One record of a log, as the page and the GIF read it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Item<'a> {
+    /// A state record.
+    State(&'a StateRecord),
+    /// A cycle record.
+    Cycle(&'a CycleRecord),
+}
+
+/// Feeds the states and cycles of a log in memory to `f` in the order of a log file: each cycle
+/// after the states up to its time.
+pub(crate) fn visit_log(
+    log: &RunLog,
+    f: &mut dyn FnMut(Item<'_>) -> Result<(), ReplayError>,
+) -> Result<(), ReplayError> {
+    let mut cycles = log.cycles.iter().peekable();
+    for s in &log.states {
+        while let Some(c) = cycles.next_if(|c| c.t < s.t) {
+            f(Item::Cycle(c))?;
+        }
+        f(Item::State(s))?;
+    }
+    for c in cycles {
+        f(Item::Cycle(c))?;
+    }
+    Ok(())
+}
+
+/// Streams the log at `path` to `f` in file order; returns its header and outcome.
+pub(crate) fn visit_file(
+    path: &Path,
+    f: &mut dyn FnMut(&Header, Item<'_>) -> Result<(), ReplayError>,
+) -> Result<(Header, Outcome), ReplayError> {
+    let mut reader = LogReader::open(path)?;
+    let header = reader.header().clone();
+    let mut outcome = None;
+    while let Some(record) = reader.next_record()? {
+        match record {
+            Record::State(s) => f(&header, Item::State(&s))?,
+            Record::Cycle(c) => f(&header, Item::Cycle(&c))?,
+            Record::Outcome(o) => outcome = Some(o),
+            Record::Header(_) => {}
+        }
+    }
+    let outcome = outcome.ok_or_else(|| LogError::Structure {
+        path: path.to_path_buf(),
+        message: "no outcome (the run did not finish)".into(),
+    })?;
+    Ok((header, outcome))
+}
+
+/// The static points of a log thinned for the page and the GIF (every k-th in file order, at
+/// most `max_points`), and the geometry of its clearances (every point).
+pub(crate) fn geometry(
+    header: &Header,
+    log_dir: &Path,
+    max_points: usize,
+) -> Result<(Vec<[f64; 3]>, TrueGeometry), ReplayError> {
+    let points =
+        read_log_points(header, log_dir).map_err(|message| ReplayError::Points { message })?;
+    let thinned = points.as_ref().map_or_else(Vec::new, |pts| {
+        let every = pts.len().div_ceil(max_points.max(1)).max(1);
+        pts.iter().step_by(every).copied().collect()
+    });
+    Ok((thinned, TrueGeometry::with_points(header, points)))
+}
+
+/// A state kept in the page.
+#[derive(Debug, Clone)]
+struct KeptState {
+    t: f64,
+    p: [f64; 3],
+    speed: f64,
+    /// The smallest `[static, dynamic]` clearance since the previous kept state, this one's
+    /// included.
+    clear: [f64; 2],
+    obstacles: Vec<[f64; 3]>,
+}
+
+/// A cycle kept in the page: its compact form, and what later cycles may inherit.
+#[derive(Debug, Clone)]
+struct KeptCycle {
+    value: Map<String, Value>,
+    events: Vec<String>,
+    route: Option<Value>,
+}
+
+fn min2(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    [a[0].min(b[0]), a[1].min(b[1])]
+}
+
+/// The page's data, built record by record in bounded memory (see [`ReplayParams`]): states
+/// kept at `state_step_s` (doubled whenever more than `max_states` would be kept), cycles kept
+/// every one (every second, fourth, … whenever more than `max_cycles` would be).
+pub(crate) struct PageBuilder<'p> {
+    params: &'p ReplayParams,
+    geometry: TrueGeometry,
+    page_tolerance: f64,
+    state_step: f64,
+    next_state_t: f64,
+    states: Vec<KeptState>,
+    pending_clear: [f64; 2],
+    latest: Option<StateRecord>,
+    cycle_stride: usize,
+    cycle_count: usize,
+    cycles: Vec<KeptCycle>,
+    pending_events: Vec<String>,
+    pending_route: Option<Value>,
+}
+
+impl<'p> PageBuilder<'p> {
+    pub(crate) fn new(params: &'p ReplayParams, geometry: TrueGeometry) -> Self {
+        PageBuilder {
+            params,
+            geometry,
+            page_tolerance: 0.5 * 10f64.powi(-params.decimals),
+            state_step: params.state_step_s,
+            next_state_t: f64::NEG_INFINITY,
+            states: Vec::new(),
+            pending_clear: [f64::INFINITY; 2],
+            latest: None,
+            cycle_stride: 1,
+            cycle_count: 0,
+            cycles: Vec::new(),
+            pending_events: Vec::new(),
+            pending_route: None,
+        }
+    }
+
+    /// The time span of the states seen (first, latest).
+    pub(crate) fn span(&self) -> Option<(f64, f64)> {
+        Some((self.states.first()?.t, self.latest.as_ref()?.t))
+    }
+
+    pub(crate) fn item(&mut self, item: Item<'_>) {
+        match item {
+            Item::State(s) => self.state(s),
+            Item::Cycle(c) => self.cycle(c),
+        }
+    }
+
+    fn state(&mut self, s: &StateRecord) {
+        let (st, dy, _) = self.geometry.clearances(s);
+        self.pending_clear = min2(self.pending_clear, [st, dy]);
+        if s.t + 1e-9 >= self.next_state_t {
+            self.push_state(s);
+            self.next_state_t = s.t + self.state_step;
+            if self.states.len() > self.params.max_states.max(2) {
+                self.halve_states();
+            }
+        }
+        self.latest = Some(s.clone());
+    }
+
+    fn push_state(&mut self, s: &StateRecord) {
+        self.states.push(KeptState {
+            t: s.t,
+            p: s.p,
+            speed: (s.v[0] * s.v[0] + s.v[1] * s.v[1] + s.v[2] * s.v[2]).sqrt(),
+            clear: self.pending_clear,
+            obstacles: s.obstacles.clone(),
+        });
+        self.pending_clear = [f64::INFINITY; 2];
+    }
+
+    /// Keeps every other state (the first included), each with the smallest clearance of the
+    /// window it now covers; doubles the step.
+    fn halve_states(&mut self) {
+        let old = std::mem::take(&mut self.states);
+        let mut carried = [f64::INFINITY; 2];
+        for (k, mut s) in old.into_iter().enumerate() {
+            if k % 2 == 1 {
+                carried = s.clear;
+            } else {
+                s.clear = min2(s.clear, carried);
+                carried = [f64::INFINITY; 2];
+                self.states.push(s);
+            }
+        }
+        self.pending_clear = min2(self.pending_clear, carried);
+        self.state_step = (2.0 * self.state_step).max(0.02);
+        self.next_state_t = self.states.last().map_or(f64::NEG_INFINITY, |s| s.t) + self.state_step;
+    }
+
+    fn cycle(&mut self, c: &CycleRecord) {
+        let index = self.cycle_count;
+        self.cycle_count += 1;
+        let route = c.route.as_ref().map(|r| json!(r));
+        if !index.is_multiple_of(self.cycle_stride) {
+            // Not kept: its events and route go to the next kept cycle.
+            self.pending_events.extend(c.events.iter().cloned());
+            if route.is_some() {
+                self.pending_route = route;
+            }
+            return;
+        }
+        let mut events = std::mem::take(&mut self.pending_events);
+        events.extend(c.events.iter().cloned());
+        let route = route.or_else(|| self.pending_route.take());
+        self.pending_route = None;
+        let vehicle = self.latest.as_ref().map_or([f64::NAN; 3], |s| s.p);
+        let mut m = Map::new();
+        m.insert("t".into(), num(c.t));
+        m.insert("main".into(), json!(c.main));
+        if let Some(b) = &c.branch_samples {
+            let tolerance = self.params.branch_tolerance_m.max(self.page_tolerance);
+            m.insert(
+                "branches".into(),
+                Value::Array(
+                    b.iter()
+                        .map(|b| {
+                            let xyz: Vec<[f64; 3]> =
+                                b.samples.iter().map(|s| [s[1], s[2], s[3]]).collect();
+                            json!(simplify(&xyz, tolerance))
+                        })
+                        .collect(),
+                ),
+            );
+            m.insert(
+                "ids".into(),
+                Value::Array(b.iter().map(|b| json!(b.id)).collect()),
+            );
+        }
+        if let Some(f) = &c.forecasts {
+            let near = f.iter().filter(|f| {
+                forecast_is_near(
+                    f,
+                    &vehicle,
+                    c.branch_samples.as_deref(),
+                    self.params.forecast_near_m,
+                )
+            });
+            m.insert(
+                "forecasts".into(),
+                Value::Array(near.map(compact_forecast).collect()),
+            );
+        }
+        self.cycles.push(KeptCycle {
+            value: m,
+            events,
+            route,
+        });
+        if self.cycles.len() > self.params.max_cycles.max(2) {
+            self.halve_cycles();
+        }
+    }
+
+    /// Keeps every other cycle (the first included); a dropped cycle's events and route go to
+    /// the next kept one.
+    fn halve_cycles(&mut self) {
+        let old = std::mem::take(&mut self.cycles);
+        let mut carried_events: Vec<String> = Vec::new();
+        let mut carried_route = None;
+        for (k, mut c) in old.into_iter().enumerate() {
+            if k % 2 == 1 {
+                carried_events = c.events;
+                carried_route = c.route;
+            } else {
+                if !carried_events.is_empty() {
+                    carried_events.append(&mut c.events);
+                    c.events = std::mem::take(&mut carried_events);
+                }
+                if c.route.is_none() {
+                    c.route = carried_route.take();
+                }
+                carried_route = None;
+                self.cycles.push(c);
+            }
+        }
+        carried_events.append(&mut self.pending_events);
+        self.pending_events = carried_events;
+        if self.pending_route.is_none() {
+            self.pending_route = carried_route;
+        }
+        self.cycle_stride *= 2;
+    }
+
+    /// The page's data: `header` and `outcome` as logged (so optional fields added later pass
+    /// through), the thinned static `points`, the kept `states` (time, position, speed,
+    /// `[static, dynamic]` clearance — the smallest since the previous kept state —, obstacle
+    /// centres) and per kept cycle its time, main branch, events (with those of the cycles
+    /// dropped before it), branches (main first, simplified to `[x, y, z]` polylines), the
+    /// forecasts near the vehicle or a branch (compact arrays, see [`compact_forecast`]) and the
+    /// route when logged.
+    pub(crate) fn finish(
+        mut self,
+        header: &Header,
+        outcome: &Outcome,
+        points: &[[f64; 3]],
+    ) -> Value {
+        if let Some(s) = self.latest.take()
+            && self.states.last().is_none_or(|k| k.t < s.t)
+        {
+            self.push_state(&s);
+        }
+        let n = self.states.len();
+        let (mut t, mut p, mut speed, mut clear, mut obstacles) = (
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+        );
+        for s in &self.states {
+            t.push(num(s.t));
+            p.push(json!(s.p));
+            speed.push(num(s.speed));
+            clear.push(json!([num(s.clear[0]), num(s.clear[1])]));
+            obstacles.push(json!(s.obstacles));
+        }
+        let cycles: Vec<Value> = self
+            .cycles
+            .into_iter()
+            .map(|c| {
+                let mut m = c.value;
+                m.insert("events".into(), json!(c.events));
+                if let Some(r) = c.route {
+                    m.insert("route".into(), r);
+                }
+                Value::Object(m)
+            })
+            .collect();
+        let mut data = json!({
+            "header": serde_json::to_value(header).unwrap_or(Value::Null),
+            "outcome": serde_json::to_value(outcome).unwrap_or(Value::Null),
+            "points": points,
+            "states": {"t": t, "p": p, "speed": speed, "clear": clear, "obstacles": obstacles},
+            "cycles": cycles,
+        });
+        round(&mut data, 10f64.powi(self.params.decimals));
+        data
+    }
+}
+
+/// The page's data of a log in memory ([`PageBuilder::finish`]).
 pub(crate) fn page_data(
     log: &RunLog,
     log_dir: &Path,
     params: &ReplayParams,
 ) -> Result<Value, ReplayError> {
     check_params(params)?;
-    let clearances =
-        state_clearances(log, log_dir).map_err(|message| ReplayError::Points { message })?;
-    let points = match &log.header.static_points_file {
-        Some(f) => {
-            let pts = read_static_points(&log_dir.join(f))
-                .map_err(|message| ReplayError::Points { message })?;
-            let every = pts.len().div_ceil(params.max_points.max(1)).max(1);
-            pts.into_iter().step_by(every).collect()
-        }
-        None => Vec::new(),
-    };
-    let kept = kept_states(log, params.state_step_s);
-    let page_tolerance = 0.5 * 10f64.powi(-params.decimals);
-    let mut t = Vec::with_capacity(kept.len());
-    let mut p = Vec::with_capacity(kept.len());
-    let mut speed = Vec::with_capacity(kept.len());
-    let mut clear = Vec::with_capacity(kept.len());
-    let mut obstacles = Vec::with_capacity(kept.len());
-    for &i in &kept {
-        let s = &log.states[i];
-        t.push(num(s.t));
-        p.push(json!(s.p));
-        speed.push(num(
-            (s.v[0] * s.v[0] + s.v[1] * s.v[1] + s.v[2] * s.v[2]).sqrt()
-        ));
-        clear.push(json!([num(clearances[i][0]), num(clearances[i][1])]));
-        obstacles.push(json!(s.obstacles));
-    }
-    let header = serde_json::to_value(&log.header).unwrap_or(Value::Null);
-    let outcome = serde_json::to_value(&log.outcome).unwrap_or(Value::Null);
-    let cycles: Vec<Value> = log
-        .cycles
-        .iter()
-        .map(|c| {
-            let mut m = Map::new();
-            m.insert("t".into(), num(c.t));
-            m.insert("main".into(), json!(c.main));
-            m.insert("events".into(), json!(c.events));
-            if let Some(b) = &c.branch_samples {
-                m.insert(
-                    "branches".into(),
-                    Value::Array(
-                        b.iter()
-                            .map(|b| {
-                                let xyz: Vec<[f64; 3]> =
-                                    b.samples.iter().map(|s| [s[1], s[2], s[3]]).collect();
-                                json!(simplify(
-                                    &xyz,
-                                    params.branch_tolerance_m.max(page_tolerance)
-                                ))
-                            })
-                            .collect(),
-                    ),
-                );
-                m.insert(
-                    "ids".into(),
-                    Value::Array(b.iter().map(|b| json!(b.id)).collect()),
-                );
-            }
-            if let Some(f) = &c.forecasts {
-                let vehicle = log.states[log.states.partition_point(|s| s.t <= c.t).max(1) - 1].p;
-                let near = f.iter().filter(|f| {
-                    forecast_is_near(
-                        f,
-                        &vehicle,
-                        c.branch_samples.as_deref(),
-                        params.forecast_near_m,
-                    )
-                });
-                m.insert(
-                    "forecasts".into(),
-                    Value::Array(near.map(compact_forecast).collect()),
-                );
-            }
-            // Fields other crates may add to the cycle record (a re-planned global route).
-            if let Ok(Value::Object(all)) = serde_json::to_value(c)
-                && let Some(route) = all.get("route")
-                && !route.is_null()
-            {
-                m.insert("route".into(), route.clone());
-            }
-            Value::Object(m)
-        })
-        .collect();
-    let mut data = json!({
-        "header": header,
-        "outcome": outcome,
-        "points": points,
-        "states": {"t": t, "p": p, "speed": speed, "clear": clear, "obstacles": obstacles},
-        "cycles": cycles,
-    });
-    round(&mut data, 10f64.powi(params.decimals));
-    Ok(data)
+    let (points, geometry) = geometry(&log.header, log_dir, params.max_points)?;
+    let mut page = PageBuilder::new(params, geometry);
+    visit_log(log, &mut |item| {
+        page.item(item);
+        Ok(())
+    })?;
+    Ok(page.finish(&log.header, &log.outcome, &points))
 }
 
 /// `data` as JSON that can sit inside a `<script>` element: every `<` is written `\u003c`, so

@@ -7,9 +7,9 @@ use trust_plot::{
     Bounds, Color, ForecastRings, GifWritten, MapView, Marker, MarkerShape, Polyline, Shape,
     write_gif,
 };
-use trust_runlog::audit::read_static_points;
-use trust_runlog::{CycleRecord, RunLog, StaticShape};
+use trust_runlog::{CycleRecord, Header, RunLog, StateRecord, StaticShape};
 
+use crate::data::{Item, geometry, visit_log};
 use crate::{GifParams, ReplayError};
 
 fn xy(p: &[f64; 3]) -> Point2<f64> {
@@ -28,12 +28,6 @@ pub(crate) fn route_of(record: &serde_json::Value) -> Option<Vec<Point2<f64>>> {
             Some(Point2::new(a.first()?.as_f64()?, a.get(1)?.as_f64()?))
         })
         .collect()
-}
-
-/// The latest cycle at or before `t`.
-pub(crate) fn cycle_at(cycles: &[CycleRecord], t: f64) -> Option<&CycleRecord> {
-    let n = cycles.partition_point(|c| c.t <= t + 1e-9);
-    n.checked_sub(1).map(|i| &cycles[i])
 }
 
 /// The times of the frames: from the first state to the last, `frame_step_s` apart at least and
@@ -57,7 +51,7 @@ fn frame_times(t0: f64, t1: f64, params: &GifParams) -> Vec<f64> {
     times
 }
 
-fn check(params: &GifParams) -> Result<(), ReplayError> {
+pub(crate) fn check(params: &GifParams) -> Result<(), ReplayError> {
     let invalid = |field, value: String, expected| {
         Err(ReplayError::InvalidParam {
             field,
@@ -81,13 +75,115 @@ fn check(params: &GifParams) -> Result<(), ReplayError> {
     Ok(())
 }
 
+/// The latest state, cycle and route at one frame's time, and the path flown until then.
+#[derive(Debug, Clone)]
+struct Snapshot {
+    state: StateRecord,
+    cycle: Option<CycleRecord>,
+    route: Option<Vec<Point2<f64>>>,
+    flown: Vec<Point2<f64>>,
+}
+
+/// Most points of a frame's flown path (one per 0.1 s, the spacing doubling beyond).
+const MAX_FLOWN_POINTS: usize = 4_000;
+
+/// Collects the frames' snapshots from the records in log order, in bounded memory: the
+/// latest state, cycle and route, and the flown path thinned to [`MAX_FLOWN_POINTS`].
+pub(crate) struct FrameCollector {
+    times: Vec<f64>,
+    next: usize,
+    latest: Option<StateRecord>,
+    cycle: Option<CycleRecord>,
+    route: Option<Vec<Point2<f64>>>,
+    flown: Vec<Point2<f64>>,
+    flown_step: f64,
+    flown_next_t: f64,
+    snapshots: Vec<Snapshot>,
+    has_route: bool,
+    has_regions: bool,
+}
+
+impl FrameCollector {
+    /// Frames of a flight whose states span `t0` to `t1` ([`frame_times`]).
+    pub(crate) fn new(t0: f64, t1: f64, params: &GifParams) -> Self {
+        FrameCollector {
+            times: frame_times(t0, t1, params),
+            next: 0,
+            latest: None,
+            cycle: None,
+            route: None,
+            flown: Vec::new(),
+            flown_step: 0.1,
+            flown_next_t: f64::NEG_INFINITY,
+            snapshots: Vec::new(),
+            has_route: false,
+            has_regions: false,
+        }
+    }
+
+    /// Takes the snapshots of the frames before `t`.
+    fn capture_before(&mut self, t: f64) {
+        while self.next < self.times.len() && self.times[self.next] < t - 1e-9 {
+            if let Some(s) = &self.latest {
+                let mut flown = self.flown.clone();
+                flown.push(xy(&s.p));
+                self.snapshots.push(Snapshot {
+                    state: s.clone(),
+                    cycle: self.cycle.clone(),
+                    route: self.route.clone(),
+                    flown,
+                });
+            }
+            self.next += 1;
+        }
+    }
+
+    pub(crate) fn item(&mut self, item: Item<'_>) {
+        match item {
+            Item::State(s) => {
+                self.capture_before(s.t);
+                if s.t >= self.flown_next_t - 1e-9 {
+                    self.flown.push(xy(&s.p));
+                    self.flown_next_t = s.t + self.flown_step;
+                    if self.flown.len() > MAX_FLOWN_POINTS {
+                        let mut k = 0;
+                        self.flown.retain(|_| {
+                            k += 1;
+                            k % 2 == 1
+                        });
+                        self.flown_step *= 2.0;
+                    }
+                }
+                self.latest = Some(s.clone());
+            }
+            Item::Cycle(c) => {
+                self.capture_before(c.t);
+                if let Some(r) = &c.route {
+                    self.route = Some(r.iter().map(xy).collect());
+                    self.has_route = true;
+                }
+                self.has_regions |= c
+                    .forecasts
+                    .as_ref()
+                    .is_some_and(|fs| fs.iter().any(|f| f.walls.is_some()));
+                self.cycle = Some(c.clone());
+            }
+        }
+    }
+
+    fn finish(mut self) -> (Vec<Snapshot>, bool, bool) {
+        self.capture_before(f64::INFINITY);
+        (self.snapshots, self.has_route, self.has_regions)
+    }
+}
+
 /// Writes the top view of `log`'s flight (read from a file in `log_dir`) as an animated GIF at
 /// `path`: per frame the static geometry, the flown path so far, the true obstacles, the
 /// forecasts of the latest cycle at their current radius (and dashed the regions whose walls the
 /// planner mirrors them at, when the log has any), its branches (main thick, the others
 /// thin and dashed), start, goal and the vehicle; the title carries the time and the cycle's
 /// events. Frames are `params.frame_step_s` of simulated time apart (more for long flights, at
-/// most `params.max_frames`).
+/// most `params.max_frames`); the static points are thinned to 20 000.
 ///
 /// # Errors
 /// [`ReplayError::InvalidParam`], [`ReplayError::Points`], [`ReplayError::Plot`].
@@ -98,7 +194,26 @@ pub fn write_top_view_gif(
     params: &GifParams,
 ) -> Result<GifWritten, ReplayError> {
     check(params)?;
-    let h = &log.header;
+    let (cloud, _) = geometry(&log.header, log_dir, 20_000)?;
+    let states = &log.states;
+    let mut frames = FrameCollector::new(states[0].t, states[states.len() - 1].t, params);
+    visit_log(log, &mut |item| {
+        frames.item(item);
+        Ok(())
+    })?;
+    draw_gif(&log.header, &cloud, frames, path, params)
+}
+
+/// Draws the collected frames (see [`write_top_view_gif`]).
+pub(crate) fn draw_gif(
+    h: &Header,
+    cloud: &[[f64; 3]],
+    frames: FrameCollector,
+    path: &Path,
+    params: &GifParams,
+) -> Result<GifWritten, ReplayError> {
+    check(params)?;
+    let (snapshots, has_route, has_regions) = frames.finish();
     let bounds = Bounds::new(xy(&h.bounds.min), xy(&h.bounds.max));
     let shapes: Vec<Shape> = h
         .static_shapes
@@ -118,37 +233,17 @@ pub fn write_top_view_gif(
             },
         })
         .collect();
-    let cloud: Vec<Point2<f64>> = match &h.static_points_file {
-        Some(f) => read_static_points(&log_dir.join(f))
-            .map_err(|message| ReplayError::Points { message })?
-            .iter()
-            .map(xy)
-            .collect(),
-        None => Vec::new(),
-    };
+    let cloud: Vec<Point2<f64>> = cloud.iter().map(xy).collect();
     let header_route = serde_json::to_value(h).ok().and_then(|v| route_of(&v));
-    let cycle_routes: Vec<Option<Vec<Point2<f64>>>> = log
-        .cycles
-        .iter()
-        .map(|c| serde_json::to_value(c).ok().and_then(|v| route_of(&v)))
-        .collect();
-    let has_route = header_route.is_some() || cycle_routes.iter().any(Option::is_some);
-    let has_regions = log.cycles.iter().any(|c| {
-        c.forecasts
-            .as_ref()
-            .is_some_and(|fs| fs.iter().any(|f| f.walls.is_some()))
-    });
-    let states = &log.states;
-    let times = frame_times(states[0].t, states[states.len() - 1].t, params);
+    let has_route = has_route || header_route.is_some();
     let truth_color = Color::rgb(204, 51, 17);
     let forecast_color = Color::rgb(238, 153, 0);
     let main_color = Color::rgb(0, 90, 200);
     let path_color = Color::BLACK;
-    let mut frames = Vec::with_capacity(times.len());
-    for &t in &times {
-        let k = states.partition_point(|s| s.t <= t + 1e-9).max(1) - 1;
-        let s = &states[k];
-        let cycle = cycle_at(&log.cycles, t);
+    let mut frames = Vec::with_capacity(snapshots.len());
+    for snap in snapshots {
+        let s = &snap.state;
+        let cycle = snap.cycle.as_ref();
         let events = cycle
             .map(|c| {
                 c.events
@@ -179,11 +274,9 @@ pub fn write_top_view_gif(
             view = view.point_cloud(cloud.clone(), Color::DARK_GREY, "static points");
         }
         if has_route {
-            let n = log.cycles.partition_point(|c| c.t <= t + 1e-9);
-            let route = cycle_routes[..n]
-                .iter()
-                .rev()
-                .find_map(Clone::clone)
+            let route = snap
+                .route
+                .clone()
                 .or_else(|| header_route.clone())
                 .unwrap_or_default();
             view = view.polyline(
@@ -296,7 +389,7 @@ pub fn write_top_view_gif(
                 .width_px(3)
                 .label("main branch"),
         );
-        let flown: Vec<Point2<f64>> = states[..=k].iter().map(|s| xy(&s.p)).collect();
+        let flown = snap.flown;
         view = view
             .polyline(
                 Polyline::new(flown)

@@ -21,14 +21,32 @@
 //! The branches and forecasts come from the cycles' optional `branch_samples` and `forecasts`
 //! (added in issue 20; written by `trust-sim run` unless `--no-log-branches`); a log without them
 //! replays without branches and forecasts. The clearance traces are recomputed from the states
-//! with the audit's own distance formulas ([`trust_runlog::audit::state_clearances`]).
+//! with the audit's own distance formulas ([`trust_runlog::audit::TrueGeometry`], a k-d tree for
+//! a static point cloud).
+//!
+//! # Long flights: bounded memory, decimated page
+//!
+//! [`write_replay`] streams the log twice ([`trust_runlog::LogReader`]): once for the page, once
+//! for the GIF's frames (their times need the flight's end). Neither holds every state:
+//!
+//! - the page keeps a state every [`ReplayParams::state_step_s`] (0.1 s), and whenever more than
+//!   [`ReplayParams::max_states`] (6 000) would be kept, every other one is dropped and the step
+//!   doubled; each kept state carries the smallest clearance since the previous kept one, so the
+//!   clearance trace keeps every minimum. Cycles are kept all, up to
+//!   [`ReplayParams::max_cycles`] (3 000); beyond, every other one is dropped as often as
+//!   needed, its events and route going to the next kept cycle (the timeline keeps every event,
+//!   shifted by at most the kept spacing). A one-hour flight (180 000 states, 36 000 cycles)
+//!   keeps a state every 0.8 s and a cycle every 1.6 s: a page of about 10 MB with 100
+//!   obstacles.
+//! - the GIF keeps, per frame, the latest state, cycle and route, and the flown path at one point
+//!   per 0.1 s, the spacing doubling beyond 4 000 points.
+//! - the static points are read once, thinned to [`ReplayParams::max_points`] for the page and
+//!   the GIF; the clearances use all of them.
+//!
+//! [`page_html`] and [`write_top_view_gif`] do the same from a log already in memory.
 //!
 //! This crate sits beside the plots, on the far side of the simulator: it depends on
 //! `trust-runlog` and `trust-plot` and nothing depends on it but the `trust-sim` binary and xtask.
-//!
-//! # Changelog
-//!
-//! - New in issue 20.
 #![warn(missing_docs)]
 
 pub mod browser;
@@ -39,11 +57,11 @@ mod page;
 
 use std::path::{Path, PathBuf};
 
+use data::PageBuilder;
 pub use error::ReplayError;
 pub use frames::write_top_view_gif;
 pub use page::page_html;
 pub use trust_plot::GifWritten;
-use trust_runlog::RunLog;
 
 /// Settings of a replay (choices of ours, not the paper's: they keep the page of a 30 s E4 flight
 /// with 100 obstacles at a few MB and its GIF under 1 MB).
@@ -62,8 +80,18 @@ pub struct ReplayParams {
     /// radius) of the vehicle, or of a kept branch at the same time (m). Default 5 m; E4 has 100
     /// obstacles and the page would otherwise carry all their forecasts in every cycle.
     pub forecast_near_m: f64,
-    /// At most this many static points in the page (thinned in file order). Default 20 000.
+    /// At most this many static points in the page and the GIF (thinned in file order). Default
+    /// 20 000.
     pub max_points: usize,
+    /// At most this many states in the page: beyond, every other kept state is dropped and
+    /// `state_step_s` doubled, as often as needed (a kept state's clearance is the smallest
+    /// since the previous kept one, so the traces keep every minimum). Default 6 000 (10 min of
+    /// flight at 0.1 s; an hour's flight is kept every 0.8 s).
+    pub max_states: usize,
+    /// At most this many cycles in the page: beyond, every other kept cycle is dropped, as often
+    /// as needed, its events (and route) going to the next kept one. Default 3 000 (5 min of
+    /// cycles at 10 Hz; an hour's are kept every 1.6 s).
+    pub max_cycles: usize,
     /// The GIF.
     pub gif: GifParams,
 }
@@ -76,6 +104,8 @@ impl Default for ReplayParams {
             branch_tolerance_m: 0.03,
             forecast_near_m: 5.0,
             max_points: 20_000,
+            max_states: 6_000,
+            max_cycles: 3_000,
             gif: GifParams::default(),
         }
     }
@@ -127,25 +157,48 @@ pub fn write_replay(
     out_dir: &Path,
     params: &ReplayParams,
 ) -> Result<ReplayFiles, ReplayError> {
-    let log = RunLog::read(log_path)?;
+    data::check_params(params)?;
+    frames::check(&params.gif)?;
     let log_dir = log_path.parent().unwrap_or(Path::new("."));
     let stem = log_path
         .file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("run");
+    // Pass 1, the page: the log streamed once, the points read once.
+    let mut prepared: Option<(Vec<[f64; 3]>, PageBuilder<'_>)> = None;
+    let (header, outcome) = data::visit_file(log_path, &mut |header, item| {
+        if prepared.is_none() {
+            let (points, geometry) = data::geometry(header, log_dir, params.max_points)?;
+            prepared = Some((points, PageBuilder::new(params, geometry)));
+        }
+        if let Some((_, page)) = prepared.as_mut() {
+            page.item(item);
+        }
+        Ok(())
+    })?;
+    let (points, page) = prepared.expect("a log has at least one state");
+    let (t0, t1) = page.span().expect("a log has at least one state");
+    let data = page.finish(&header, &outcome, &points);
+    let html = page::html_of(&header, &outcome, &data);
     std::fs::create_dir_all(out_dir).map_err(|source| ReplayError::Write {
         path: out_dir.to_path_buf(),
         source,
     })?;
-    let html = page_html(&log, log_dir, params)?;
     let html_path = out_dir.join(format!("{stem}.replay.html"));
     std::fs::write(&html_path, &html).map_err(|source| ReplayError::Write {
         path: html_path.clone(),
         source,
     })?;
-    let gif = write_top_view_gif(
-        &log,
-        log_dir,
+    // Pass 2, the GIF: the frames' snapshots, the log streamed again.
+    let mut frames = frames::FrameCollector::new(t0, t1, &params.gif);
+    data::visit_file(log_path, &mut |_, item| {
+        frames.item(item);
+        Ok(())
+    })?;
+    let gif = frames::draw_gif(
+        &header,
+        &points,
+        frames,
         &out_dir.join(format!("{stem}.replay.gif")),
         &params.gif,
     )?;

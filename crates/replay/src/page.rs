@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use trust_runlog::RunLog;
+use trust_runlog::{Header, Outcome, RunLog};
 
 use crate::data::{page_data, script_safe_json};
 use crate::{ReplayError, ReplayParams};
@@ -32,19 +32,23 @@ pub fn page_html(
     params: &ReplayParams,
 ) -> Result<String, ReplayError> {
     let data = page_data(log, log_dir, params)?;
-    let h = &log.header;
+    Ok(html_of(&log.header, &log.outcome, &data))
+}
+
+/// The page around its `data` ([`crate::data::PageBuilder::finish`]).
+pub(crate) fn html_of(h: &Header, outcome: &Outcome, data: &serde_json::Value) -> String {
     let title = escape(&format!(
         "{} — {} (seed {}): {}",
         h.scenario,
         h.planner,
         h.seed,
-        log.outcome.status.as_str()
+        outcome.status.as_str()
     ));
     // The data goes last: it is the only part that may contain arbitrary text (escaped for a
     // script element by `script_safe_json`), so no placeholder can be found inside it.
-    Ok(TEMPLATE
+    TEMPLATE
         .replace("{{TITLE}}", &title)
         .replace("{{STYLE}}", STYLE)
         .replace("{{SCRIPT}}", SCRIPT)
-        .replace("{{DATA}}", &script_safe_json(&data)))
+        .replace("{{DATA}}", &script_safe_json(data))
 }

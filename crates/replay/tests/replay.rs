@@ -424,3 +424,72 @@ fn a_static_point_cloud_is_drawn_and_a_missing_one_is_named() {
     assert_eq!(data["points"][1], serde_json::json!([0.6, 8.0, 0.15]));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_long_flight_is_decimated_with_every_clearance_minimum_kept() {
+    let dir = temp_dir("decimated");
+    let log = dir.join("run.jsonl");
+    write_log(&log, 3.0, true);
+    let params = ReplayParams {
+        max_states: 8,
+        max_cycles: 4,
+        ..ReplayParams::default()
+    };
+    let files = write_replay(&log, &dir, &params).unwrap();
+    let html = std::fs::read_to_string(&files.html).unwrap();
+    let data: serde_json::Value = serde_json::from_str(embedded_json(&html)).unwrap();
+    let t = data["states"]["t"].as_array().unwrap();
+    assert!(t.len() <= 9, "{}", t.len());
+    assert_eq!(t.last().unwrap(), 3.0, "the last state is kept");
+    let cycles = data["cycles"].as_array().unwrap();
+    assert!(cycles.len() <= 4, "{}", cycles.len());
+    // Every event of the 30 cycles is still on the timeline.
+    let events = |v: &[serde_json::Value]| -> usize {
+        v.iter()
+            .map(|c| c["events"].as_array().unwrap().len())
+            .sum()
+    };
+    let full = write_replay(&log, &dir, &ReplayParams::default()).unwrap();
+    let all: serde_json::Value =
+        serde_json::from_str(embedded_json(&std::fs::read_to_string(&full.html).unwrap())).unwrap();
+    assert_eq!(events(cycles), events(all["cycles"].as_array().unwrap()));
+    // The smallest clearance of the flight survives the decimation.
+    let smallest = |d: &serde_json::Value, k: usize| {
+        d["states"]["clear"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|c| c[k].as_f64())
+            .fold(f64::INFINITY, f64::min)
+    };
+    let exact =
+        trust_runlog::audit::state_clearances(&trust_runlog::RunLog::read(&log).unwrap(), &dir)
+            .unwrap()
+            .iter()
+            .map(|c| c[1])
+            .fold(f64::INFINITY, f64::min);
+    assert!((smallest(&data, 1) - exact).abs() < 0.01, "{exact}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[cfg(unix)]
+#[test]
+fn a_points_file_at_dev_zero_is_refused() {
+    let dir = temp_dir("dev-zero");
+    let log = dir.join("run.jsonl");
+    write_log(&log, 1.0, false);
+    let text = std::fs::read_to_string(&log).unwrap();
+    std::fs::write(
+        &log,
+        text.replacen(
+            "\"static_points_file\":null",
+            "\"static_points_file\":\"zero.xyz\"",
+            1,
+        ),
+    )
+    .unwrap();
+    std::os::unix::fs::symlink("/dev/zero", dir.join("zero.xyz")).unwrap();
+    let e = write_replay(&log, &dir, &ReplayParams::default()).unwrap_err();
+    assert!(e.to_string().contains("not a regular file"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -11,7 +11,7 @@
 //!
 //! Layout: the points are reordered in place so that every sub-slice is a subtree whose median
 //! (at the slice's middle) splits it along the axis of the sub-slice's largest spread; that
-//! axis is stored beside the median. Slices of at most [`LEAF_SIZE`] points are scanned.
+//! axis is stored beside the median. Slices of at most 8 points are scanned.
 
 /// Slices this small are scanned rather than split.
 const LEAF_SIZE: usize = 8;
