@@ -208,6 +208,9 @@ fn summary_without_timing(dir: &Path) -> serde_json::Value {
             "solve_ms_per_trajectory",
             "cycle_ms_median",
             "cycle_ms_p99",
+            "cycle_ms_max",
+            "over_budget",
+            "skipped_ticks",
         ] {
             p[k] = serde_json::Value::Null;
         }
