@@ -6,7 +6,7 @@
 //! [`Solution`] with its cost breakdown (eq. design-of-J) and solve status, and the one error type
 //! [`PlanError`].
 //!
-//! The three plugin traits let each stage be swapped (paper Fig. framework):
+//! The three plugin traits let each stage be swapped (paper Sec. III-A, Fig. framework):
 //!
 //! | trait | implementations | paper |
 //! |---|---|---|
@@ -15,10 +15,8 @@
 //! | [`HomotopyChecker`] | UVD, TVD (`trust-topo-prm`) | Sec. III-A |
 //!
 //! A few pieces of mathematics that several stages share live here once, as free functions:
-//! [`bernstein_points`] (convex-hull bounds of a polynomial piece; the manager's safety check and
-//! UTF-MINCO's penalty integration), [`guidance_radius`] (`r_des` of the goal guidance surface;
-//! DEV-PRM and UTF-MINCO) and [`straight_end`] (the straight guide; the straight-line frontend
-//! and the manager).
+//! [`bernstein_points`] (convex-hull bounds of a polynomial piece), [`guidance_radius`] (`r_des` of
+//! the goal guidance surface) and [`straight_end`] (the straight guide).
 //!
 //! Use this crate when you write a new frontend, backend or checker, or when you drive the planner
 //! yourself. It depends only on `trust-geometry` and `trust-predict`; implementations depend on it,
@@ -26,40 +24,22 @@
 //!
 //! # Scale policy
 //!
-//! Every public entry point of the planner accepts only the magnitudes of [`scale`] (defined in
-//! `trust-geometry`, re-exported here): positions `|x| ≤ 1e6` m, lengths and sizes `≤ 1e6` m,
-//! speeds `≤ 1e4` m/s, accelerations `≤ 1e5` m/s², times and durations `≤ 1e7` s, strictly
-//! positive limits, durations and steps `≥ 1e-9`, generated samples `≤ 1e6` per call. Inside these
-//! ranges every computation stays finite; outside them the call returns [`PlanError::Scale`] (or
-//! [`PlanError::Count`]) naming the field, the value in scientific notation and the accepted
-//! range. Points outside the map bounds give [`PlanError::OutOfBounds`].
+//! Every public entry point accepts only the magnitudes of [`scale`] (positions `|x| ≤ 1e6` m,
+//! speeds `≤ 1e4` m/s, times `≤ 1e7` s, …); outside them a call returns [`PlanError::Scale`] (or
+//! [`PlanError::Count`]) naming the field, the value and the accepted range. Points outside the map
+//! bounds give [`PlanError::OutOfBounds`].
 //!
 //! # The backend contract
 //!
-//! [`TrajectoryBackend::optimize`] returns:
-//!
-//! - `Err(PlanError)` for invalid input or misuse only: a request, scene or parameter outside its
-//!   documented range, a start inside a static obstacle, a start or goal outside the bounds. The
-//!   error names the input that is wrong (the field path, e.g. `params.penalty.smoothing`,
-//!   `request.start.t`), its value in readable scientific notation and the accepted range. A
-//!   parameter accepted at construction never makes a solve fail with an error about something
-//!   else.
-//! - `Ok(Solution)` whenever the solve ran: a finite trajectory starting at the request's start
-//!   state, its cost breakdown and statistics. Not converging is a [`SolveStatus`], not an error.
-//!   **`Ok` does not mean safe.** Every solution carries [`Solution::violations`], the result of
-//!   [`verify_trajectory`] on the returned trajectory against the request's scene and limits:
-//!   each kind of violation (penetration of the static map, of each forecast, leaving the bounds
-//!   along each axis, over-speed, over-acceleration) is listed with its worst checked instant —
-//!   how deep or by how much, when and where. An empty list means none was found at instants
-//!   spaced at most [`VERIFY_STEP_S`] apart; a caller that needs a proof (the manager's safety
-//!   check) still checks with its own step.
-//!
-//! # Changelog
-//!
-//! - Issue 18: [`Solution::violations`] (with [`Violation`], [`verify_trajectory`],
-//!   [`Solution::is_clean`]) and [`check_range`]. Adding the field breaks code that builds a
-//!   `Solution` with a struct literal: add `violations: Vec::new()` (or the result of
-//!   [`verify_trajectory`]). Serialized solutions without the field still deserialize.
+//! [`TrajectoryBackend::optimize`] returns `Err(PlanError)` for invalid input or misuse only (a
+//! request, scene or parameter outside its documented range, a start inside a static obstacle, a start
+//! or goal outside the bounds), naming the input that is wrong. It returns `Ok(Solution)` whenever the
+//! solve ran: a finite trajectory from the request's start, its costs and statistics; not converging
+//! is a [`SolveStatus`]. **`Ok` does not mean safe.** Every solution carries
+//! [`Solution::violations`], the result of [`verify_trajectory`] against the request's scene and
+//! limits (penetration of the static map or of each forecast, leaving the bounds, over-speed,
+//! over-acceleration, each with its worst instant), checked at instants at most [`VERIFY_STEP_S`]
+//! apart; a caller that needs a proof (the manager's safety check) checks with its own step.
 //!
 //! ```
 //! use trust_core::{PolyTraj, Vec3};
@@ -100,7 +80,7 @@ pub use traits::{
 pub use traj::{Derivative, MAX_DERIVATIVE_BOUND, Piece, PolyTraj, eval_piece};
 pub use verify::{VERIFY_MAX_SAMPLES, VERIFY_STEP_S, Violation, verify_trajectory};
 
-pub use trust_geometry::{Aabb, StaticMap, Vec3, scale};
+pub use trust_geometry::{Aabb, MapWork, StaticMap, Vec3, scale};
 pub use trust_predict::{Forecast, ObstacleShape};
 
 /// The random number generator every randomized component takes: seeded, portable, fast

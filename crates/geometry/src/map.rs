@@ -52,6 +52,32 @@ pub struct StaticMap {
     shape_coord_max: f64,
 }
 
+/// Elementary operations done by the counted map queries ([`StaticMap::segment_clear_counted`],
+/// [`StaticMap::is_free_counted`], [`StaticMap::distance_and_gradient_counted`]): what a search
+/// with a deterministic work budget charges for a query, since their cost differs by orders of
+/// magnitude between an empty map, a few shapes and a dense point-cloud ESDF.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct MapWork {
+    /// Queries answered (one broad phase each).
+    pub queries: u64,
+    /// ESDF samples (one trilinear interpolation each; a line-of-sight trace takes many).
+    pub esdf_samples: u64,
+    /// Exact shape tests: a segment against one shape (narrow phase) or one shape's distance at a
+    /// point.
+    pub shape_tests: u64,
+}
+
+impl MapWork {
+    /// The sum of two counts.
+    pub fn plus(self, other: MapWork) -> MapWork {
+        MapWork {
+            queries: self.queries.saturating_add(other.queries),
+            esdf_samples: self.esdf_samples.saturating_add(other.esdf_samples),
+            shape_tests: self.shape_tests.saturating_add(other.shape_tests),
+        }
+    }
+}
+
 /// Prefixes the field name of an error with `prefix` (e.g. `shapes[3].`).
 fn prefixed(e: GeometryError, prefix: &str) -> GeometryError {
     match e {
@@ -215,6 +241,12 @@ impl StaticMap {
     /// A non-finite `p` gives `(-inf, 0)` ("not free"); so does a point beyond
     /// [`crate::scale::QUERY_LIMIT`] near a shape (the shapes' distance functions answer so).
     pub fn distance_and_gradient(&self, p: &Vec3) -> (f64, Vec3) {
+        self.distance_and_gradient_counted(p, &mut MapWork::default())
+    }
+
+    /// [`StaticMap::distance_and_gradient`], adding the operations it does to `work`.
+    pub fn distance_and_gradient_counted(&self, p: &Vec3, work: &mut MapWork) -> (f64, Vec3) {
+        work.queries = work.queries.saturating_add(1);
         if !p.iter().all(|c| c.is_finite()) {
             return (f64::NEG_INFINITY, Vec3::zeros());
         }
@@ -222,9 +254,10 @@ impl StaticMap {
             .esdf
             .as_ref()
             .map_or((f64::INFINITY, Vec3::zeros()), |e| {
+                work.esdf_samples = work.esdf_samples.saturating_add(1);
                 e.distance_and_gradient(p)
             });
-        if let Some((_, d, g)) = self.nearest_shape_within(p, best.0)
+        if let Some((_, d, g)) = self.nearest_shape_within(p, best.0, work)
             && d <= best.0
         {
             best = (d, g);
@@ -266,12 +299,17 @@ impl StaticMap {
         if !p.iter().all(|c| c.is_finite()) {
             return None;
         }
-        self.nearest_shape_within(p, f64::INFINITY)
+        self.nearest_shape_within(p, f64::INFINITY, &mut MapWork::default())
     }
 
     /// Best-first BVH search for the shape of least signed distance below `max` (ties and values
     /// equal to `max` included via the final comparison by the caller).
-    fn nearest_shape_within(&self, p: &Vec3, max: f64) -> Option<(usize, f64, Vec3)> {
+    fn nearest_shape_within(
+        &self,
+        p: &Vec3,
+        max: f64,
+        work: &mut MapWork,
+    ) -> Option<(usize, f64, Vec3)> {
         if self.shapes.is_empty() {
             return None;
         }
@@ -281,11 +319,17 @@ impl StaticMap {
         } else {
             max
         };
-        let (i, _) = self.bvh.find_best(
+        let tests = std::cell::Cell::new(0u64);
+        let found = self.bvh.find_best(
             limit,
             |node: &BvhNode, _| node_sdf(node, p),
-            |leaf, _| Some(self.shapes[leaf as usize].signed_distance(p)),
-        )?;
+            |leaf, _| {
+                tests.set(tests.get() + 1);
+                Some(self.shapes[leaf as usize].signed_distance(p))
+            },
+        );
+        work.shape_tests = work.shape_tests.saturating_add(tests.get() + 1);
+        let (i, _) = found?;
         let (d, g) = self.shapes[i as usize].distance_and_gradient(p);
         Some((i as usize, d, g))
     }
@@ -293,13 +337,20 @@ impl StaticMap {
     /// True if `p` is at signed distance `>= clearance` from every obstacle. A NaN clearance or a
     /// non-finite `p` gives `false`.
     pub fn is_free(&self, p: &Vec3, clearance: f64) -> bool {
+        self.is_free_counted(p, clearance, &mut MapWork::default())
+    }
+
+    /// [`StaticMap::is_free`], adding the operations it does to `work`.
+    pub fn is_free_counted(&self, p: &Vec3, clearance: f64, work: &mut MapWork) -> bool {
+        work.queries = work.queries.saturating_add(1);
         if clearance.is_nan() || !p.iter().all(|c| c.is_finite()) {
             return false;
         }
-        if let Some(e) = &self.esdf
-            && e.signed_distance(p) < clearance
-        {
-            return false;
+        if let Some(e) = &self.esdf {
+            work.esdf_samples = work.esdf_samples.saturating_add(1);
+            if e.signed_distance(p) < clearance {
+                return false;
+            }
         }
         if self.shapes.is_empty() {
             return true;
@@ -307,7 +358,13 @@ impl StaticMap {
         let mut leaves = self
             .bvh
             .leaves(|node: &BvhNode| node_sdf(node, p) < clearance);
-        !leaves.any(|i| self.shapes[i as usize].signed_distance(p) < clearance)
+        let mut tests = 0u64;
+        let blocked = leaves.any(|i| {
+            tests += 1;
+            self.shapes[i as usize].signed_distance(p) < clearance
+        });
+        work.shape_tests = work.shape_tests.saturating_add(tests);
+        !blocked
     }
 
     /// Line of sight: true if every point of the segment `[a, b]` is at distance `>= clearance`
@@ -329,6 +386,19 @@ impl StaticMap {
     ///   a non-finite end point or one outside the scale policy ([`crate::scale`]: a coordinate
     ///   beyond [`crate::scale::MAX_COORD_M`]) gives `false`.
     pub fn segment_clear(&self, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
+        self.segment_clear_counted(a, b, clearance, &mut MapWork::default())
+    }
+
+    /// [`StaticMap::segment_clear`], adding the operations it does to `work` (the ESDF samples of
+    /// the trace and the exact tests of the shapes the broad phase keeps).
+    pub fn segment_clear_counted(
+        &self,
+        a: &Vec3,
+        b: &Vec3,
+        clearance: f64,
+        work: &mut MapWork,
+    ) -> bool {
+        work.queries = work.queries.saturating_add(1);
         if clearance.is_nan()
             || !crate::scale::position_in_scale(a)
             || !crate::scale::position_in_scale(b)
@@ -337,7 +407,7 @@ impl StaticMap {
         }
         let clearance = clearance.max(0.0);
         if let Some(e) = &self.esdf
-            && !esdf_segment_clear(e, a, b, clearance)
+            && !esdf_segment_clear(e, a, b, clearance, &mut work.esdf_samples)
         {
             return false;
         }
@@ -354,13 +424,17 @@ impl StaticMap {
         // (a closest pair closer than the clearance lies there): a long segment past a small
         // shape then costs GJK no precision.
         let pad = clearance + 1e-9 * (1.0 + clearance);
-        !candidates.any(|i| {
+        let mut tests = 0u64;
+        let blocked = candidates.any(|i| {
             let shape = &self.shapes[i as usize];
             let Some((p, q)) = shape.aabb().inflated(pad).clip_segment(a, b) else {
                 return false;
             };
+            tests += 1;
             segment_blocked(shape, &p, &q, clearance)
-        })
+        });
+        work.shape_tests = work.shape_tests.saturating_add(tests);
+        !blocked
     }
 
     /// Indices of the shapes whose bounding boxes intersect `region` (broad phase), ascending.
@@ -378,7 +452,7 @@ impl StaticMap {
 
 /// Conservative line-of-sight test of `[a, b]` against the ESDF (see
 /// [`StaticMap::segment_clear`]).
-fn esdf_segment_clear(esdf: &Esdf, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
+fn esdf_segment_clear(esdf: &Esdf, a: &Vec3, b: &Vec3, clearance: f64, samples: &mut u64) -> bool {
     let len = (b - a).norm();
     if !len.is_finite() {
         return false;
@@ -398,6 +472,7 @@ fn esdf_segment_clear(esdf: &Esdf, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
         let p = if t >= len { *b } else { a + dir * t };
         // The same test at every sample, the end point included, so that the verdict does not
         // depend on the segment's length as it shrinks to a point.
+        *samples = samples.saturating_add(1);
         let slack = esdf.signed_distance(&p) - clearance;
         if slack.is_nan() || slack < margin {
             return false;

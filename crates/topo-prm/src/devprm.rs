@@ -18,7 +18,7 @@
 //!   and is ignored by the roadmap — the trajectory backend handles it in time;
 //! * the budget `t_max` (`budget_ms`) covers the roadmap construction (obstacle-aware and random
 //!   samples) and the shortcutting of the raw paths, as a deterministic work count
-//!   (`budget_ms · work_per_ms` units, [`crate::roadmap::RoadmapWork::units`]) and, unless
+//!   (`budget_ms · work_per_ms` units, [`crate::QueryWork`]) and, unless
 //!   `wall_clock_budget` is off, the monotonic clock; the graph search is bounded by
 //!   `max_expansions`, and the selection tests only the paths it could keep;
 //! * besides `t_max` and `N_max`, random sampling stops when the roadmap stalls
@@ -64,14 +64,14 @@ pub struct DevPrmParams {
     /// Fast-Planner's 5 ms (E1 uses 20 ms).
     /// Accepted: `(0, 6e5]` ms ([`crate::ranges::MAX_BUDGET_MS`]).
     pub budget_ms: f64,
-    /// Work units per ms of `budget_ms` (units: [`crate::roadmap::RoadmapWork::units`], one
-    /// visibility test each): the search stops after `budget_ms · work_per_ms` units — 80 % for
-    /// the roadmap, the rest for shortcutting the raw paths — and returns the paths found so far
-    /// with `SearchStats::budget_exhausted` set. Unlike the clock, the count gives the same paths
-    /// for the same seed on any machine. Ours: 360, measured on the 2-core development machine
-    /// (2.8 µs per unit, least squares over the 96 DEV-PRM searches of E4 seed 0 on the point-cloud
-    /// ESDF, ratio of measured to predicted 0.63–1.26 at the 10th–90th percentile).
-    /// Accepted: `(0, 1e9]` ([`crate::ranges::MAX_WORK_PER_MS`]).
+    /// Work units per ms of `budget_ms`: the search stops after `budget_ms · work_per_ms`
+    /// units — 80 % for the roadmap, the rest for shortcutting the raw paths — and returns the
+    /// paths found so far with `SearchStats::budget_exhausted` set. A unit is an estimated
+    /// nanosecond of the development machine ([`crate::QueryWork`]: map queries, ESDF samples,
+    /// shape and cone tests, samples, each with a fitted weight), so the default `1e6` makes the
+    /// budget about `budget_ms` of that machine whatever the map. Unlike the clock, the count
+    /// gives the same paths for the same seed on any machine.
+    /// Accepted: `(0, 1e12]` ([`crate::ranges::MAX_WORK_PER_MS`]).
     pub work_per_ms: f64,
     /// Also stop on the monotonic clock at `budget_ms` (the wall-clock guard of real-time runs).
     /// Default `true`; `false` leaves only the work budget and the counts, so a run depends on its
@@ -139,7 +139,7 @@ impl Default for DevPrmParams {
             clearance: 0.3,
             resolution: 0.1,
             budget_ms: 5.0,
-            work_per_ms: 360.0,
+            work_per_ms: 1.0e6,
             wall_clock_budget: true,
             max_samples: 2000,
             stall_samples: 200,

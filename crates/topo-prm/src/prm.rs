@@ -27,9 +27,41 @@ pub const COINCIDENT_M: f64 = 1e-9;
 /// Margin (m) added around the sampling region when selecting the cones that can matter.
 const REGION_MARGIN_M: f64 = 1.0;
 
-/// Dense points (one per `resolution` along a raw path) that shortcutting handles per work unit
-/// ([`RoadmapWork::units`]). Measured with the DEV-PRM searches of one E4 flight (seed 0).
-pub(crate) const SHORTCUT_POINTS_PER_UNIT: usize = 3;
+/// The work of a search so far, in units: its obstacle queries' ([`crate::QueryWork::units`]) plus the
+/// roadmap's own bookkeeping per sample ([`RoadmapWork::SAMPLE_UNITS`]).
+pub(crate) fn search_units(obstacles: &Obstacles<'_>, roadmap: RoadmapWork) -> u64 {
+    let own = (roadmap.sample_count as u64).saturating_mul(RoadmapWork::SAMPLE_UNITS);
+    obstacles.work().units().saturating_add(own)
+}
+
+/// Appends one line per search to the file named by `TRUST_PRM_WORK_TRACE` (fit of the unit
+/// weights; see `examples/prm_work_fit.rs`): elapsed ns, then the counts.
+fn trace_work(obstacles: &Obstacles<'_>, roadmap: RoadmapWork, elapsed: Duration) {
+    use std::io::Write;
+    let Some(path) = std::env::var_os("TRUST_PRM_WORK_TRACE") else {
+        return;
+    };
+    let w = obstacles.work();
+    if let Ok(mut f) = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+    {
+        let _ = writeln!(
+            f,
+            "{} {} {} {} {} {} {} {} {}",
+            elapsed.as_nanos(),
+            w.map.queries,
+            w.map.esdf_samples,
+            w.map.shape_tests,
+            w.cone_boxes,
+            w.cone_tests,
+            roadmap.sample_count,
+            roadmap.visibility_count,
+            roadmap.uvd_count
+        );
+    }
+}
 
 /// Part of the work budget the roadmap may use; the rest is left to shortcutting and selection.
 const ROADMAP_WORK_SHARE: f64 = 0.8;
@@ -155,12 +187,12 @@ impl PrmSetup {
     }
 
     /// The deterministic work budget: `budget_ms · work_per_ms` units.
-    fn work_budget(&self) -> usize {
+    fn work_budget(&self) -> u64 {
         let units = (self.budget_ms * self.work_per_ms).ceil();
-        if units >= usize::MAX as f64 {
-            usize::MAX
+        if units >= u64::MAX as f64 {
+            u64::MAX
         } else {
-            units as usize
+            units as u64
         }
     }
 
@@ -337,10 +369,7 @@ pub(crate) fn run(
     let start = query.start.p;
     let deadline = since + setup.budget("prm")?;
     let work_budget = setup.work_budget();
-    let roadmap_work_budget = (work_budget as f64 * ROADMAP_WORK_SHARE) as usize;
-    let out_of_budget = |work: RoadmapWork| {
-        work.units() >= roadmap_work_budget || (setup.wall_clock && Instant::now() >= deadline)
-    };
+    let roadmap_work_budget = (work_budget as f64 * ROADMAP_WORK_SHARE) as u64;
 
     let terminal = if setup.goal_surface {
         Terminal::goal_guidance_surface(&start, &query.goal, query.horizon_s, query.limits.v_max)
@@ -384,6 +413,10 @@ pub(crate) fn run(
     };
     let mut builder = RoadmapBuilder::new(start, terminal, &obstacles, params, region);
     let mut stats = SearchStats::default();
+    let out_of_budget = |work: RoadmapWork| {
+        search_units(&obstacles, work) >= roadmap_work_budget
+            || (setup.wall_clock && Instant::now() >= deadline)
+    };
 
     // Obstacle-aware samples first (Algorithm 2, ConstructRoadMap(G, P_PDC)). They are persistent:
     // one that sees a single guard now is retried against the guards random sampling adds.
@@ -424,7 +457,7 @@ pub(crate) fn run(
         stats.budget_exhausted = true;
     }
     stats.stalled = stall.stalled();
-    let mut work_units = builder.work().units();
+    let roadmap_work = builder.work();
     let graph = builder.finish();
     stats.node_count = graph.alive_count();
 
@@ -451,16 +484,13 @@ pub(crate) fn run(
     let mut short: Vec<Vec<Vec3>> = Vec::with_capacity(raw.len());
     for nodes in &raw {
         let points = graph.path_points(nodes);
-        let dense = (crate::uvd::polyline_length(&points) / setup.resolution).ceil();
-        let units = (dense / SHORTCUT_POINTS_PER_UNIT as f64).min(usize::MAX as f64) as usize;
         if !short.is_empty()
-            && (work_units.saturating_add(units) > work_budget
+            && (search_units(&obstacles, roadmap_work) >= work_budget
                 || (setup.wall_clock && Instant::now() >= deadline))
         {
             stats.budget_exhausted = true;
             break;
         }
-        work_units = work_units.saturating_add(units);
         short.push(shortcut(
             &points,
             &obstacles,
@@ -479,6 +509,7 @@ pub(crate) fn run(
         .map(GuidePath::new)
         .collect::<Result<Vec<_>, _>>()?;
     stats.elapsed = since.elapsed();
+    trace_work(&obstacles, roadmap_work, stats.elapsed);
     Ok(SearchResult { paths, stats })
 }
 

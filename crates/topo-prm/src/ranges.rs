@@ -33,8 +33,8 @@ pub const MAX_SURFACE_SAMPLES: usize = scale::MAX_SOLVED_SAMPLE_COUNT / 10;
 /// Largest accepted length ratio (a path this many times the shortest is dropped).
 pub const MAX_LENGTH_RATIO: f64 = 1.0e6;
 
-/// Largest accepted work rate (units per ms, [`crate::roadmap::RoadmapWork::units`]).
-pub const MAX_WORK_PER_MS: f64 = 1.0e9;
+/// Largest accepted work rate (units per ms, [`crate::QueryWork`]).
+pub const MAX_WORK_PER_MS: f64 = 1.0e12;
 
 /// A count for [`PlanError::InvalidInput`]'s value: exact up to 10⁹, scientific above.
 struct CountValue(usize);

@@ -190,21 +190,10 @@ pub struct RoadmapWork {
 }
 
 impl RoadmapWork {
-    /// Cost of one sample's clearance query, in visibility tests ([`RoadmapWork::units`]).
-    pub const SAMPLE_UNITS: usize = 7;
-    /// Cost of one UVD equivalence test, in visibility tests ([`RoadmapWork::units`]).
-    pub const UVD_UNITS: usize = 35;
-
-    /// The work in units of one visibility test: `visibility_count + 7·sample_count +
-    /// 35·uvd_count`. The weights are a least-squares fit of the roadmap time of the 96 DEV-PRM
-    /// searches of one E4 flight (point-cloud ESDF, seed 0): one unit took 2.8 µs on the 2-core
-    /// development machine, the searches' time per unit ranged 0.63–1.26× that (10th–90th
-    /// percentile).
-    pub fn units(&self) -> usize {
-        self.visibility_count
-            .saturating_add(Self::SAMPLE_UNITS.saturating_mul(self.sample_count))
-            .saturating_add(Self::UVD_UNITS.saturating_mul(self.uvd_count))
-    }
+    /// Cost of one sample's bookkeeping beyond its obstacle queries (drawing, guard lookups,
+    /// graph updates), in work units ([`crate::QueryWork`]: estimated ns of the development
+    /// machine, fitted with the query weights).
+    pub const SAMPLE_UNITS: u64 = 123;
 }
 
 /// Builds a [`Roadmap`] one sample at a time.

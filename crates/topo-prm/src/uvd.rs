@@ -501,12 +501,11 @@ fn pair_clear(
     if p == q {
         return true;
     }
-    let cones = obstacles.cones();
     let seg_box = Aabb::from_segment(p, q);
     which
         .iter()
-        .all(|&i| cones[i].segment_clear_in_box(p, q, c, &seg_box))
-        && (!map_relevant || obstacles.map().segment_clear(p, q, c))
+        .all(|&i| obstacles.cone_segment_clear(i, p, q, c, &seg_box))
+        && (!map_relevant || obstacles.map_segment_clear(p, q, c))
 }
 
 /// Whether the matched chords `k0..=k1` are clear of the cones in `parent` (indices into
@@ -688,8 +687,8 @@ fn block_clear(
         let seg_box = Aabb::from_segment(p, q);
         local
             .iter()
-            .all(|&i| cones[i].segment_clear_in_box(p, q, c, &seg_box))
-            && (!map_relevant || map.segment_clear(p, q, c))
+            .all(|&i| obstacles.cone_segment_clear(i, p, q, c, &seg_box))
+            && (!map_relevant || obstacles.map_segment_clear(p, q, c))
     })
 }
 

@@ -52,7 +52,7 @@
 //! With `planner.reproducible = true` (the default) wall-clock budgets are switched off: the
 //! manager does not pass its cycle deadline to the backend (`enforce_budget = false`), DEV-PRM and
 //! V-PRM keep their `budget_ms` only as a deterministic work budget (`wall_clock_budget = false`:
-//! `budget_ms · work_per_ms` visibility-test units, measured on the development machine, see
+//! `budget_ms · work_per_ms` units of estimated query time on the development machine, see
 //! `trust_topo_prm::DevPrmParams::work_per_ms`), and sparse A* gets a budget of
 //! [`REPRODUCIBLE_BUDGET_MS`] so that only its expansion cap ends a search. A run then depends
 //! only on the seeds, not on how loaded the machine is; wall-clock budgets make runs
