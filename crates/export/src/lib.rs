@@ -2,7 +2,9 @@
 //!
 //! [`export_mcap`] turns a run log ([`trust_runlog::RunLog`], schema `trust-sim-log/1`) into an
 //! [MCAP](https://mcap.dev) file that replays the flight in 3-D. It knows no simulator type: a log
-//! is all it reads, so a log written anywhere can be exported.
+//! is all it reads, so a log written anywhere can be exported. Use it (`trust-sim export RUN.jsonl
+//! --mcap FILE`) to inspect a flight of the paper's experiments (Sec. IV) in a 3-D viewer or to feed
+//! ROS 2 tools; the planner itself does not need it.
 //!
 //! # Channels
 //!
@@ -19,24 +21,12 @@
 //!
 //! # Size: what each panel shows
 //!
-//! No message repeats the whole path at full resolution, so the file grows linearly with the
-//! flight: a synthetic one-hour flight (180 000 states, 100 moving obstacles, two branches every
-//! 0.1 s; `cargo run --release -p trust-runlog --example hour_log -- hour.jsonl`) exports to
-//! 663 MB. What a viewer shows:
-//!
-//! - Foxglove's **3D panel** on `/scene/path` keeps every entity it has received (lifetime 0),
-//!   so while playing forward it draws the whole path at 0.1 s resolution, segment by segment;
-//!   after a seek it has the newest message's coarse `flown_path` (the whole flight, at most
-//!   [`MAX_COARSE_PATH_POINTS`] points: every 0.1 s for flights up to 25 s, coarser beyond) and
-//!   the segments from there on.
-//! - A **path display of `nav_msgs/Path`** (Foxglove's 3D panel, RViz, `ros2 bag play`) shows
-//!   the newest `/ros/vehicle/path` message: the whole flight up to it, one pose per 0.1 s for
-//!   flights up to 100 s, coarser beyond (the spacing doubles whenever the poses would exceed
-//!   [`MAX_ROS_PATH_POSES`]).
-//! - The obstacles move at 10 Hz up to 50 obstacles, 5 Hz up to 100, … ([`obstacle_period_s`]),
-//!   the vehicle at the log's rate (50 Hz): the obstacles' messages are the bulk of the file
-//!   (about 200 bytes an obstacle). Branch, path and obstacle coordinates are rounded to the
-//!   millimetre; poses keep every digit.
+//! No message repeats the whole path at full resolution, so the file grows linearly with the flight
+//! (a synthetic one-hour flight: 663 MB; `docs/decisions/0006-mcap-incremental-path.md`). While
+//! playing forward Foxglove's 3D panel draws every `/scene/path` segment; after a seek it has the
+//! coarse `flown_path` (at most [`MAX_COARSE_PATH_POINTS`] points) and the segments from there on. A
+//! `nav_msgs/Path` display shows the newest `/ros/vehicle/path` (at most [`MAX_ROS_PATH_POSES`]
+//! poses). Obstacles move at 10 Hz up to 50 obstacles, 5 Hz up to 100 ([`obstacle_period_s`]).
 //!
 //! [`export_file`] streams the log ([`trust_runlog::LogReader`]): memory is one line plus the
 //! two bounded paths, whatever the flight's length.
@@ -53,10 +43,15 @@
 //! `00 01 00 00` (CDR_LE), each primitive aligned to its size relative to the end of the header.
 //!
 //! A static point cloud file (`static_points_file`) is not exported; its generating shapes are,
-//! when the log has them.
+//! when the log has them. Chunks are written uncompressed (the `mcap` crate without its C codecs).
 //!
-//! Chunks are written uncompressed: the `mcap` crate is built without its default `zstd`/`lz4`
-//! features (C libraries), and every MCAP reader reads uncompressed chunks.
+//! ```no_run
+//! use std::path::Path;
+//!
+//! let summary = trust_export::export_file(Path::new("out/run/run.jsonl"), Path::new("run.mcap"))?;
+//! println!("{summary:?}");
+//! # Ok::<(), trust_export::ExportError>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod cdr;

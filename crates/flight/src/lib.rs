@@ -1,6 +1,6 @@
 //! # trust-flight — the closed loop: one flight of one planner through one world, written as a run log
 //!
-//! The simulator's middle stage (paper Sec. IV-D): it takes a [`World`] built by `trust-world`,
+//! The simulator's middle stage (paper Sec. IV): it takes a [`World`] built by `trust-world`,
 //! assembles the planner the scenario names ([`trust_world::planner::build`]), flies it and writes
 //! the run log of `trust-runlog`. Use [`fly`] for one flight; studies and experiments
 //! (`trust-experiments`) call it once per trial and planner. To drive the loop yourself (another
@@ -12,16 +12,29 @@
 //! ([`trust_world::sensing::Sensing`]); at the replanning rate the manager plans from the measured
 //! vehicle state and the trackers' forecasts — never from the true obstacles. When its plan takes
 //! effect, and whether a busy planner skips replanning ticks, is the [`Clock`]'s: a fixed latency
-//! (reproducible), or real time (the cycle's measured wall time, optionally scaled, is charged).
-//! After every physics step the true vehicle sphere is checked against the true static geometry
-//! and the true obstacles; the flight ends when it collides, arrives within the goal tolerance,
-//! when the planner's verdict that the goal cannot be reached has held for
-//! [`UNREACHABLE_SETTLE_S`], or when it runs out of time.
+//! (reproducible), or real time (the cycle's measured wall time, optionally scaled, is charged;
+//! `docs/decisions/0004-real-time-clock-model.md`). After every physics step the true vehicle
+//! sphere is checked against the true static geometry and the true obstacles; the flight ends when
+//! it collides, arrives within the goal tolerance, when the planner's verdict that the goal cannot
+//! be reached has held for [`UNREACHABLE_SETTLE_S`], or when it runs out of time.
 //!
 //! The run log ([`trust_runlog`]) holds a `state` record at the log rate and at the last instant
 //! (so a collision or arrival between two log ticks is in the log), a `cycle` record per planning
 //! cycle, and the `outcome`, whose figures are computed from the logged states exactly as the
 //! contract defines them.
+//!
+//! ```no_run
+//! use std::path::{Path, PathBuf};
+//! use trust_flight::{RunOptions, fly};
+//! use trust_world::{World, load_checked};
+//!
+//! let scenario = load_checked(Path::new("scenarios/quickstart.toml"))?;
+//! let world = World::build(&scenario)?;
+//! let options = RunOptions { log_path: Some(PathBuf::from("out/run.jsonl")), ..RunOptions::default() };
+//! let flight = fly(&world, &scenario.resolve_planner(), &options, |_| {})?;
+//! println!("{:?}", flight.summary.outcome.status);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 #![warn(missing_docs)]
 
 use std::path::{Path, PathBuf};

@@ -37,13 +37,6 @@
 //! assert!(written.svg.ends_with("speed.svg") && written.png.ends_with("speed.png"));
 //! # Ok::<(), trust_plot::PlotError>(())
 //! ```
-//!
-//! # Changelog
-//!
-//! - Moved out of `trust-sim` (issue 17): `trust_sim::plot` is this crate's root, with its bundled
-//!   font.
-//! - [`quantile_sorted`] returns `Option<f64>` (`None` for an empty slice) instead of NaN; it is
-//!   the workspace's one quantile (box plots, the flight summary, the study medians).
 #![warn(missing_docs)]
 
 mod animation;

@@ -1,7 +1,7 @@
 //! # trust-replay — watch a flight: one self-contained HTML page and an animated GIF from a run log
 //!
-//! Use it to *see* what a flight did, after the fact, from its run log alone (`trust-runlog`,
-//! schema `trust-sim-log/1`, `docs/run-log.md`): [`write_replay`] turns `RUN.jsonl` into
+//! Use it to *see* what a flight of the simulator (paper Sec. IV) did, from its run log alone
+//! (`trust-runlog`, `docs/run-log.md`): [`write_replay`] turns `RUN.jsonl` into
 //!
 //! - `RUN.replay.html` ([`page_html`]): one page with everything inline — the flight's data as
 //!   embedded JSON, the script and the style sheet — and no network access (no CDN, no fonts, no
@@ -47,6 +47,17 @@
 //!
 //! This crate sits beside the plots, on the far side of the simulator: it depends on
 //! `trust-runlog` and `trust-plot` and nothing depends on it but the `trust-sim` binary and xtask.
+//! Why one offline page, checked without WebDriver: `docs/decisions/0016`.
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use trust_replay::{ReplayParams, write_replay};
+//!
+//! let log = Path::new("out/run/run.jsonl");
+//! let files = write_replay(log, Path::new("out/run"), &ReplayParams::default())?;
+//! println!("open {}", files.html.display());
+//! # Ok::<(), trust_replay::ReplayError>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod browser;

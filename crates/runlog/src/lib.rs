@@ -1,12 +1,14 @@
-//! # trust-runlog — run logs of the closed loop: JSON Lines following `shared/contracts/run-log-v1.md` (schema `trust-sim-log/1`),
-//! documented in full in `docs/run-log.md`.
+//! # trust-runlog — run logs of the closed loop (JSON Lines, schema `trust-sim-log/1`)
 //!
-//! One object per line, each with a `"type"`: a `header` first, `state` records of the true vehicle
-//! and obstacles at ≥ 50 Hz, one `cycle` record per planning cycle, and an `outcome` last. The
-//! contract's fields are never dropped or renamed; this module adds fields (marked "added" in their
-//! docs) and nothing else.
+//! The record of one simulated flight (paper Sec. IV's experiments are judged on these), following
+//! `shared/contracts/run-log-v1.md` and documented in full in `docs/run-log.md`. One object per line,
+//! each with a `"type"`: a `header` first, `state` records of the true vehicle and obstacles at
+//! ≥ 50 Hz, one `cycle` record per planning cycle, and an `outcome` last. The contract's fields are
+//! never dropped or renamed; this crate adds fields (marked "added" in their docs) and nothing else.
 //!
-//! # Code map
+//! Use it to write a log (the closed loop in `trust-flight` does), to read one without building a
+//! world (the replay, the MCAP export, studies), or to re-check a log's outcome independently
+//! (`trust-sim audit`). It knows no simulator type: its `StaticShape` is also the scenario's.
 //!
 //! - The record types ([`Header`], [`StateRecord`], [`CycleRecord`], [`Outcome`], [`Record`]) and
 //!   [`LogWriter`], which writes a log line by line (buffered) in the shortest form that reads
@@ -22,6 +24,18 @@
 //!   its module docs).
 //! - [`audit`]: the independent re-check of a log's outcome from its header and states, with its
 //!   value policy and consistency checks.
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use trust_runlog::RunLog;
+//! use trust_runlog::audit::{AuditOptions, audit_file};
+//!
+//! let log = RunLog::read(Path::new("out/run/run.jsonl"))?;
+//! println!("{:?} after {} s", log.outcome.status, log.outcome.flight_time_s);
+//! let audit = audit_file(Path::new("out/run/run.jsonl"), AuditOptions::default())?;
+//! assert!(audit.findings.is_empty(), "{:?}", audit.findings);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod audit;

@@ -1,4 +1,5 @@
-//! `trust-sim`: fly a scenario, validate scenario files, audit run logs, run studies.
+//! `trust-sim`: fly a scenario, validate scenario files, audit run logs, run studies — the
+//! simulator and the experiments of the paper's Sec. IV from the command line.
 //!
 //! ```text
 //! trust-sim run SCENARIO.toml [--planner NAME] [--seed S] [--out DIR] [--vehicle quadrotor|perfect]

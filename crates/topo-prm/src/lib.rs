@@ -32,8 +32,9 @@
 //! [`trust_core::PlanError::InvalidInput`], a start or goal outside the map
 //! [`trust_core::PlanError::OutOfBounds`], inside a static obstacle
 //! [`trust_core::PlanError::InCollision`]. All randomness comes from the `rng` argument. DEV-PRM and
-//! V-PRM stop on a work budget (`budget_ms · work_per_ms` visibility tests), so the same seed gives the
-//! same paths on any machine, and also on the monotonic clock unless `wall_clock_budget` is off.
+//! V-PRM stop on a work budget (`budget_ms · work_per_ms` units of estimated work, [`QueryWork`]),
+//! so the same seed gives the same paths on any machine, and also on the monotonic clock unless
+//! `wall_clock_budget` is off.
 //!
 //! ```
 //! use rand::SeedableRng;

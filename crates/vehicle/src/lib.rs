@@ -1,4 +1,4 @@
-//! # Vehicles: what flies the plan in the closed loop
+//! # trust-vehicle — what flies the plan in the closed loop
 //!
 //! A [`Vehicle`] advances its true state by `dt` following a plan sampled through a
 //! `&dyn Fn(f64) -> Reference` (position, velocity, acceleration, jerk and yaw at an absolute
@@ -15,32 +15,23 @@
 //!   (see [`QuadrotorParams`]).
 //! - [`PerfectTracking`] — the state *is* the reference, for fast studies of the planner alone.
 //!
-//! The rigid body knows nothing of the plan and the controller only reads the reference and the
-//! state; perfect tracking is another implementation of the trait, not a flag in the dynamics.
-//! Nothing reads a clock or global state: the same inputs give bitwise the same states.
+//! Use it wherever a plan must be flown: the simulator's closed loop (`trust-flight`) does, and so
+//! can any other loop. The rigid body knows nothing of the plan and the controller only reads the
+//! reference and the state; perfect tracking is another implementation of the trait, not a flag in
+//! the dynamics. Nothing reads a clock or global state: the same inputs give bitwise the same states.
 //!
-//! ## Measured tracking error on a figure-eight
+//! Tracking error of the default [`ControlledQuadrotor`] at 500 Hz over three laps of each
+//! [`FigureEight`] (`cargo run --release -p trust-vehicle --example figure_eight`):
 //!
-//! Default [`ControlledQuadrotor`] ([`QuadrotorParams::default`], [`Se3Gains::default`]) at
-//! 500 Hz (`dt = 0.002 s`, the step the vehicle was validated at), starting on the reference,
-//! three laps of each [`FigureEight`]; errors sampled after every step:
+//! | figure-eight | peak speed / accel. | RMS / max position error | peak thrust | peak body rate |
+//! |---|---|---|---|---|
+//! | [`FigureEight::gentle`] (8 m × 4 m, 9 s) | 3.95 m/s / 4.14 m/s² | 0.86 mm / 1.1 mm | 9.05 N | 0.57 rad/s |
+//! | [`FigureEight::aggressive`] (15 m × 7.5 m, 7 s) | 9.52 m/s / 12.8 m/s² | 5.1 mm / 7.3 mm | 13.7 N | 2.3 rad/s |
 //!
-//! | figure-eight | peak speed | peak accel. | RMS / max position error | RMS / max velocity error | peak thrust | peak body rate |
-//! |---|---|---|---|---|---|---|
-//! | [`FigureEight::gentle`] (8 m × 4 m, 9 s) | 3.95 m/s | 4.14 m/s² | 0.86 mm / 1.1 mm | 1.2 mm/s / 2.2 mm/s | 9.05 N | 0.57 rad/s |
-//! | [`FigureEight::aggressive`] (15 m × 7.5 m, 7 s) | 9.52 m/s | 12.8 m/s² | 5.1 mm / 7.3 mm | 12 mm/s / 27 mm/s | 13.7 N | 2.3 rad/s |
-//!
-//! No thrust, torque or rate limit is reached (peak thrust 50 % of the 27.5 N available).
-//! [`PerfectTracking`] has zero error by construction. The model is ideal — exact parameters, no
-//! rotor dynamics, delay, noise or wind — so the error is the controller's own: the lag of the
-//! attitude loop (no angular-acceleration feed-forward, zero-order hold; raising its gains shrinks
-//! the error). A real vehicle would do worse.
-//! Reproduce with `cargo run --release -p trust-vehicle --example figure_eight`, which also prints the
-//! cost: ≈ 0.4 µs per step including the error bookkeeping, ≈ 6 ms for a 30 s flight, measured on
-//! a shared, loaded 2-core machine; a step allocates nothing. `tests/vehicle.rs` asserts
-//! RMS < 3 mm (gentle) and < 15 mm (aggressive).
-//!
-//! ## Using it in the loop
+//! No thrust, torque or rate limit is reached. The model is ideal — exact parameters, no rotor
+//! dynamics, delay, noise or wind — so the error is the controller's own (the lag of the attitude
+//! loop); a real vehicle would do worse. A step costs ≈ 0.4 µs and allocates nothing;
+//! `tests/vehicle.rs` asserts RMS < 3 mm (gentle) and < 15 mm (aggressive).
 //!
 //! ```
 //! use trust_vehicle::{
@@ -63,11 +54,6 @@
 //! assert!(error < 0.05);
 //! # Ok::<(), trust_vehicle::VehicleError>(())
 //! ```
-//!
-//! # Changelog
-//!
-//! - Moved out of `trust-sim` (issue 17): `trust_sim::vehicle` is this crate's root, with the same
-//!   items; its errors stay [`VehicleError`]s.
 #![warn(missing_docs)]
 
 mod controlled;

@@ -1,21 +1,18 @@
 //! # trust-world — everything a scenario file describes, built once per trial
 //!
 //! The first stage of the simulator's data path (scenario file → world → closed loop → run log →
-//! experiments; paper Sec. IV-D): [`scenario`] parses and checks the TOML file, [`World::build`]
-//! generates the layout and the planner's map from the seeds, [`traffic`] moves the true
-//! obstacles (scripted ones along [`script`]), [`sensing`] turns them into the forecasts the planner sees, and [`planner`] turns the
-//! scenario's `[planner]` section into the parameters of the parts it names (the closed loop in
-//! `trust-flight` assembles them). Errors are [`WorldError`]s naming the file, field and value.
+//! experiments; paper Sec. IV): [`scenario`] parses and checks the TOML file, [`World::build`]
+//! generates the layout and the planner's map from the seeds, [`traffic`] moves the true obstacles
+//! (scripted ones along [`script`]), [`sensing`] turns them into the forecasts the planner sees, and
+//! [`planner`] turns the scenario's `[planner]` section into the parameters of the parts it names
+//! (the closed loop in `trust-flight` assembles them). Errors are [`WorldError`]s naming the file,
+//! field and value.
 //!
-//! The built world of one trial: the true geometry, the planner's static map, and the initial
-//! moving obstacles, generated deterministically from the scenario and its seed.
-//!
-//! [`World::build`] validates the scenario, generates the layout from the world seed
-//! ([`Seeds::world`]), and builds the planner's map. Everything that varies between planners of
-//! one trial is created from the world afterwards: [`World::traffic`], [`World::sensing`],
-//! [`World::planner_context`]. A world is immutable and `Send + Sync`: build it once per trial
-//! and share it read-only (`Arc<World>`) between the runs of different planners — E4's voxel map
-//! is the expensive part (below).
+//! Use it to load a scenario and build its world: [`World::build`] validates the scenario, generates
+//! the layout from the world seed ([`Seeds::world`]) and builds the planner's map. Everything that
+//! varies between planners of one trial is created from the world afterwards: [`World::traffic`],
+//! [`World::sensing`], [`World::planner_context`]. A world is immutable and `Send + Sync`: build it
+//! once per trial and share it read-only (`Arc<World>`); E4's voxel map takes about 5 s and 0.9 GB.
 //!
 //! # Truth and the planner's view
 //!
@@ -23,61 +20,16 @@
 //!   `static_shapes`). With `source = "inline"` or `"file"` point clouds, the points are truth too
 //!   ([`World::static_points`], [`World::static_points_file`]).
 //! * [`World::true_static_clearance`] is the simulator's collision test: shapes analytically
-//!   (a BVH of the true shapes), points through a k-d tree — microseconds per call, fine at the
-//!   500 Hz physics rate.
+//!   (a BVH of the true shapes), points through a k-d tree.
 //! * [`World::planner_map`] is what the planner sees: the shapes analytically without a point
-//!   cloud; only a voxel ESDF of the sampled cloud with `source = "shapes"` (the planner does not
-//!   see the shapes: [`sample_shapes`] documents the sampling); the shapes plus an ESDF of the
-//!   points for inline and file clouds. [`World::static_map_error_m`] bounds how much it may
-//!   overestimate a true distance, and the planner's clearances include it.
+//!   cloud; only a voxel ESDF of the sampled cloud with `source = "shapes"` ([`sample_shapes`]
+//!   documents the sampling); the shapes plus an ESDF of the points for inline and file clouds.
+//!   [`World::static_map_error_m`] bounds how much it may overestimate a true distance, and the
+//!   planner's clearances include it.
 //!
-//! # Generators (distributions and why)
-//!
-//! The paper does not publish its worlds; these reproduce the stated settings.
-//!
-//! * **`e1`** (Sec. IV-A, 20 × 20 × 10 m): `obstacle_count` moving obstacles with the
-//!   distributions of `trust_topo_prm::scenes::SceneParams::default()` — half spheres, half
-//!   full-height cylinders, radius U[0.5, 1.5] m, speed U[0.5, 3] m/s, direction uniform on the
-//!   sphere (horizontal for cylinders), centre uniform inside the box, start and goal 1 m clear
-//!   beyond the vehicle radius. The topo-prm function itself is not called because it draws its
-//!   own start and goal; the scenario fixes them.
-//! * **`e2-static`, `e2-dynamic`** (Sec. IV-B, 50 × 20 × 10 m): the fixed scenes of
-//!   `trust_minco::scenes` — five static shapes, or five moving obstacles whose forecast
-//!   `p0`, `v0`, `r_o` become the truth at constant velocity (their forecast `mu` and `r_safe`
-//!   are not used: the sensing makes the forecasts).
-//! * **`e3`** (Sec. IV-C, the setting of Fig. Sim-A-1-1(a)): bounds `[-5, -10, 0]..[70, 10, 15]`
-//!   for the start at the origin and the goal `[65, 0, 7.5]` (so `r_des = 65 − 4 s · 10 m/s =
-//!   25 m` with the manager's 4 s horizon); `obstacle_count` E1-like obstacles in x ∈ [5, 45] m,
-//!   the first horizon's reach, with random maneuvers.
-//! * **`e4`** (Sec. IV-D, 250 × 75 × 20 m): static obstacles placed by rejection sampling,
-//!   largest first — `block_count` blocks (boxes of side U[2, 6] m, height U[3, 15] m),
-//!   `wall_count` walls (length U[4, 12] m, thickness U[0.4, 0.8] m, height U[6, 20] m, along x or
-//!   y with equal probability), `pillar_count` full-height pillars (radius U[0.5, 1.5] m) — each
-//!   at a uniform position with its footprint inside the bounds, at least `min_gap_m` = 2.5 m
-//!   (horizontally) from every other footprint, so that passages of about eight vehicle radii
-//!   exist everywhere, and at least `endpoint_clear_m` = 10 m from the start and the goal.
-//!   Defaults 40 + 40 + 320 shapes covering about 9–10 % of the ground (measured over seeds
-//!   0–3: 9.0–9.7 %); the planner sees them as a point cloud (`source = "shapes"`, 0.2 m voxels
-//!   in `scenarios/e4.toml`, about 4.5 M points). Then `moving_count` = 100 moving obstacles: half spheres of
-//!   radius U[0.4, 1.0] m, half cylinders of radius U[0.3, 0.8] m and half-height U[1, 2.5] m;
-//!   speed U[0.5, 2.5] m/s; spheres climb at most 20°; centres uniform in the region x ∈
-//!   [10, 240] m (they stay there, reflecting), not overlapping a static shape at `t = 0`; random
-//!   maneuvers within the default forecasts' `μ`. Every trial seed gives a different world.
-//!   Moving obstacles ignore the static ones (they may pass through a pillar); only the region
-//!   walls reflect them.
-//!
-//! Explicit `[[static.shapes]]`, `[[obstacles]]` and `[[random_obstacles]]` are added after the
-//! generator's; random groups draw from the same world stream after the generator.
-//!
-//! # E4 build cost
-//!
-//! The E4 ESDF at 0.2 m voxels has 1250 × 375 × 100 = 46.9 M voxels; the world keeps 375 MB of
-//! `f64` distances. Measured with the release build of the `world_view` example on the shared
-//! 2-core machine (load average about 3.5 from other jobs), seeds 0–2: about 4.6 M sampled cloud
-//! points, layout 15–23 ms, sampling 0.16–0.24 s, ESDF 4.8–5.0 s (the two exact distance
-//! transforms of `trust_geometry::Esdf`), 5.0–5.2 s in all; peak resident memory 870–890 MB
-//! (occupancy, the outside and inside transforms and the points, at once). Build it once per
-//! trial and share it.
+//! The generators (`e1`, `e2-static`, `e2-dynamic`, `e3`, `e4`) reproduce the paper's stated
+//! settings; their distributions and why: `docs/decisions/0020-world-generators.md`; the point-cloud
+//! view: `0005-point-cloud-esdf.md`.
 //!
 //! # Validation
 //!
@@ -85,6 +37,16 @@
 //! the file's checks with the scale policy ([`scenario::scale`]), the layout, and the traffic,
 //! sensor, planner assembly and vehicle model of the flight; a file it accepts builds and
 //! starts. Files the scenario names are read under [`scenario::files`]' caps and path policy.
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use trust_world::{World, load_checked};
+//!
+//! let scenario = load_checked(Path::new("scenarios/quickstart.toml"))?;
+//! let world = World::build(&scenario)?;
+//! println!("{} static shapes", world.static_shapes().len());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 #![warn(missing_docs)]
 
