@@ -359,15 +359,28 @@ fn bad_input_is_a_typed_error_naming_the_file() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// Whether this is a CI run: the environment variable `CI` is set (`.ci/run` exports `CI=1`, as
+/// hosted CI services do), and not to an empty string, `0` or `false`.
+fn under_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| !matches!(v.trim(), "" | "0" | "false"))
+}
+
 /// Opens the page in headless Chromium, moves the slider (through `#t=`) and checks that the
-/// vehicle moved, with no script or console error. CI installs Chromium (`.ci/run`); without it
-/// the test says so and passes.
+/// vehicle moved, with no script or console error. CI installs Chromium (`.ci/run`), and under
+/// CI a missing Chromium fails the test; in a local run without it the test says SKIPPED and
+/// passes.
 #[test]
 fn the_page_plays_in_headless_chromium() {
     let Some(chromium) = browser::find_chromium() else {
+        assert!(
+            !under_ci(),
+            "no chromium on the PATH under CI (CI={:?}): .ci/run installs the Debian packages \
+             chromium and chromium-driver, or set TRUST_CHROMIUM",
+            std::env::var("CI").unwrap_or_default()
+        );
         eprintln!(
             "SKIPPED: no chromium on the PATH (set TRUST_CHROMIUM or install the Debian packages \
-             chromium and chromium-driver; CI does)"
+             chromium and chromium-driver; CI does, and fails here without it)"
         );
         return;
     };
