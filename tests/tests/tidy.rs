@@ -437,3 +437,259 @@ fn no_module_cycles_inside_a_crate() {
         offenders.join("\n")
     );
 }
+
+// ---------------------------------------------------------------------------------------------
+// Docs stay short and true (issue 33): README as a front page, ARCHITECTURE as a map, crate roots
+// that say what a crate is, no commit hashes where a reader looks first. History belongs in
+// CHANGELOG.md, reasons in docs/decisions/, numbers in docs/results.md (`cargo xtask results`).
+
+const README_MAX_LINES: usize = 150;
+const README_MAX_WORDS: usize = 1_200;
+const README_MAX_TABLE_ROWS: usize = 12;
+const TABLE_CELL_MAX_CHARS: usize = 120;
+const ARCHITECTURE_MAX_LINES: usize = 350;
+const CRATE_ROOT_MAX_DOC_LINES: usize = 60;
+const DECISION_RECORD_MAX_LINES: usize = 60;
+
+fn read_root_file(name: &str) -> String {
+    std::fs::read_to_string(workspace_root().join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// The cells of a Markdown table row (`| a | b |`), split at `|` outside code spans and not
+/// escaped as `\|`; `None` for a line that is not a table row.
+fn table_cells(line: &str) -> Option<Vec<String>> {
+    let row = line.trim();
+    if !row.starts_with('|') {
+        return None;
+    }
+    let mut cells = Vec::new();
+    let (mut cell, mut in_code, mut escaped) = (String::new(), false, false);
+    for c in row[1..].chars() {
+        match c {
+            '|' if !in_code && !escaped => cells.push(std::mem::take(&mut cell)),
+            _ => {
+                if c == '`' {
+                    in_code = !in_code;
+                }
+                cell.push(c);
+            }
+        }
+        escaped = c == '\\';
+    }
+    if !cell.trim().is_empty() {
+        cells.push(cell);
+    }
+    Some(cells.into_iter().map(|c| c.trim().to_string()).collect())
+}
+
+/// Whether a table row is the header separator (`|---|:--:|`).
+fn is_separator(cells: &[String]) -> bool {
+    cells
+        .iter()
+        .all(|c| !c.is_empty() && c.chars().all(|ch| matches!(ch, '-' | ':' | ' ')))
+}
+
+/// What breaks the README's front-page rules.
+fn readme_problems(text: &str) -> Vec<String> {
+    let mut problems = Vec::new();
+    let lines = text.lines().count();
+    if lines > README_MAX_LINES {
+        problems.push(format!(
+            "README.md has {lines} lines (at most {README_MAX_LINES})"
+        ));
+    }
+    let words = text.split_whitespace().count();
+    if words > README_MAX_WORDS {
+        problems.push(format!(
+            "README.md has {words} words (at most {README_MAX_WORDS})"
+        ));
+    }
+    let mut rows = 0;
+    for (i, line) in text.lines().enumerate() {
+        let Some(cells) = table_cells(line) else {
+            continue;
+        };
+        if is_separator(&cells) {
+            continue;
+        }
+        rows += 1;
+        for cell in cells
+            .iter()
+            .filter(|c| c.chars().count() > TABLE_CELL_MAX_CHARS)
+        {
+            problems.push(format!(
+                "README.md:{}: a table cell of {} characters (at most {TABLE_CELL_MAX_CHARS}): {cell:?}",
+                i + 1,
+                cell.chars().count()
+            ));
+        }
+    }
+    if rows > README_MAX_TABLE_ROWS {
+        problems.push(format!(
+            "README.md has {rows} table rows, headers included (at most {README_MAX_TABLE_ROWS}): \
+             the full tables belong in docs/results.md"
+        ));
+    }
+    problems
+}
+
+/// The words of `text` that look like commit hashes: 7–40 hex digits with at least one digit and
+/// one letter a–f (so `1234567`, `deadbeef`, `f64` and `e4` are not), with line numbers.
+fn commit_hashes(text: &str) -> Vec<(usize, String)> {
+    let mut found = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        for word in line.split(|c: char| !c.is_ascii_alphanumeric()) {
+            let hex = word.chars().all(|c| c.is_ascii_hexdigit());
+            let digit = word.chars().any(|c| c.is_ascii_digit());
+            let letter = word.chars().any(|c| c.is_ascii_alphabetic());
+            if hex && digit && letter && (7..=40).contains(&word.len()) {
+                found.push((i + 1, word.to_string()));
+            }
+        }
+    }
+    found
+}
+
+/// What breaks the rules of a crate root: more than [`CRATE_ROOT_MAX_DOC_LINES`] lines of `//!`,
+/// or a changelog heading among them.
+fn crate_root_problems(name: &str, text: &str) -> Vec<String> {
+    let doc: Vec<&str> = text
+        .lines()
+        .filter(|l| l.trim_start().starts_with("//!"))
+        .collect();
+    let mut problems = Vec::new();
+    if doc.len() > CRATE_ROOT_MAX_DOC_LINES {
+        problems.push(format!(
+            "{name}: {} lines of crate docs (at most {CRATE_ROOT_MAX_DOC_LINES}): what it is, when \
+             to use it, the paper section and an example; move history to CHANGELOG.md and \
+             reasons to docs/decisions/",
+            doc.len()
+        ));
+    }
+    for line in &doc {
+        let body = line.trim_start().trim_start_matches("//!").trim();
+        if body.starts_with('#') && body.to_lowercase().contains("changelog") {
+            problems.push(format!(
+                "{name}: a changelog in the crate docs ({body:?}): it belongs in CHANGELOG.md"
+            ));
+        }
+    }
+    problems
+}
+
+#[test]
+fn the_docs_checks_find_what_they_look_for() {
+    // Table rows and cells.
+    assert_eq!(
+        table_cells("| a | `x|y` | b\\|c |"),
+        Some(vec!["a".into(), "`x|y`".into(), "b\\|c".into()])
+    );
+    assert_eq!(table_cells("not | a row"), None);
+    assert!(is_separator(&table_cells("|---|:--:|").unwrap()));
+    let wide = format!("| what | ours |\n|---|---|\n| E4 | {} |\n", "x".repeat(121));
+    assert_eq!(
+        readme_problems(&wide).len(),
+        1,
+        "{:?}",
+        readme_problems(&wide)
+    );
+    let many: String = std::iter::once("| h |\n|---|\n".to_string())
+        .chain((0..12).map(|i| format!("| {i} |\n")))
+        .collect();
+    assert!(readme_problems(&many)[0].contains("13 table rows"));
+    let long = "word\n".repeat(151);
+    assert!(readme_problems(&long)[0].contains("151 lines"));
+    let wordy = "word ".repeat(1_201);
+    assert!(readme_problems(&wordy)[0].contains("1201 words"));
+    assert!(readme_problems("# Title\n\n| a | b |\n|---|---|\n| 1 | 2 |\n").is_empty());
+    // Commit hashes.
+    let hashes = commit_hashes("commit 737472e, fa354d2f; 1234567 deadbeef f64 e4 0x1f 2c88551\n");
+    let words: Vec<&str> = hashes.iter().map(|(_, w)| w.as_str()).collect();
+    assert_eq!(words, ["737472e", "fa354d2f", "2c88551"]);
+    assert!(
+        commit_hashes("1e6 m, 2.5e-3, u64::MAX, 961ed1843997ed5c6dd2d5dbd2b5e925f958c1544")
+            .is_empty()
+    );
+    // Crate roots.
+    let root = format!("{}#![warn(missing_docs)]\n", "//! text\n".repeat(61));
+    assert!(crate_root_problems("x", &root)[0].contains("61 lines"));
+    assert!(
+        crate_root_problems("x", "//! # x\n//!\n//! # Changelog\n//! - y\n")[0]
+            .contains("changelog")
+    );
+    assert!(crate_root_problems("x", "//! # x\n//! See the changelog.\n").is_empty());
+}
+
+#[test]
+fn readme_is_a_front_page() {
+    let problems = readme_problems(&read_root_file("README.md"));
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+#[test]
+fn architecture_is_a_map_not_a_log() {
+    let lines = read_root_file("ARCHITECTURE.md").lines().count();
+    assert!(
+        lines <= ARCHITECTURE_MAX_LINES,
+        "ARCHITECTURE.md has {lines} lines (at most {ARCHITECTURE_MAX_LINES}): experiment logs \
+         belong in docs/decisions/ and CHANGELOG.md"
+    );
+}
+
+#[test]
+fn no_commit_hashes_in_readme_or_architecture() {
+    let mut offenders = Vec::new();
+    for name in ["README.md", "ARCHITECTURE.md"] {
+        for (line, word) in commit_hashes(&read_root_file(name)) {
+            offenders.push(format!("{name}:{line}: {word}"));
+        }
+    }
+    assert!(
+        offenders.is_empty(),
+        "commit hashes (results go to docs/results.md, stamped by `cargo xtask results`):\n{}",
+        offenders.join("\n")
+    );
+}
+
+#[test]
+fn crate_roots_are_short_and_keep_no_changelog() {
+    let mut problems = Vec::new();
+    for m in members() {
+        for root in ["src/lib.rs", "src/main.rs"] {
+            if let Ok(text) = std::fs::read_to_string(m.dir.join(root)) {
+                problems.extend(crate_root_problems(&format!("{} {root}", m.name()), &text));
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+#[test]
+fn decision_records_are_short_and_indexed_in_architecture() {
+    let architecture = read_root_file("ARCHITECTURE.md");
+    let dir = workspace_root().join("docs/decisions");
+    let mut records: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("docs/decisions")
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "md"))
+        .collect();
+    records.sort();
+    assert!(!records.is_empty(), "no decision records in docs/decisions");
+    let mut problems = Vec::new();
+    for path in &records {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let lines = std::fs::read_to_string(path).unwrap().lines().count();
+        if lines > DECISION_RECORD_MAX_LINES {
+            problems.push(format!(
+                "docs/decisions/{name}: {lines} lines (at most {DECISION_RECORD_MAX_LINES})"
+            ));
+        }
+        if !architecture.contains(&format!("docs/decisions/{name}")) {
+            problems.push(format!(
+                "docs/decisions/{name} is not in ARCHITECTURE.md's index of decision records"
+            ));
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
