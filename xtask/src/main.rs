@@ -18,6 +18,8 @@
 //!   non-finite output, wrong answer or call over 1 s.
 //! - `proptest [--seeds K] [--cases N]`: every property test under K random seeds
 //!   (`PROPTEST_RNG_SEED`), reporting each failing seed with its reproducing command.
+//! - `results [--study SUMMARY.json] [--suite RUNS.csv]... [--out FILE]`: `docs/results.md` from
+//!   studies already run, stamped with the commit and the machine (`results.rs`).
 //! - `replay-check PAGE [--at T]`: opens a replay page (`trust-sim replay`) in headless Chromium
 //!   at `#t=0` and `#t=T`, fails on any script or console error, and checks that the vehicle
 //!   moved (its canvas position and the screenshots' pixels; `trust_replay::browser`).
@@ -32,6 +34,7 @@ use trust_experiments::{e1, e2};
 
 mod fuzz;
 mod proptest;
+mod results;
 
 #[derive(Parser)]
 #[command(
@@ -101,6 +104,19 @@ enum Cmd {
         /// Build and run the tests in the release profile instead of the test profile.
         #[arg(long)]
         release: bool,
+    },
+    /// Write `docs/results.md` from studies already run (a study's `summary.json`, suites'
+    /// `runs.csv`), stamped with the commit and the machine; fails naming a missing input.
+    Results {
+        /// The study's `summary.json` (`cargo xtask ablate` writes it).
+        #[arg(long, default_value = results::DEFAULT_STUDY)]
+        study: PathBuf,
+        /// A suite's `runs.csv` (repeatable; default: `out/suite/runs.csv` when it exists).
+        #[arg(long = "suite")]
+        suites: Vec<PathBuf>,
+        /// The file to write.
+        #[arg(long, default_value = results::DEFAULT_OUT)]
+        out: PathBuf,
     },
     /// Open a replay page in headless Chromium (`$TRUST_CHROMIUM` or `chromium` on the PATH):
     /// no script or console errors, and the vehicle moves when the slider does.
@@ -205,6 +221,9 @@ fn main() -> Result<()> {
                 release,
             },
         ),
+        Cmd::Results { study, suites, out } => {
+            results::run(&root, &results::Options { study, suites, out })
+        }
         Cmd::ReplayCheck { page, at, out } => replay_check(&page, at, &root.join(out)),
     }
 }
