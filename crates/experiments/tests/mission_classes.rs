@@ -208,6 +208,40 @@ fn a_sealed_goal_is_said_unreachable_within_a_second() {
     assert!(!events.iter().any(|e| e == "route_failed"), "{events:?}");
 }
 
+/// Issue 31: a goal inside an obstacle (a generated column, also without a global route): the
+/// verdict in the first cycle, a stop held short of the column, the flight ended `unreachable`
+/// after the settling time, no collision, an audited log.
+#[test]
+fn a_goal_inside_an_obstacle_is_said_unreachable_at_once() {
+    for route in [true, false] {
+        let mut s = load("unreachable", "goal_in_column");
+        s.planner.route.enabled = route;
+        let (flight, _) = fly_audited(
+            &s,
+            if route {
+                "in_column"
+            } else {
+                "in_column_no_route"
+            },
+        );
+        let o = &flight.summary.outcome;
+        assert_eq!(o.status, Status::Unreachable, "{o:?}");
+        assert!(
+            o.reason
+                .as_deref()
+                .is_some_and(|r| r.contains("inside an obstacle")),
+            "{o:?}"
+        );
+        let first = flight.record.cycles[0]
+            .events
+            .iter()
+            .any(|e| e == "goal_unreachable");
+        assert!(first, "the verdict in the first cycle");
+        assert!(o.t <= trust_flight::UNREACHABLE_SETTLE_S + 0.5, "{o:?}");
+        assert!(o.min_clearance_static_m > 0.0, "{o:?}");
+    }
+}
+
 /// Issue 31: a full wall whose one slot (0.4 m) is narrower than the vehicle (0.5 m): the route
 /// search exhausts the start's side of the wall (a few hundred thousand units, sliced over the
 /// cycles while the vehicle holds its place) and the verdict is "sealed off", not a time-out.

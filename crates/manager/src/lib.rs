@@ -63,7 +63,7 @@ pub mod safety;
 pub use brake::{
     brake_along, brake_straight, braking_tail, dash_maneuvers, escape_maneuvers, hermite_quintic,
 };
-pub use manager::{Branch, MainDecision, Manager, choose_main};
+pub use manager::{Branch, HOLD_CLEARANCE_M, MainDecision, Manager, choose_main};
 pub use params::{
     GROWTH_FRACTION, ManagerParams, ReanchorParams, SOLVE_DEADLINE_FRACTION, SafetyParams,
 };

@@ -21,7 +21,7 @@ use crate::report::{
 use crate::safety::{
     SafetyVerdict, assess_trajectory, check_trajectory, forecasts_near, window_bounds,
 };
-use trust_route::{GlobalRoute, RoutePoint, RouteProgress, RouteSearch};
+use trust_route::{GlobalRoute, RoutePoint, RouteProgress, RouteSearch, UnreachableCause};
 
 use crate::routing::{RouteReason, Router, rerouted, route_failed};
 
@@ -433,10 +433,12 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
     /// Planning failures are reported in the [`StepReport`] (events, fallback); the committed plan
     /// afterwards is [`Manager::plan`].
     ///
+    /// A goal outside the map bounds or inside a static obstacle is not an error: the report's
+    /// [`StepReport::goal_unreachable`] says why, and the vehicle holds a stop short of it
+    /// (the farthest point toward it in sight, [`HOLD_CLEARANCE_M`] from the static map).
+    ///
     /// # Errors
-    /// Only for invalid input: non-finite `now`, state or goal (named), a goal outside the map
-    /// bounds ([`PlanError::OutOfBounds`]) or inside a static obstacle
-    /// ([`PlanError::InCollision`]).
+    /// Only for invalid input: non-finite `now`, state or goal (named).
     pub fn step(
         &mut self,
         now: f64,
@@ -445,7 +447,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         scene: &Scene<'_>,
     ) -> Result<StepReport, PlanError> {
         let mut spans = Spans::start();
-        check_step_input(now, measured, goal, scene)?;
+        check_step_input(now, measured, goal)?;
         let real_goal = *goal;
         // The forecasts the cycle plans against: their growth stopped after
         // `forecast_growth_s`, and their mirror images at the walls.
@@ -468,11 +470,32 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             ..*scene
         };
         let scene = &planned;
+        // A goal outside the bounds or inside a static obstacle is a verdict, checked every
+        // cycle: the vehicle holds a stop short of it (no route search is needed to know).
+        let invalid_goal = invalid_goal_cause(goal, scene);
+        let newly_invalid = match &invalid_goal {
+            Some(cause) => self.hold_short_of_invalid_goal(cause, measured, goal, scene),
+            None => {
+                if self.router.is_none() {
+                    // Without a router the only verdict is an invalid goal's.
+                    self.unreachable = None;
+                }
+                false
+            }
+        };
         // With a standing verdict that the goal cannot be reached, the cycle plans toward the
         // reachable point nearest it (a held stop); the route keeps being re-checked.
         let target = self.target(goal);
         let mut cycle = self.begin_cycle(now, measured, &target, spans.started);
-        self.update_route(&mut cycle, measured, &real_goal, scene, &mut spans);
+        if let Some(u) = self.unreachable.as_ref().filter(|_| newly_invalid) {
+            cycle.events.push(Event::GoalUnreachable {
+                cause: u.cause.clone(),
+                held_at: u.held_at,
+            });
+        }
+        if invalid_goal.is_none() {
+            self.update_route(&mut cycle, measured, &real_goal, scene, &mut spans);
+        }
         // A vehicle at rest waits where it is for its first route toward a new goal (a few
         // cycles): flown toward the goal meanwhile it would head into the trap the route is
         // for. It still plans (to hold its place), so it still gets out of a moving obstacle's
@@ -533,6 +556,35 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         self.route.is_none()
             && matches!(self.route_search, Some((RouteReason::First, _)))
             && measured.v.norm() <= REST_SPEED_FRACTION * self.limits.v_max
+    }
+
+    /// Sets the verdict for a goal outside the bounds or inside a static obstacle (kept with its
+    /// first time and hold point while the goal stays the same): the hold point is the farthest
+    /// point toward the goal (clipped into the bounds) that the vehicle sees from where it is and
+    /// that keeps [`HOLD_CLEARANCE_M`] from the static map. Returns whether the verdict is new.
+    fn hold_short_of_invalid_goal(
+        &mut self,
+        cause: &UnreachableCause,
+        measured: &State,
+        goal: &Vec3,
+        scene: &Scene<'_>,
+    ) -> bool {
+        let cause = cause.to_string();
+        let same = self.routed_goal.is_some_and(|g| (g - goal).norm() <= 1e-9)
+            && self.unreachable.as_ref().is_some_and(|u| u.cause == cause);
+        if same {
+            return false;
+        }
+        self.route_search = None;
+        self.routed_goal = Some(*goal);
+        self.routed_at = measured.t;
+        let held = hold_point_toward(&measured.p, goal, scene);
+        self.unreachable = Some(crate::GoalUnreachable {
+            cause,
+            held_at: Some([held.x, held.y, held.z]),
+            since_t: measured.t,
+        });
+        true
     }
 
     /// Where the cycle plans to: `goal`, or while the goal is held unreachable
@@ -1347,17 +1399,46 @@ fn with_wall_images(
 }
 
 /// Checks the inputs of [`Manager::step`].
-fn check_step_input(
-    now: f64,
-    measured: &State,
-    goal: &Vec3,
-    scene: &Scene<'_>,
-) -> Result<(), PlanError> {
+fn check_step_input(now: f64, measured: &State, goal: &Vec3) -> Result<(), PlanError> {
     check_finite("now", now)?;
     measured.validate("state")?;
-    check_finite_vec("goal", goal)?;
-    scene.check_in_bounds("goal", goal)?;
-    scene.check_static_free("goal", goal, 0.0)
+    check_finite_vec("goal", goal)
+}
+
+/// Clearance (m) from the static map of the stop held short of a goal outside the bounds or
+/// inside a static obstacle ([`Manager::step`]).
+pub const HOLD_CLEARANCE_M: f64 = 0.5;
+
+/// Why a (finite) goal cannot be reached whatever the route: outside the map bounds, or inside a
+/// static obstacle (signed distance below zero).
+fn invalid_goal_cause(goal: &Vec3, scene: &Scene<'_>) -> Option<UnreachableCause> {
+    if scene.check_in_bounds("goal", goal).is_err() {
+        return Some(UnreachableCause::GoalOutsideBounds);
+    }
+    let signed_distance_m = scene.static_clearance(goal);
+    (signed_distance_m < 0.0).then_some(UnreachableCause::GoalInsideObstacle { signed_distance_m })
+}
+
+/// The farthest point of the segment from `from` toward `goal` (clipped into the map bounds) that
+/// `from` sees and that keeps [`HOLD_CLEARANCE_M`] from the static map, on a grid of 64 steps;
+/// `from` when there is none.
+fn hold_point_toward(from: &Vec3, goal: &Vec3, scene: &Scene<'_>) -> Vec3 {
+    let b = scene.map.bounds();
+    let aim = Vec3::new(
+        goal.x.clamp(b.min.x, b.max.x),
+        goal.y.clamp(b.min.y, b.max.y),
+        goal.z.clamp(b.min.z, b.max.z),
+    );
+    const STEPS: u32 = 64;
+    (1..=STEPS)
+        .rev()
+        .map(|k| from + (aim - from) * (f64::from(k) / f64::from(STEPS)))
+        .find(|q| {
+            b.contains(q)
+                && scene.static_clearance(q) >= HOLD_CLEARANCE_M
+                && scene.map.segment_clear(from, q, 0.0)
+        })
+        .unwrap_or(*from)
 }
 
 /// A vehicle slower than this fraction of `v_max` is at rest for

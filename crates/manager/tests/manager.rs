@@ -865,27 +865,57 @@ fn without_obstacles_the_plan_heads_straight_for_the_goal() {
 }
 
 #[test]
+fn a_goal_inside_a_wall_or_outside_the_bounds_is_unreachable_and_a_stop_is_held_short_of_it() {
+    let map = two_gap_corridor();
+    let scene = Scene::new(&map, &[], 0.0).unwrap();
+    let start = State::at_rest(0.0, START);
+    for (goal, cause) in [
+        (Vec3::new(14.5, 0.0, 3.0), "inside"),
+        (Vec3::new(50.0, 0.0, 3.0), "outside the map bounds"),
+    ] {
+        let mut m = planner(ManagerParams::trust());
+        let mut state = start;
+        let mut first_since = None;
+        let mut held = state.p;
+        for k in 0..60 {
+            let t = 0.1 * f64::from(k);
+            state.t = t;
+            let r = m.step(t, &state, &goal, &scene).unwrap();
+            let u = r.goal_unreachable.clone().expect("a verdict every cycle");
+            assert!(u.cause.contains(cause), "{}", u.cause);
+            let since = *first_since.get_or_insert(u.since_t);
+            assert_eq!(u.since_t, since, "the verdict keeps its first time");
+            let verdicts = r
+                .events
+                .iter()
+                .filter(|e| matches!(e, Event::GoalUnreachable { .. }))
+                .count();
+            assert_eq!(
+                verdicts,
+                usize::from(k == 0),
+                "the event once, at the verdict"
+            );
+            held = u.held_at.map(|p| Vec3::new(p[0], p[1], p[2])).unwrap();
+            assert!(map.bounds().contains(&held));
+            assert!(scene.static_clearance(&held) >= trust_manager::HOLD_CLEARANCE_M);
+            if let Some(plan) = m.plan() {
+                state = plan.state(t + 0.1);
+            }
+        }
+        // The plan ends at rest at the held stop, short of the goal, clear of the walls.
+        let plan = m.plan().expect("a plan");
+        let end = plan.position(plan.t_start() + plan.duration());
+        assert!((end - held).norm() < 1.0, "{end:?} vs {held:?}");
+        assert!(held.x < 14.0 && (held - START).norm() > 5.0, "{held:?}");
+        assert!(scene.static_clearance(&end) > 0.0);
+    }
+}
+
+#[test]
 fn bad_input_is_an_error_naming_the_field() {
     let map = two_gap_corridor();
     let mut m = planner(ManagerParams::trust());
     let scene = Scene::new(&map, &[], 0.0).unwrap();
-    let inside_wall = Vec3::new(14.5, 0.0, 3.0);
-    let e = m
-        .step(0.0, &State::at_rest(0.0, START), &inside_wall, &scene)
-        .unwrap_err();
-    assert!(
-        matches!(e, PlanError::InCollision { ref field, .. } if field == "goal"),
-        "{e}"
-    );
-    let e = m
-        .step(
-            0.0,
-            &State::at_rest(0.0, START),
-            &Vec3::new(50.0, 0.0, 3.0),
-            &scene,
-        )
-        .unwrap_err();
-    assert!(matches!(e, PlanError::OutOfBounds { .. }), "{e}");
     let mut nan = State::at_rest(0.0, START);
     nan.v.y = f64::NAN;
     let e = m.step(0.0, &nan, &GOAL, &scene).unwrap_err().to_string();
