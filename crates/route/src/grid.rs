@@ -26,6 +26,8 @@ pub(crate) struct Meter {
     pub(crate) work: usize,
     /// Units this call may reach.
     pub(crate) limit: usize,
+    /// Units already paid toward the query that paused the previous slice (kept by the search).
+    pub(crate) prepaid: usize,
 }
 
 impl Meter {
@@ -38,7 +40,28 @@ impl Meter {
             Ok(())
         }
     }
+
+    /// Takes the units of a line-of-sight query over `len_m` metres: one, plus one per
+    /// [`SIGHT_UNIT_M`] (a long segment meets more shapes and ESDF samples). A query dearer
+    /// than what is left of the slice is paid over several slices ([`Meter::prepaid`]) and runs
+    /// once paid, so no slice exceeds its budget and the total does not depend on the slicing.
+    pub(crate) fn charge_sight(&mut self, len_m: f64) -> Result<(), Paused> {
+        let units = 1 + (len_m / SIGHT_UNIT_M).clamp(0.0, 1.0e9) as usize;
+        while self.prepaid < units {
+            if self.work >= self.limit {
+                return Err(Paused);
+            }
+            let take = (units - self.prepaid).min(self.limit - self.work);
+            self.work += take;
+            self.prepaid += take;
+        }
+        self.prepaid = 0;
+        Ok(())
+    }
 }
+
+/// Metres of a line-of-sight query charged as one more unit ([`Meter::charge_sight`]).
+pub(crate) const SIGHT_UNIT_M: f64 = 2.0;
 
 /// The grid the search runs on: cell centres `origin + h · (i, j, k)`, all inside the bounds.
 #[derive(Debug, Clone, Copy)]
@@ -311,7 +334,11 @@ mod tests {
 
     #[test]
     fn the_meter_refuses_the_unit_past_its_limit() {
-        let mut m = Meter { work: 0, limit: 2 };
+        let mut m = Meter {
+            work: 0,
+            limit: 2,
+            prepaid: 0,
+        };
         assert!(m.charge().is_ok() && m.charge().is_ok());
         assert_eq!(m.charge(), Err(Paused));
         assert_eq!(m.work, 2);
@@ -327,6 +354,7 @@ mod tests {
         let mut m = Meter {
             work: 0,
             limit: usize::MAX,
+            prepaid: 0,
         };
         for i in (0..layer.grid.len()).step_by(97) {
             let d = layer.sd(&map, i, &mut m).unwrap();

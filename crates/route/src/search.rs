@@ -14,8 +14,8 @@ use trust_geometry::StaticMap;
 use crate::Vec3;
 use crate::error::{Endpoint, RouteError, UnreachableCause};
 use crate::grid::{
-    CLOSED, FLOOD_C, FLOOD_CR, FLOOD_R, Grid, Layer, Meter, Open, Paused, SEEN, neighbour_steps,
-    octile,
+    CLOSED, FLOOD_C, FLOOD_CR, FLOOD_R, Grid, Layer, Meter, Open, Paused, SEEN, SIGHT_UNIT_M,
+    neighbour_steps, octile,
 };
 use crate::params::RouteParams;
 use crate::route::GlobalRoute;
@@ -67,9 +67,11 @@ pub struct Unreachable {
 /// panic-free, answer).
 ///
 /// **Unit of work.** One unit is one of: a signed-distance evaluation of the map (a grid cell's
-/// centre, the start or goal, a gradient step out of an obstacle), one
-/// [`StaticMap::segment_clear`] query (the straight line, an edge the cell distances cannot
-/// prove clear, a snap's line of sight, a shortcut test), or one cell expansion (popping a cell
+/// centre, the start or goal, a gradient step out of an obstacle), a
+/// [`StaticMap::segment_clear`] query (an edge the cell distances cannot prove clear; a snap's
+/// line of sight or a shortcut test costs one unit plus one per 2 m of its length, and the
+/// straight line from start to goal is tested in 2 m pieces of one unit each), or one cell
+/// expansion (popping a cell
 /// of the A* or of a flood and looking at its neighbours, the neighbours' queries charged
 /// separately). Cached values are free. A unit's time depends on the map (see the crate docs
 /// for measured costs).
@@ -92,6 +94,10 @@ pub struct RouteSearch {
     sd_start: Option<f64>,
     sd_target: Option<f64>,
     straight_clear: Option<bool>,
+    /// Pieces of the straight line of sight found clear so far.
+    straight_pieces: usize,
+    /// Units paid toward the query that paused the last slice ([`Meter::charge_sight`]).
+    prepaid: usize,
     built: bool,
     layers: Vec<Layer>,
     /// The layer the verdicts are proved on (the finest grid that fits `max_cells`).
@@ -185,8 +191,9 @@ impl SnapCursor {
                 match self.sight {
                     None => return Ok(Some(i)),
                     Some(s) => {
-                        m.charge()?;
-                        if map.segment_clear(p, &layer.grid.center_of(i), s) {
+                        let center = layer.grid.center_of(i);
+                        m.charge_sight((center - p).norm())?;
+                        if map.segment_clear(p, &center, s) {
                             return Ok(Some(i));
                         }
                     }
@@ -499,7 +506,7 @@ impl Finishing {
         let last = self.points.len().saturating_sub(1);
         while self.anchor < last {
             if self.j < last {
-                m.charge()?;
+                m.charge_sight((self.points[self.j + 1] - self.points[self.anchor]).norm())?;
                 if map.segment_clear(
                     &self.points[self.anchor],
                     &self.points[self.j + 1],
@@ -580,6 +587,8 @@ impl RouteSearch {
             sd_start: None,
             sd_target: None,
             straight_clear: None,
+            straight_pieces: 0,
+            prepaid: 0,
             built: false,
             layers: Vec::new(),
             fine: 0,
@@ -612,9 +621,11 @@ impl RouteSearch {
         let mut m = Meter {
             work: self.work,
             limit: self.work.saturating_add(budget),
+            prepaid: self.prepaid,
         };
         let r = self.drive(map, &mut m);
         self.work = m.work;
+        self.prepaid = m.prepaid;
         match r {
             Ok(mut answer) => {
                 if let RouteProgress::Unreachable(u) = &mut answer {
@@ -792,10 +803,23 @@ impl RouteSearch {
             let clear = match self.straight_clear {
                 Some(v) => v,
                 None => {
-                    m.charge()?;
-                    *self
-                        .straight_clear
-                        .insert(map.segment_clear(&self.start, &self.goal, c))
+                    // In pieces of `SIGHT_UNIT_M`, one unit each, so that a long line of sight
+                    // (a 600 m trip across a city) is spread over the slices like the rest.
+                    let d = self.goal - self.start;
+                    let pieces = ((d.norm() / SIGHT_UNIT_M).ceil() as usize).clamp(1, 1 << 20);
+                    let mut clear = true;
+                    while self.straight_pieces < pieces {
+                        m.charge()?;
+                        let k = self.straight_pieces as f64;
+                        let a = self.start + d * (k / pieces as f64);
+                        let b = self.start + d * ((k + 1.0) / pieces as f64);
+                        if !map.segment_clear(&a, &b, c) {
+                            clear = false;
+                            break;
+                        }
+                        self.straight_pieces += 1;
+                    }
+                    *self.straight_clear.insert(clear)
                 }
             };
             if clear {
