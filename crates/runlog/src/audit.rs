@@ -54,8 +54,7 @@ use crate::{
 pub const CLEARANCE_TOLERANCE_M: f64 = 0.02;
 /// Relative tolerance of the contract on maxima.
 pub const MAXIMA_TOLERANCE: f64 = 0.01;
-/// Largest magnitude of a coordinate the audit accepts (m): 1000 km.
-pub const MAX_COORDINATE_M: f64 = 1e6;
+pub use crate::files::MAX_COORDINATE_M;
 /// Largest magnitude of a velocity component the audit accepts (m/s).
 pub const MAX_SPEED_M_S: f64 = 1e4;
 /// Largest magnitude of an acceleration component the audit accepts (m/s²).

@@ -29,6 +29,9 @@ use std::path::{Component, Path, PathBuf};
 
 use crate::LogError;
 
+/// Largest magnitude of a coordinate the audit and the points reader accept (m): 1000 km.
+pub const MAX_COORDINATE_M: f64 = 1e6;
+
 /// Largest run log read (bytes): 16 GiB.
 pub const MAX_LOG_BYTES: u64 = 16 << 30;
 /// Largest static points file read (bytes): 512 MiB (as `trust-world`'s cap on points files).
@@ -213,7 +216,7 @@ pub fn resolve_points_file(log_dir: &Path, name: &str) -> Result<PathBuf, String
 /// Reads a static points file: one point per line, `x y z` (whitespace- or comma-separated),
 /// blank lines and lines starting with `#` ignored, and an optional header line `x y z`
 /// (case-insensitive, same separators) before the first point. Every coordinate must be finite
-/// and at most [`crate::audit::MAX_COORDINATE_M`] in magnitude.
+/// and at most [`MAX_COORDINATE_M`] in magnitude.
 ///
 /// # Errors
 /// A message naming the file (and the line, quoted by [`echo`]): unreadable or not a regular
@@ -260,14 +263,14 @@ pub fn read_points(path: &Path) -> Result<Vec<[f64; 3]>, String> {
         let mut p = [0.0; 3];
         for (k, f) in fields.iter().enumerate() {
             match f.parse::<f64>() {
-                Ok(x) if x.is_finite() && x.abs() <= crate::audit::MAX_COORDINATE_M => p[k] = x,
+                Ok(x) if x.is_finite() && x.abs() <= MAX_COORDINATE_M => p[k] = x,
                 _ => {
                     return Err(format!(
                         "{}: field {} = {} is not a finite number within ±{} m",
                         at(n),
                         k + 1,
                         echo(f),
-                        readable(crate::audit::MAX_COORDINATE_M)
+                        readable(MAX_COORDINATE_M)
                     ));
                 }
             }
