@@ -116,16 +116,19 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-route",
             ][..],
         ),
+        // The fuzz driver is a tool at the top, like the simulator: it drives the library APIs
+        // and the file-facing surfaces (scenarios, tracks, run logs, replay, export).
         (
             "trust-fuzz",
-            &[
-                "trust-geometry",
-                "trust-predict",
-                "trust-core",
-                "trust-lbfgs",
-                "trust-minco",
-                "trust-topo-prm",
-            ][..],
+            with(&[
+                "trust-vehicle",
+                "trust-world",
+                "trust-runlog",
+                "trust-export",
+                "trust-flight",
+                "trust-plot",
+                "trust-replay",
+            ]),
         ),
         ("trust-plot", &[][..]),
         ("trust-runlog", &[][..]),
