@@ -102,6 +102,8 @@ pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, ExperimentEr
     let mut resolved = scenario.resolve_planner();
     resolved.route = None;
     resolved.manager.wall_images = false;
+    // One cycle shows every branch: all its cold solves in that cycle.
+    resolved.manager.cold_solves_per_cycle = None;
     let trust_flight::Setup {
         sensing,
         mut manager,

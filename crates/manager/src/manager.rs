@@ -224,6 +224,9 @@ pub struct Manager<F, B, H> {
     routed_at: f64,
     /// The standing verdict that the goal cannot be reached ([`crate::GoalUnreachable`]).
     unreachable: Option<crate::GoalUnreachable>,
+    /// Guide paths of the last exploration still to be solved
+    /// ([`ManagerParams::cold_solves_per_cycle`]).
+    deferred_guides: Vec<GuidePath>,
     /// The route search under way, and why it started.
     route_search: Option<(RouteReason, RouteSearch)>,
 }
@@ -270,6 +273,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             routed_goal: None,
             routed_at: f64::NEG_INFINITY,
             unreachable: None,
+            deferred_guides: Vec::new(),
             route_search: None,
             cycle_count: 0,
         })
@@ -422,6 +426,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         self.routed_goal = None;
         self.route_search = None;
         self.unreachable = None;
+        self.deferred_guides.clear();
         self.branches.clear();
         self.main = None;
         self.committed = None;
@@ -513,7 +518,9 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         // in parallel with FwdExplore.
         let warm = self.warm_branches();
         let aim = self.aim(&cycle.start.p, goal, cycle.stalled, scene.map);
-        let (explored, resolved) = self.solve_in_parallel(&cycle, &aim, scene, &warm, &mut spans);
+        let (mut explored, resolved) =
+            self.solve_in_parallel(&cycle, &aim, scene, &warm, &mut spans);
+        self.deferred_guides = std::mem::take(&mut explored.deferred);
         if let Some(error) = explored.frontend_error {
             cycle.events.push(Event::FrontendFailed { error });
         }
@@ -794,10 +801,11 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             route_guide: self.route_guide(&cycle.start.p, goal),
         };
         let (frontend, rng) = (&self.frontend, &mut self.rng);
+        let pending = std::mem::take(&mut self.deferred_guides);
         rayon::join(
             || match cycle.explore {
                 true => fwd_explore(frontend, rng, &query, &solver, spans),
-                false => Explored::default(),
+                false => solve_deferred(pending, &solver),
             },
             || {
                 warm.par_iter()
@@ -1481,6 +1489,8 @@ struct Explored {
     frontend_error: Option<String>,
     /// Whether the straight guide was explored ([`ManagerParams::straight_guide_when_empty`]).
     straight_guide: bool,
+    /// Guide paths left for the following cycles ([`ManagerParams::cold_solves_per_cycle`]).
+    deferred: Vec<GuidePath>,
 }
 
 /// FwdExplore (Algorithm 1, line 8): the frontend's paths from the replan start (its first
@@ -1530,14 +1540,73 @@ fn fwd_explore<F: PathFrontend, B: TrajectoryBackend>(
             explored.straight_guide = true;
         }
     }
-    explored.candidates = paths
+    if let Some(k) = params.cold_solves_per_cycle.filter(|_| params.history) {
+        explored.deferred = paths.split_off(k.min(paths.len()));
+    }
+    explored.candidates = solve_cold(&paths, solver);
+    explored
+}
+
+/// The cold solves of `paths` (in parallel), each repaired if narrowly unsafe.
+fn solve_cold<B: TrajectoryBackend>(
+    paths: &[GuidePath],
+    solver: &Solver<'_, '_, B>,
+) -> Vec<Candidate> {
+    paths
         .par_iter()
         .map(|p| {
-            let cold = solver.solve_with(InitialGuess::Guide(p), params.cold_max_evaluations);
+            let cold =
+                solver.solve_with(InitialGuess::Guide(p), solver.params.cold_max_evaluations);
             solver.repaired(cold)
         })
+        .collect()
+}
+
+/// A cycle that does not explore solves the next [`ManagerParams::cold_solves_per_cycle`] of
+/// the guide paths the last exploration left, each from this cycle's start: the part of the
+/// guide behind its point nearest the start is dropped and the start put in front.
+fn solve_deferred<B: TrajectoryBackend>(
+    mut pending: Vec<GuidePath>,
+    solver: &Solver<'_, '_, B>,
+) -> Explored {
+    let k = solver.params.cold_solves_per_cycle.unwrap_or(usize::MAX);
+    let rest = pending.split_off(k.min(pending.len()));
+    let paths: Vec<GuidePath> = pending
+        .iter()
+        .filter_map(|g| rebased_guide(g, &solver.start.p))
         .collect();
-    explored
+    Explored {
+        candidates: solve_cold(&paths, solver),
+        deferred: rest,
+        ..Explored::default()
+    }
+}
+
+/// `guide` from `from`: `from`, then the guide from its point nearest `from` on (`None` if the
+/// guide does not lead anywhere from there).
+fn rebased_guide(guide: &GuidePath, from: &Vec3) -> Option<GuidePath> {
+    let pts = &guide.points;
+    let mut best = (f64::INFINITY, 0, *from);
+    for (i, w) in pts.windows(2).enumerate() {
+        let d = w[1] - w[0];
+        let len2 = d.norm_squared();
+        let t = if len2 > 0.0 {
+            ((from - w[0]).dot(&d) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let q = w[0] + d * t;
+        let dist = (q - from).norm();
+        if dist < best.0 {
+            best = (dist, i + 1, q);
+        }
+    }
+    let mut points = vec![*from];
+    points.extend(pts.get(best.1..).unwrap_or(&[]).iter().copied());
+    points.dedup_by(|a, b| (*a - *b).norm() <= 1e-9);
+    (points.len() >= 2)
+        .then(|| GuidePath::new(points).ok())
+        .flatten()
 }
 
 /// The named spans of a cycle that [`Spans`] times.
@@ -1805,6 +1874,36 @@ fn ms(d: Duration) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_rebased_guide_starts_at_the_new_start_and_drops_what_lies_behind() {
+        let g = GuidePath::new(vec![
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(10.0, 0.0, 1.0),
+            Vec3::new(10.0, 10.0, 1.0),
+        ])
+        .unwrap();
+        let r = rebased_guide(&g, &Vec3::new(3.0, 0.5, 1.0)).unwrap();
+        assert_eq!(
+            r.points,
+            vec![
+                Vec3::new(3.0, 0.5, 1.0),
+                Vec3::new(10.0, 0.0, 1.0),
+                Vec3::new(10.0, 10.0, 1.0)
+            ]
+        );
+        // Past the corner: the second leg only.
+        let r = rebased_guide(&g, &Vec3::new(10.5, 4.0, 1.0)).unwrap();
+        assert_eq!(r.points.len(), 2);
+        assert_eq!(r.points[1], Vec3::new(10.0, 10.0, 1.0));
+        // At the guide's end: nothing left to follow.
+        assert!(rebased_guide(&g, &Vec3::new(10.0, 10.0, 1.0)).is_none());
+        // A one-point guide (start on the goal) leads nowhere.
+        let one = GuidePath::new(vec![Vec3::new(1.0, 1.0, 1.0)]).unwrap();
+        assert!(
+            rebased_guide(&one, &Vec3::new(0.0, 0.0, 1.0)).is_some_and(|r| r.points.len() == 2)
+        );
+    }
 
     #[test]
     fn only_narrow_failures_are_repaired() {

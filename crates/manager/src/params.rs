@@ -72,6 +72,13 @@ pub struct ManagerParams {
     /// Evaluation budget of a cold solve from a frontend path (FwdExplore); `None`: the backend's
     /// own.
     pub cold_max_evaluations: Option<usize>,
+    /// Cold solves per cycle (with history): an exploring cycle solves the first this many of
+    /// its guide paths and keeps the rest, each following cycle solves the next this many from
+    /// its own start (the guide's part behind the vehicle dropped), until the next exploration
+    /// replaces them. `None`: every path in the exploring cycle (the paper's Algorithm 1).
+    /// Default 2 (beyond the paper): an exploring cycle no longer pays for all its cold solves
+    /// at once, which made it the worst cycle (E4: 10–16 solves, 2–3× the 50 ms budget).
+    pub cold_solves_per_cycle: Option<usize>,
     /// Run FwdExplore (the frontend and the cold solves) every this many cycles, and in every cycle
     /// that starts with fewer than two kept branches or without a main branch. 1: every cycle (the
     /// paper's Algorithm 1). At least 1. Default 3 (beyond the paper): the kept branches carry
@@ -158,6 +165,7 @@ impl ManagerParams {
             warm_max_evaluations: Some(100),
             sub_branch_max_evaluations: Some(50),
             cold_max_evaluations: None,
+            cold_solves_per_cycle: Some(2),
             explore_period_cycles: 3,
             repair_margin_m: 0.05,
             ranking: None,
@@ -179,6 +187,7 @@ impl ManagerParams {
     pub fn multi_branch_without_history() -> Self {
         ManagerParams {
             history: false,
+            cold_solves_per_cycle: None,
             ..Self::trust()
         }
     }
@@ -189,6 +198,7 @@ impl ManagerParams {
             max_branches: 1,
             history: false,
             max_explored_paths: 1,
+            cold_solves_per_cycle: None,
             ..Self::trust()
         }
     }
@@ -227,6 +237,13 @@ impl ManagerParams {
                 "manager.max_branches",
                 self.max_branches,
                 "an integer >= 1",
+            ));
+        }
+        if self.cold_solves_per_cycle == Some(0) {
+            return Err(PlanError::invalid(
+                "manager.cold_solves_per_cycle",
+                0,
+                "at least 1 solve per cycle, or none (all in the exploring cycle)",
             ));
         }
         if self.max_explored_paths == 0 {

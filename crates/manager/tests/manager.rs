@@ -181,6 +181,58 @@ fn consecutive_plans_join_continuously() {
 }
 
 #[test]
+fn an_exploring_cycle_solves_at_most_cold_solves_per_cycle_and_leaves_the_rest_for_the_next() {
+    // Every cycle explores with one cold solve at most: the frontend's other paths are solved
+    // in the following (non-exploring) cycles, so the cold solves of a flight are spread.
+    let map = two_gap_corridor();
+    let limited = ManagerParams {
+        cold_solves_per_cycle: Some(1),
+        explore_period_cycles: 3,
+        ..ManagerParams::trust()
+    };
+    let mut m = planner(limited);
+    let reports = fly(&mut m, &map, GOAL, State::at_rest(0.0, START), 12, |_| {
+        Vec::new()
+    });
+    assert!(
+        reports
+            .iter()
+            .all(|r| r.timing.cold_solve_count <= 1 + r.timing.repair_count)
+    );
+    let explored: usize = reports
+        .iter()
+        .filter_map(|r| r.frontend.as_ref())
+        .map(|f| f.explored_count)
+        .sum();
+    assert!(explored >= 2, "the frontend gave several paths");
+    let later = reports
+        .iter()
+        .filter(|r| r.frontend.is_none() && r.timing.cold_solve_count > 0)
+        .count();
+    assert!(
+        later >= 1,
+        "deferred paths are solved in non-exploring cycles"
+    );
+    // Without the limit the first (exploring) cycle solves all its paths at once.
+    let mut all = planner(ManagerParams {
+        cold_solves_per_cycle: None,
+        ..ManagerParams::trust()
+    });
+    let first = &fly(&mut all, &map, GOAL, State::at_rest(0.0, START), 1, |_| {
+        Vec::new()
+    })[0];
+    assert!(first.timing.cold_solve_count >= 2, "{:?}", first.timing);
+    assert!(
+        ManagerParams {
+            cold_solves_per_cycle: Some(0),
+            ..ManagerParams::trust()
+        }
+        .validate()
+        .is_err()
+    );
+}
+
+#[test]
 fn re_solves_respect_their_evaluation_budgets() {
     // The main branch's FwdMarch gets `warm_max_evaluations`, each sub-branch's BwdReplan the
     // smaller `sub_branch_max_evaluations` (repairs off: a repair re-solves with the cold budget).

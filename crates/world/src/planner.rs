@@ -480,6 +480,9 @@ pub struct ManagerOverrides {
     /// Replaces `ManagerParams::cold_max_evaluations`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cold_max_evaluations: Option<usize>,
+    /// Replaces `ManagerParams::cold_solves_per_cycle`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cold_solves_per_cycle: Option<usize>,
     /// Replaces `ManagerParams::explore_period_cycles`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub explore_period_cycles: Option<usize>,
@@ -555,6 +558,9 @@ impl ManagerOverrides {
         }
         if let Some(v) = self.cold_max_evaluations {
             p.cold_max_evaluations = Some(v);
+        }
+        if let Some(v) = self.cold_solves_per_cycle {
+            p.cold_solves_per_cycle = Some(v);
         }
         if let Some(v) = self.explore_period_cycles {
             p.explore_period_cycles = v;
