@@ -733,7 +733,7 @@ fn cycle_record(
             .as_ref()
             .filter(|f| !f.collision_free)
             .map(|f| f.shortfall_m),
-        fallback_along: report.fallback.as_ref().map(|f| f.along.clone()),
+        fallback_along: report.fallback.as_ref().map(|f| f.along.to_string()),
         dropped: dropped(report),
         route: route
             .filter(|_| rerouted)

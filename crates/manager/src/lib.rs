@@ -69,8 +69,8 @@ pub use params::{
 };
 pub use progress::{ProgressMonitor, ProgressParams, StallRule};
 pub use report::{
-    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, GoalUnreachable,
-    LimitExcess, Origin, STUB_FRACTION, StepReport,
+    BranchId, BranchReport, CycleTiming, Event, FallbackKind, FallbackReport, FrontendReport,
+    GoalUnreachable, LimitExcess, Origin, STUB_FRACTION, StepReport, SwitchReason,
 };
-pub use routing::{RECHECK_S, ROUTE_WORK_PER_CYCLE, Router};
+pub use routing::{RECHECK_S, ROUTE_WORK_PER_CYCLE, RouteReason, Router};
 pub use safety::{Hit, SafetyVerdict, Violation, assess_trajectory, check_trajectory};

@@ -15,8 +15,8 @@ use crate::brake::{brake_along, brake_straight, dash_maneuvers, escape_maneuvers
 use crate::params::SOLVE_DEADLINE_FRACTION;
 use crate::progress::ProgressMonitor;
 use crate::report::{
-    BranchId, BranchReport, CycleTiming, Event, FallbackReport, FrontendReport, LimitExcess,
-    Origin, STUB_FRACTION, StepReport,
+    BranchId, BranchReport, CycleTiming, Event, FallbackKind, FallbackReport, FrontendReport,
+    LimitExcess, Origin, STUB_FRACTION, StepReport, SwitchReason,
 };
 use crate::safety::{
     SafetyVerdict, assess_trajectory, check_trajectory, forecasts_near, window_bounds,
@@ -853,7 +853,11 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 cycle
                     .events
                     .push(dropped_collision(id, &verdict, &self.limits));
-                let kind = if id.is_some() { "branch" } else { "candidate" };
+                let kind = if id.is_some() {
+                    FallbackKind::Branch
+                } else {
+                    FallbackKind::Candidate
+                };
                 cycle.rejected.push((kind, solution.traj));
                 None
             }
@@ -1163,16 +1167,18 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let decision = choose_main(&ranked, incumbent, ideal, self.params.hysteresis)?;
         if decision.switched && self.params.history {
             let reason = match (incumbent, decision.incumbent_kept) {
-                (None, _) => "first",
-                (Some(_), true) => "better",
-                (Some(_), false) if incumbent_short => "reaches_goal",
-                (Some(id), false) if stalled && kept.iter().any(|b| b.id == id) => "progress",
-                (Some(_), false) => "incumbent_dropped",
+                (None, _) => SwitchReason::First,
+                (Some(_), true) => SwitchReason::Better,
+                (Some(_), false) if incumbent_short => SwitchReason::ReachesGoal,
+                (Some(id), false) if stalled && kept.iter().any(|b| b.id == id) => {
+                    SwitchReason::Progress
+                }
+                (Some(_), false) => SwitchReason::IncumbentDropped,
             };
             events.push(Event::SwitchedMain {
                 from: self.main,
                 to: decision.main,
-                reason: reason.into(),
+                reason,
             });
         }
         Some(decision.main)
@@ -1183,25 +1189,25 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         &mut self,
         start: &State,
         reanchored: bool,
-        rejected: &[(&'static str, PolyTraj)],
+        rejected: &[(FallbackKind, PolyTraj)],
         scene: &Scene<'_>,
         events: &mut Vec<Event>,
     ) -> Option<FallbackReport> {
         let hold_s = self.params.brake_hold();
         let a_max = self.limits.a_max;
-        let mut options: Vec<(&'static str, PolyTraj)> = Vec::new();
+        let mut options: Vec<(FallbackKind, PolyTraj)> = Vec::new();
         if let Some(plan) = self.committed.as_ref().filter(|_| !reanchored)
             && let Ok(b) = brake_along(plan, start.t, a_max, hold_s)
         {
-            options.push(("committed", b));
+            options.push((FallbackKind::Committed, b));
         }
         for (kind, traj) in rejected {
             if let Ok(b) = brake_along(traj, start.t, a_max, hold_s) {
-                options.push((kind, b));
+                options.push((*kind, b));
             }
         }
         if let Ok(b) = brake_straight(start, a_max, hold_s) {
-            options.push(("straight", b));
+            options.push((FallbackKind::Straight, b));
         }
         // Beyond the paper: the rejected trajectories flown as they are. Braking is the answer
         // to an obstacle ahead, not to one walking into a vehicle at rest (the suite's rooms with
@@ -1209,7 +1215,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         // longer there, and the next cycle replans from it. Only taken when no braking option is
         // collision-free and it is clear for longer than every one of them.
         for (_, traj) in rejected {
-            options.push(("evade", traj.clone()));
+            options.push((FallbackKind::Evade, traj.clone()));
         }
         // And short escapes to rest in eight horizontal directions and up and down, a quarter of
         // the horizon's reach at v_max away (scales with the vehicle: 1 m at 1 m/s, 10 m at
@@ -1224,14 +1230,14 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             .chain([Vec3::z(), -Vec3::z()])
             .collect();
         if let Ok(escapes) = escape_maneuvers(start, &directions, reach, &self.limits, hold_s) {
-            options.extend(escapes.into_iter().map(|t| ("escape", t)));
+            options.extend(escapes.into_iter().map(|t| (FallbackKind::Escape, t)));
         }
         // And dashes in the same directions: 0.9 v_max reached at once, held for a quarter of the
         // horizon, then braking (a person walking at the vehicle's own speed reaches a vehicle
         // that escapes to rest before it is out of the way).
         let cruise_s = 0.25 * self.params.horizon_s;
         if let Ok(dashes) = dash_maneuvers(start, &directions, cruise_s, &self.limits, hold_s) {
-            options.extend(dashes.into_iter().map(|t| ("dash", t)));
+            options.extend(dashes.into_iter().map(|t| (FallbackKind::Dash, t)));
         }
         // The options are judged against the forecasts grown for at most a quarter of the
         // horizon (the scene's forecasts already stop growing after `forecast_growth`, 0.25 s
@@ -1266,8 +1272,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         // A rejected trajectory that breaks the speed or acceleration limits is no way out
         // (without this, one rejected only for its limits passed as "collision-free" and the
         // vehicle flew it: up to 1.08 a_max in the rooms with people).
-        let admissible = |kind: &str, traj: &PolyTraj, v: &SafetyVerdict| {
-            kind != "evade" || !(v.over_limits || max_jerk(traj) > jerk_limit)
+        let admissible = |kind: FallbackKind, traj: &PolyTraj, v: &SafetyVerdict| {
+            kind != FallbackKind::Evade || !(v.over_limits || max_jerk(traj) > jerk_limit)
         };
         let mut best: Option<(usize, SafetyVerdict)> = None;
         let rank = |v: &SafetyVerdict| {
@@ -1282,7 +1288,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         for (i, (kind, traj)) in options.iter().enumerate() {
             let v = assess(traj, &judged);
             verdicts.push(v);
-            if !admissible(kind, traj, &v) {
+            if !admissible(*kind, traj, &v) {
                 continue;
             }
             if v.violation.is_none() {
@@ -1330,7 +1336,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
                 let widest = options
                     .iter()
                     .enumerate()
-                    .filter(|(i, (kind, traj))| admissible(kind, traj, &verdicts[*i]))
+                    .filter(|(i, (kind, traj))| admissible(*kind, traj, &verdicts[*i]))
                     .filter_map(|(i, (_, traj))| {
                         let v = assess(traj, &level);
                         v.violation.is_none().then(|| (i, v.min_margin_m()))
@@ -1351,13 +1357,13 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let collision_free = verdict.violation.is_none();
         let stop_time = traj.t_end() - hold_s;
         events.push(Event::Fallback {
-            along: along.into(),
+            along,
             collision_free,
             min_margin_m: verdict.min_margin_m(),
         });
         self.committed = Some(traj);
         Some(FallbackReport {
-            along: along.into(),
+            along,
             collision_free,
             min_margin_m: verdict.min_margin_m(),
             shortfall_m: if collision_free {
@@ -1473,9 +1479,9 @@ struct Cycle {
     explore: bool,
     /// The cycle's events, in order.
     events: Vec<Event>,
-    /// Trajectories dropped by the safety pass, with what they were (`"branch"` or
-    /// `"candidate"`): the fallback may brake along them.
-    rejected: Vec<(&'static str, PolyTraj)>,
+    /// Trajectories dropped by the safety pass, with what they were (a branch or a candidate):
+    /// the fallback may brake along them.
+    rejected: Vec<(FallbackKind, PolyTraj)>,
 }
 
 /// What [`fwd_explore`] found (empty when the cycle does not explore).

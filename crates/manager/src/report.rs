@@ -157,9 +157,8 @@ pub enum Event {
         from: Option<BranchId>,
         /// The new one.
         to: BranchId,
-        /// `"better"` (beat the incumbent by the hysteresis factor), `"incumbent_dropped"`,
-        /// `"reaches_goal"` (reaches the goal while the incumbent stops short of it) or `"first"`.
-        reason: String,
+        /// Why.
+        reason: SwitchReason,
     },
     /// The vehicle's progress toward the goal stayed below the threshold over the window away
     /// from the goal ([`crate::progress`]): the manager escalates until [`Event::Escaped`].
@@ -175,7 +174,7 @@ pub enum Event {
     /// route yet toward this goal) or `"stalled"` (after [`Event::Stalled`]).
     Rerouted {
         /// Why the route was planned.
-        reason: String,
+        reason: crate::RouteReason,
         /// Its length (m).
         length_m: f64,
         /// Its vertices, start and goal included.
@@ -185,7 +184,7 @@ pub enum Event {
     /// or aims at the final goal without one.
     RouteFailed {
         /// Why the route was planned.
-        reason: String,
+        reason: crate::RouteReason,
         /// The route planner's error message.
         error: String,
     },
@@ -210,17 +209,90 @@ pub enum Event {
     },
     /// No branch was feasible: the plan is a braking fallback.
     Fallback {
-        /// What it brakes along: `"committed"`, `"branch"`, `"candidate"` or `"straight"`; or
-        /// `"evade"`: a trajectory the safety pass rejected, flown as it is because it stays
-        /// clear longer than every braking option (an obstacle coming at a vehicle at rest); or
-        /// `"escape"`: a short manoeuvre to rest out of the way ([`crate::escape_maneuvers`]),
-        /// for the same reason.
-        along: String,
+        /// What it brakes along, or which way out it takes.
+        along: FallbackKind,
         /// Whether it passed the safety check against the current forecasts.
         collision_free: bool,
         /// Its smallest clearance margin (m).
         min_margin_m: f64,
     },
+}
+
+/// What a braking fallback brakes along, or which way out it takes ([`Event::Fallback`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FallbackKind {
+    /// The committed plan.
+    Committed,
+    /// A kept branch the safety pass rejected.
+    Branch,
+    /// An explored candidate the safety pass rejected.
+    Candidate,
+    /// The current velocity direction.
+    Straight,
+    /// A rejected trajectory flown as it is: it stays clear longer than every braking option
+    /// (an obstacle coming at a vehicle at rest).
+    Evade,
+    /// A short manoeuvre to rest out of the way ([`crate::escape_maneuvers`]).
+    Escape,
+    /// A dash at 0.9 `v_max` out of the way, then braking ([`crate::dash_maneuvers`]).
+    Dash,
+}
+
+impl FallbackKind {
+    /// The log's word for it (`"committed"`, `"evade"`, ...).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FallbackKind::Committed => "committed",
+            FallbackKind::Branch => "branch",
+            FallbackKind::Candidate => "candidate",
+            FallbackKind::Straight => "straight",
+            FallbackKind::Evade => "evade",
+            FallbackKind::Escape => "escape",
+            FallbackKind::Dash => "dash",
+        }
+    }
+}
+
+impl std::fmt::Display for FallbackKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Why the main branch changed ([`Event::SwitchedMain`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SwitchReason {
+    /// The first main branch (or one chosen without history).
+    First,
+    /// It beat the incumbent by the hysteresis factor.
+    Better,
+    /// It reaches the goal while the incumbent stops short of it.
+    ReachesGoal,
+    /// The incumbent was dropped.
+    IncumbentDropped,
+    /// While the flight is stalled, the kept branch that makes the most progress.
+    Progress,
+}
+
+impl SwitchReason {
+    /// The log's word for it (`"first"`, `"better"`, ...).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SwitchReason::First => "first",
+            SwitchReason::Better => "better",
+            SwitchReason::ReachesGoal => "reaches_goal",
+            SwitchReason::IncumbentDropped => "incumbent_dropped",
+            SwitchReason::Progress => "progress",
+        }
+    }
+}
+
+impl std::fmt::Display for SwitchReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
 }
 
 /// A trajectory shorter than this fraction of the planning horizon that does not reach the goal
@@ -338,7 +410,7 @@ impl CycleTiming {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FallbackReport {
     /// What it brakes along (see [`Event::Fallback`]).
-    pub along: String,
+    pub along: FallbackKind,
     /// Whether it passed the safety check against the current forecasts.
     pub collision_free: bool,
     /// Its smallest clearance margin (m).

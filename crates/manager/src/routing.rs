@@ -124,8 +124,9 @@ pub const ROUTE_WORK_PER_CYCLE: usize = 8_000;
 pub const RECHECK_S: f64 = 2.0;
 
 /// Why the manager planned a route ([`crate::Event::Rerouted`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum RouteReason {
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RouteReason {
     /// No route yet toward this goal.
     First,
     /// The progress monitor declared a stall.
@@ -135,7 +136,8 @@ pub(crate) enum RouteReason {
 }
 
 impl RouteReason {
-    pub(crate) fn as_str(self) -> &'static str {
+    /// The log's word for it (`"first"`, `"stalled"`, `"recheck"`).
+    pub fn as_str(self) -> &'static str {
         match self {
             RouteReason::First => "first",
             RouteReason::Stalled => "stalled",
@@ -147,7 +149,7 @@ impl RouteReason {
 /// The event for a new route.
 pub(crate) fn rerouted(reason: RouteReason, route: &GlobalRoute) -> crate::Event {
     crate::Event::Rerouted {
-        reason: reason.as_str().to_owned(),
+        reason,
         length_m: route.length(),
         vertex_count: route.points().len(),
     }
@@ -156,7 +158,7 @@ pub(crate) fn rerouted(reason: RouteReason, route: &GlobalRoute) -> crate::Event
 /// The event for a search that stopped without an answer.
 pub(crate) fn route_failed(reason: RouteReason, error: &RouteError) -> crate::Event {
     crate::Event::RouteFailed {
-        reason: reason.as_str().to_owned(),
+        reason,
         error: error.to_string(),
     }
 }

@@ -592,7 +592,7 @@ fn braking_fallback_when_every_branch_collides() {
     assert!(r.main.is_none());
     let fallback = r.fallback.as_ref().expect("fallback");
     assert!(fallback.collision_free, "{fallback:?}");
-    assert_eq!(fallback.along, "committed");
+    assert_eq!(fallback.along, trust_manager::FallbackKind::Committed);
     assert!(r.events.iter().any(|e| matches!(e, Event::Fallback { .. })));
     let plan = m.plan().unwrap();
     let end = plan.state(plan.t_end());
@@ -851,7 +851,7 @@ fn an_empty_frontend_result_holds_still_safely() {
     assert!(r.main.is_none() && r.branches.is_empty());
     let f = r.fallback.expect("fallback");
     assert!(f.collision_free);
-    assert_eq!(f.along, "straight");
+    assert_eq!(f.along, trust_manager::FallbackKind::Straight);
     let plan = m.plan().unwrap();
     assert!((plan.position(plan.t_end()) - START).norm() < 1e-9);
 }
@@ -1311,7 +1311,7 @@ fn with_a_route_a_wide_wall_ahead_is_flown_around_to_the_goal() {
     assert!(
         matches!(
             reports[routed].events.iter().find(|e| matches!(e, Event::Rerouted { .. })),
-            Some(Event::Rerouted { reason, vertex_count, .. }) if reason == "first" && *vertex_count >= 3
+            Some(Event::Rerouted { reason, vertex_count, .. }) if *reason == trust_manager::RouteReason::First && *vertex_count >= 3
         ),
         "{:?}",
         reports[routed].events
