@@ -109,10 +109,11 @@ fn a_wall_ahead_the_vehicle_leaves_the_start_and_arrives() {
 
 #[test]
 fn a_stalled_flight_says_so_then_progresses_and_arrives() {
-    // Seed 65 of the room with people stalls once and escapes. The penetration room's seeds
-    // 1, 106 and 65 stalled in turn until the forecasts' growth stopped earlier and the start
-    // from rest got faster; seeds 0–99 of it no longer stall at all.
-    let (f, events) = fly_audited(&suite("room_people").with_seed(65), "stall");
+    // Seed 63 of the room with people stalls and escapes (seeds 63, 86, 87, 109 and 129 of
+    // 60–140 do, since the cold solves are spread over cycles; 65 did before). The penetration
+    // room's seeds 1, 106 and 65 stalled in turn until the forecasts' growth stopped earlier and
+    // the start from rest got faster; seeds 0–99 of it no longer stall at all.
+    let (f, events) = fly_audited(&suite("room_people").with_seed(63), "stall");
     let o = &f.summary.outcome;
     assert_eq!(o.status, Status::Arrived, "{o:?}");
     let stalled = events.iter().position(|e| e == "stalled");
