@@ -375,7 +375,8 @@ fn plan_problem(e: PlanError, from: &str, to: &str) -> Problem {
             };
             Problem {
                 field: rest,
-                value,
+                // The planning crates write the value with `{:?}` (17 digits).
+                value: crate::problem::readable_value(&value),
                 expected,
             }
         }
@@ -850,7 +851,7 @@ impl PlannerSpec {
         {
             p.list.push(Problem {
                 field: "planner.accel_headroom".into(),
-                value: format!("{h}"),
+                value: crate::problem::fmt_num(h),
                 expected: "a fraction in [0, 0.5]".into(),
             });
         }
@@ -948,7 +949,7 @@ fn route_problem(e: RouteError) -> Problem {
                 "planner.route.params.{}",
                 field.strip_prefix("route.").unwrap_or(&field)
             ),
-            value: format!("{value}"),
+            value: crate::problem::fmt_num(value),
             expected,
         },
         other => Problem::new("planner.route.params", other, "valid route parameters"),

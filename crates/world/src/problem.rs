@@ -89,6 +89,40 @@ pub fn fmt_num(x: f64) -> String {
     }
 }
 
+/// A value another crate formatted (`{:?}` of an `f64` or a vector of them:
+/// `-1.7976931348623157e308`, `[0.30000000000000004, 2.0]`) with every number of more than 6
+/// significant digits or 12 characters written by [`fmt_num`]; other text (and `-5.0`) is kept.
+pub(crate) fn readable_value(value: &str) -> String {
+    let mut out = String::with_capacity(value.len());
+    let mut word = String::new();
+    let flush = |word: &mut String, out: &mut String| {
+        let mantissa = word.split(['e', 'E']).next().unwrap_or("");
+        let significant = mantissa
+            .chars()
+            .filter(char::is_ascii_digit)
+            .collect::<String>()
+            .trim_matches('0')
+            .len();
+        match word.parse::<f64>() {
+            Ok(x) if significant > 6 || (word.len() > 12 && significant > 0) => {
+                out.push_str(&fmt_num(x));
+            }
+            _ => out.push_str(word),
+        }
+        word.clear();
+    };
+    for c in value.chars() {
+        if c.is_whitespace() || matches!(c, ',' | '[' | ']' | '(' | ')' | '{' | '}' | ';' | ':') {
+            flush(&mut word, &mut out);
+            out.push(c);
+        } else {
+            word.push(c);
+        }
+    }
+    flush(&mut word, &mut out);
+    out
+}
+
 /// A count for a message: exact up to 10⁹, else scientific ([`fmt_num`]).
 pub fn fmt_count(n: u128) -> String {
     if n <= 1_000_000_000 {
@@ -274,6 +308,19 @@ impl Problems {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn values_from_other_crates_are_made_readable() {
+        assert_eq!(readable_value("-1.7976931348623157e308"), "-1.79769e308");
+        assert_eq!(
+            readable_value("[0.30000000000000004, 2.0, NaN]"),
+            "[0.3, 2.0, NaN]"
+        );
+        assert_eq!(readable_value("15000000000000.0"), "1.5e13");
+        assert_eq!(readable_value("-5.0"), "-5.0");
+        assert_eq!(readable_value("Some(1e-300)"), "Some(1e-300)");
+        assert_eq!(readable_value("\"dev-prm\""), "\"dev-prm\"");
+    }
 
     #[test]
     fn displays_field_value_and_expectation() {

@@ -92,7 +92,7 @@ impl SensingParams {
         if !(0.0..1.0).contains(&self.dropout_probability) {
             p.push(
                 format!("{field}.dropout_probability"),
-                self.dropout_probability,
+                crate::problem::fmt_num(self.dropout_probability),
                 "a probability in [0, 1)",
             );
         }
@@ -108,14 +108,20 @@ impl SensingParams {
 fn predict_problem(e: PredictError, prefix: &str) -> crate::problem::Problem {
     use crate::problem::Problem;
     match e {
-        PredictError::NonFinite { field, value } => {
-            Problem::new(format!("{prefix}.{field}"), value, "a finite number")
-        }
+        PredictError::NonFinite { field, value } => Problem::new(
+            format!("{prefix}.{field}"),
+            crate::problem::fmt_num(value),
+            "a finite number",
+        ),
         PredictError::OutOfRange {
             field,
             value,
             expected,
-        } => Problem::new(format!("{prefix}.{field}"), value, expected),
+        } => Problem::new(
+            format!("{prefix}.{field}"),
+            crate::problem::fmt_num(value),
+            expected,
+        ),
         other => Problem::new(format!("{prefix}.ekf"), other, "valid EKF parameters"),
     }
 }

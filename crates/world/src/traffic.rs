@@ -64,7 +64,7 @@ use trust_geometry::{box_sdf, cylinder_sdf, sphere_sdf};
 use trust_predict::ObstacleShape;
 
 use crate::error::WorldError;
-use crate::problem::{Problems, fmt_bounds, fmt_vec};
+use crate::problem::{Problems, fmt_bounds, fmt_num, fmt_vec};
 use crate::script::{
     FOURIER_CHECK_SAMPLES, FourierCurve, FourierSpec, SampledPath, SamplesSpec, Script,
     check_fourier, check_inside, check_samples,
@@ -389,7 +389,7 @@ impl MovingObstacle {
                     });
                     if let Some((t, q)) = first_out {
                         check_inside(
-                            &[(format!("{motion_field} at t = {t} s"), q)],
+                            &[(format!("{motion_field} at t = {} s", fmt_num(t)), q)],
                             &e,
                             r,
                             &format!("{field}.region"),
@@ -407,7 +407,11 @@ impl MovingObstacle {
                 if lo.is_finite() && hi.is_finite() && !(lo - 1e-9..=hi + 1e-9).contains(&s) {
                     p.push(
                         format!("{field}.velocity"),
-                        format!("{} (speed {s})", fmt_vec(self.velocity.as_slice())),
+                        format!(
+                            "{} (speed {})",
+                            fmt_vec(self.velocity.as_slice()),
+                            fmt_num(s)
+                        ),
                         format!(
                             "a speed within {field}.motion.speed_m_s {}",
                             fmt_vec(&[lo, hi])

@@ -26,6 +26,7 @@ use std::io::{BufRead, BufReader, Read};
 use std::path::{Component, Path, PathBuf};
 
 use crate::error::WorldError;
+use crate::problem::fmt_num;
 
 /// Largest scenario file read (bytes): 4 MiB.
 pub const MAX_SCENARIO_BYTES: u64 = 4 << 20;
@@ -134,6 +135,88 @@ pub fn echo(line: &str) -> String {
     }
 }
 
+/// A parser's message that quotes the file, made to follow the policy (module docs): toml shows
+/// the offending line under a `N | ` gutter with a caret line below it, at the `column C` its
+/// first line names; a quoted line longer than [`MAX_ECHO_CHARS`] characters is cut to a window
+/// of that many around the column (`…` marks each cut, the caret moves with the text). In the
+/// other lines, numbers of more than 12 digits are written readably ([`fmt_num`]: serde writes
+/// a wrong float value in full, 309 digits for `1e308`), and each line is cut to four times
+/// [`MAX_ECHO_CHARS`] (serde quotes a wrong string value whole).
+pub fn parser_message(message: &str) -> String {
+    let w = MAX_ECHO_CHARS;
+    let column = message
+        .lines()
+        .next()
+        .and_then(|l| l.rsplit_once("column "))
+        .and_then(|(_, c)| c.trim().parse::<usize>().ok())
+        .unwrap_or(1);
+    // A gutter line: where its text starts, and whether it is numbered (the quote) or not (the
+    // caret).
+    let gutter = |line: &str| -> Option<(usize, bool)> {
+        let bar = line.find("| ")?;
+        let g = line[..bar].trim();
+        g.chars()
+            .all(|c| c.is_ascii_digit())
+            .then_some((bar + 2, !g.is_empty()))
+    };
+    let long_quote = message
+        .lines()
+        .any(|l| gutter(l).is_some_and(|(at, numbered)| numbered && l[at..].chars().count() > w));
+    let start = column.saturating_sub(1).saturating_sub(w / 2);
+    let mut out: Vec<String> = Vec::new();
+    for line in message.lines() {
+        match gutter(line) {
+            Some((at, numbered)) if long_quote => {
+                let text: Vec<char> = line[at..].chars().collect();
+                let end = (start + w).min(text.len());
+                let mut cut: String = text[start.min(end)..end].iter().collect();
+                if numbered && end < text.len() {
+                    cut.push('…');
+                }
+                let lead = match (start > 0, numbered) {
+                    (true, true) => "…",
+                    (true, false) => " ",
+                    (false, _) => "",
+                };
+                out.push(format!("{}{lead}{cut}", &line[..at]));
+            }
+            Some(_) => out.push(line.to_string()),
+            None => {
+                let line = readable_numbers(line);
+                if line.chars().count() > 4 * w {
+                    let head: String = line.chars().take(4 * w).collect();
+                    out.push(format!("{head}…"));
+                } else {
+                    out.push(line);
+                }
+            }
+        }
+    }
+    out.join("\n")
+}
+
+/// `line` with every number of more than 12 digits written by [`fmt_num`].
+fn readable_numbers(line: &str) -> String {
+    let mut out = String::with_capacity(line.len());
+    let mut rest = line;
+    while let Some(i) = rest.find(|c: char| c.is_ascii_digit()) {
+        out.push_str(&rest[..i]);
+        let tail = &rest[i..];
+        let len = tail
+            .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .unwrap_or(tail.len());
+        let token = tail[..len].trim_end_matches('.');
+        let digits = token.chars().filter(char::is_ascii_digit).count();
+        match token.parse::<f64>() {
+            Ok(x) if digits > 12 => out.push_str(&fmt_num(x)),
+            _ => out.push_str(token),
+        }
+        rest = &tail[token.len()..];
+    }
+    out.push_str(rest);
+    out
+}
+
 /// Why a relative `path` from a scenario file is refused: it leaves the scenario's folder
 /// (module docs); `None` for an accepted path (every absolute path, and relative paths that stay
 /// inside).
@@ -187,6 +270,39 @@ mod tests {
         for bad in ["../a.csv", "data/../../a.csv", "./../x/a.csv"] {
             assert!(relative_path_problem(Path::new(bad)).is_some(), "{bad}");
         }
+    }
+
+    #[test]
+    fn parser_messages_keep_a_window_around_the_column_and_readable_numbers() {
+        let line = format!("x = [{}]", "1, ".repeat(1000));
+        let message = format!(
+            "TOML parse error at line 3, column 1503\n  |\n3 | {line}\n  | {}^\ninvalid type",
+            " ".repeat(1502)
+        );
+        let cut = parser_message(&message);
+        assert!(cut.lines().all(|l| l.chars().count() < 80), "{cut}");
+        let lines: Vec<&str> = cut.lines().collect();
+        let caret = lines[3].chars().position(|c| c == '^').unwrap();
+        // "3 | " and "…", 60 characters of the line, "…"; the caret under the same character.
+        assert_eq!(lines[2].chars().count(), 4 + 1 + 60 + 1, "{cut}");
+        assert_eq!(caret, 4 + 1 + 30, "{cut}");
+        assert_eq!(lines[2].chars().nth(caret), line.chars().nth(1502), "{cut}");
+        assert!(lines[4] == "invalid type");
+        // A short quote is left as it is.
+        let short = "TOML parse error at line 1, column 5\n  |\n1 | a = =\n  |     ^\nexpected";
+        assert_eq!(parser_message(short), short);
+        // Another long line (a quoted value) is cut to four times the echo.
+        let long = format!("invalid type: string \"{}\"", "y".repeat(1000));
+        assert!(parser_message(&long).chars().count() <= 4 * MAX_ECHO_CHARS + 1);
+        // serde writes a wrong float in full: 309 digits for 1e308.
+        let huge = format!(
+            "invalid type: floating point `1{}.0`, expected a table",
+            "0".repeat(308)
+        );
+        assert_eq!(
+            parser_message(&huge),
+            "invalid type: floating point `1e308`, expected a table"
+        );
     }
 
     #[test]

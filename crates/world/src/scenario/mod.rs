@@ -252,7 +252,7 @@ impl Scenario {
     pub fn from_toml_str(text: &str, origin: &Path) -> Result<Scenario, WorldError> {
         let mut s: Scenario = toml::from_str(text).map_err(|e| WorldError::Parse {
             path: origin.to_path_buf(),
-            message: e.to_string().trim_end().to_string(),
+            message: files::parser_message(e.to_string().trim_end()),
         })?;
         s.path = Some(origin.to_path_buf());
         Ok(s.with_seed(s.seed))

@@ -28,6 +28,7 @@
 //! | cloud points (inline, file, or sampled from shapes: counted before sampling) | `≤ 2e7` | [`MAX_CLOUD_POINTS`] |
 //! | sampling lattice of `spacing_m` over the bounds | `≤ trust_geometry::MAX_VOXELS` | |
 //! | samples of a track, harmonics of a Fourier list | `≤ 1e5`, `≤ 64` | [`crate::script::MAX_SAMPLES`], [`crate::script::MAX_HARMONICS`] |
+//! | track files of all obstacles (each read once per obstacle naming it) | `≤ 64 MiB` and `≤ 1e6` samples in all | [`MAX_TRACK_BYTES_TOTAL`], [`MAX_TRACK_SAMPLES_TOTAL`] |
 //! | random draws of `[mission] random` | `≤ 40 200`, and draws × static shapes `≤ 4e6` | [`MAX_ENDPOINT_WORK`] |
 //! | placement work of random obstacles and E4's static shapes | `≤ 2e7` distance tests per world | [`MAX_PLACEMENT_WORK`] |
 //!
@@ -38,7 +39,7 @@ use trust_core::Aabb;
 use trust_geometry::{MAX_VOXELS, Shape, checked_voxel_count};
 
 use super::generator::GeneratorSpec;
-use super::validate::esdf_dims;
+use super::validate::{esdf_dims, fmt_grid};
 use super::{PointCloudSpec, Scenario};
 use crate::problem::{Problems, fmt_count, fmt_num};
 use crate::traffic::Motion;
@@ -75,6 +76,13 @@ pub const MAX_OBSTACLE_COUNT: usize = 10_000;
 pub const MAX_STATIC_SHAPE_COUNT: usize = 10_000;
 /// Most points of a cloud (480 MB of coordinates).
 pub const MAX_CLOUD_POINTS: usize = 20_000_000;
+/// Most bytes of track files read for one scenario, over all its obstacles (a file named by
+/// several obstacles counts for each): four files at [`super::files::MAX_TRACK_BYTES`].
+pub const MAX_TRACK_BYTES_TOTAL: u64 = 64 << 20;
+/// Most samples of all the tracks of one scenario: ten tracks at
+/// [`crate::script::MAX_SAMPLES`] (56 MB of interpolants); without it, 10 000 obstacles naming
+/// one 16 MiB track would read 160 GB and hold 10⁹ samples.
+pub const MAX_TRACK_SAMPLES_TOTAL: usize = 1_000_000;
 /// Most shape distance tests of the `[mission] random` draw (draws × static shapes).
 pub const MAX_ENDPOINT_WORK: usize = 4_000_000;
 /// Most distance tests of the placements of one world's random obstacles and E4 shapes.
@@ -277,17 +285,13 @@ impl Scenario {
                 if let Some(b) = bounds {
                     let dims = esdf_dims(b, *s);
                     if checked_voxel_count(dims).is_err() {
-                        let count = dims.iter().map(|&d| d as f64).product::<f64>();
                         p.push(
                             "static.point_cloud.spacing_m",
                             fmt_num(*s),
                             format!(
                                 "a spacing giving at most {MAX_VOXELS} lattice points over \
-                                 world.bounds (scale policy; this one gives {} x {} x {} = {})",
-                                dims[0],
-                                dims[1],
-                                dims[2],
-                                fmt_num(count)
+                                 world.bounds (scale policy; this one gives {})",
+                                fmt_grid(b, *s)
                             ),
                         );
                     }

@@ -4,7 +4,7 @@ use trust_core::{Aabb, Vec3};
 use trust_geometry::{MAX_VOXELS, checked_voxel_count};
 
 use super::{Latency, MAX_CPU_SCALE, MovingShapeKind, PointCloudSpec, Problem, Scenario};
-use crate::problem::{Problems, fmt_bounds, fmt_num, fmt_vec};
+use crate::problem::{Problems, fmt_bounds, fmt_count, fmt_num, fmt_vec};
 use crate::scenario::points::read_points_file;
 use trust_vehicle::VehicleError;
 
@@ -26,6 +26,85 @@ pub(crate) struct FileCheck {
     /// Bounds, static map, obstacles, mission and vehicle radius are valid, so the layout can be
     /// generated and checked (`generate::check_layout`).
     pub(crate) geometry_ok: bool,
+}
+
+/// What the track files of a scenario's obstacles have read so far, against the scale policy's
+/// totals ([`super::scale::MAX_TRACK_BYTES_TOTAL`], [`super::scale::MAX_TRACK_SAMPLES_TOTAL`]).
+#[derive(Debug, Default)]
+struct TrackTotals {
+    bytes: u64,
+    samples: usize,
+    /// The totals were exceeded (reported once; no further file is read).
+    over: bool,
+}
+
+impl TrackTotals {
+    /// Whether obstacle `o` (`field`) may have its track file read: always without one; with
+    /// one, while the totals, this file's size included, stay within the policy (reported on
+    /// the first obstacle beyond them).
+    fn admit(
+        &mut self,
+        s: &Scenario,
+        o: &super::ObstacleSpec,
+        field: &str,
+        p: &mut Problems,
+    ) -> bool {
+        let crate::traffic::Motion::Samples(spec) = &o.motion else {
+            return true;
+        };
+        if spec.file.is_none() {
+            return true;
+        }
+        if self.over {
+            return false;
+        }
+        let size = spec
+            .file
+            .as_ref()
+            .and_then(|f| std::fs::metadata(s.resolve_path(f)).ok())
+            .map_or(0, |m| m.len());
+        if self.bytes.saturating_add(size) <= super::scale::MAX_TRACK_BYTES_TOTAL {
+            self.bytes += size;
+            return true;
+        }
+        self.exceeded(
+            field,
+            &format!("this file has {} bytes", fmt_count(u128::from(size))),
+            p,
+        );
+        false
+    }
+
+    /// Counts the `n` samples obstacle `field`'s file gave.
+    fn loaded(&mut self, n: usize, field: &str, p: &mut Problems) {
+        self.samples += n;
+        if self.samples > super::scale::MAX_TRACK_SAMPLES_TOTAL && !self.over {
+            self.exceeded(
+                field,
+                &format!("this file has {} samples", fmt_count(n as u128)),
+                p,
+            );
+        }
+    }
+
+    fn exceeded(&mut self, field: &str, this: &str, p: &mut Problems) {
+        use super::scale::{MAX_TRACK_BYTES_TOTAL, MAX_TRACK_SAMPLES_TOTAL};
+        self.over = true;
+        p.push(
+            format!("{field}.motion.file"),
+            format!(
+                "{} bytes and {} samples read so far",
+                fmt_count(u128::from(self.bytes)),
+                fmt_count(self.samples as u128)
+            ),
+            format!(
+                "at most {} MiB of track files and {} samples in all obstacles' tracks (scale \
+                 policy: a file counts for every obstacle naming it; {this})",
+                MAX_TRACK_BYTES_TOTAL >> 20,
+                fmt_count(MAX_TRACK_SAMPLES_TOTAL as u128),
+            ),
+        );
+    }
 }
 
 impl Scenario {
@@ -116,17 +195,13 @@ impl Scenario {
         {
             let dims = esdf_dims(b, voxel);
             if checked_voxel_count(dims).is_err() {
-                let count = dims.iter().map(|&d| d as f64).product::<f64>();
                 p.push(
                     "static.point_cloud.esdf_voxel_m",
                     fmt_num(voxel),
                     format!(
                         "a voxel size giving at most {MAX_VOXELS} voxels over world.bounds \
-                         (this one gives {} x {} x {} = {})",
-                        dims[0],
-                        dims[1],
-                        dims[2],
-                        fmt_num(count)
+                         (this one gives {})",
+                        fmt_grid(b, voxel)
                     ),
                 );
             }
@@ -190,6 +265,9 @@ impl Scenario {
     }
 
     fn check_obstacles(&self, p: &mut Problems, bounds: Option<&Aabb>) {
+        // Every track file is read whole, for each obstacle that names it: the totals are
+        // capped too (scale policy), not only each file.
+        let mut tracks = TrackTotals::default();
         for (i, o) in self.obstacles.iter().enumerate() {
             let field = format!("obstacles[{i}]");
             let before = p.list.len();
@@ -276,8 +354,14 @@ impl Scenario {
                 (None, None) => None,
             };
             if let Some(region) = region {
+                if !tracks.admit(self, o, &field, p) {
+                    continue;
+                }
                 match o.moving_obstacle(&field, region, |q| self.resolve_path(q)) {
                     Ok(m) => {
+                        if let crate::traffic::Motion::Samples(s) = &m.motion {
+                            tracks.loaded(s.samples.len(), &field, p);
+                        }
                         let mut sub = Problems::default();
                         m.check(&field, &mut sub);
                         sub.list.retain(|q| {
@@ -408,6 +492,62 @@ impl Scenario {
         }
     }
 
+    /// In real time the loop divides the planner's budgets by the CPU scale
+    /// (`trust_flight::real_time_planner`: the cycle budget and the frontend's `budget_ms`); the
+    /// divided budgets must stay within the ranges the planning crates accept, or the flight's
+    /// set-up would refuse what validation accepted (found by `trust-fuzz`'s file groups:
+    /// `budget_ms = 200` at `cpu_scale = 1e-5` is 2e7 ms). Reported on the scale, with the
+    /// budget it breaks.
+    fn check_real_time_budgets(&self, p: &mut Problems, scale: f64) {
+        use crate::planner::FrontendSpec;
+        if !(scale > 0.0 && scale <= MAX_CPU_SCALE) {
+            return;
+        }
+        let r = self.resolve_planner();
+        let frontend_ms = match &r.frontend {
+            FrontendSpec::DevPrm(x) => Some(x.budget_ms),
+            FrontendSpec::VPrm(x) => Some(x.budget_ms),
+            FrontendSpec::SparseAStar(x) => Some(x.budget_ms),
+            FrontendSpec::StraightLine(_) => None,
+        };
+        let max = trust_topo_prm::ranges::MAX_BUDGET_MS;
+        let min = trust_geometry::scale::MIN_POSITIVE;
+        let budgets = [
+            (
+                "planner.manager.cycle_budget_ms",
+                Some(r.manager.cycle_budget_ms),
+                (f64::MIN_POSITIVE, f64::MAX),
+                "finite and > 0".to_string(),
+            ),
+            (
+                "planner.frontend.budget_ms",
+                frontend_ms,
+                (min, max),
+                format!("in [{}, {}] ms", fmt_num(min), fmt_num(max)),
+            ),
+        ];
+        for (field, budget, (lo, hi), range) in budgets {
+            let Some(b) = budget.filter(|b| b.is_finite() && *b > 0.0) else {
+                // A bad budget is its own field's problem.
+                continue;
+            };
+            let scaled = b / scale;
+            if !(scaled >= lo && scaled <= hi) {
+                p.push(
+                    "sim.latency.cpu_scale",
+                    fmt_num(scale),
+                    format!(
+                        "a CPU scale that keeps the planner's budgets in range in real time \
+                         ({field} {} ms / {} = {} ms; expected {range})",
+                        fmt_num(b),
+                        fmt_num(scale),
+                        fmt_num(scaled)
+                    ),
+                );
+            }
+        }
+    }
+
     fn check_sim(&self, p: &mut Problems) {
         let s = &self.sim;
         let dt_ok = p.positive("sim.physics_dt_s", s.physics_dt_s);
@@ -464,6 +604,9 @@ impl Scenario {
                 format!("a number in (0, {MAX_CPU_SCALE}]"),
             );
         }
+        if let Latency::Measured { cpu_scale } = s.latency {
+            self.check_real_time_budgets(p, cpu_scale.unwrap_or(1.0));
+        }
         if let Latency::Fixed {
             seconds: Some(seconds),
         } = s.latency
@@ -491,14 +634,40 @@ impl Scenario {
     }
 }
 
+/// The grid [`esdf_dims`] counts, for a message: `nx x ny x nz = total`, every count readable
+/// ([`fmt_num`]) and as large as it is (not the placeholder `esdf_dims` clamps a huge count to).
+pub(crate) fn fmt_grid(bounds: &Aabb, resolution: f64) -> String {
+    let ext = bounds.extent();
+    let n: Vec<f64> = (0..3)
+        .map(|i| (ext[i] / resolution * (1.0 - 1e-12)).ceil().max(1.0))
+        .collect();
+    format!(
+        "{} x {} x {} = {}",
+        fmt_num(n[0]),
+        fmt_num(n[1]),
+        fmt_num(n[2]),
+        fmt_num(n[0] * n[1] * n[2])
+    )
+}
+
+/// Most voxels per axis [`esdf_dims`] reports: a larger count is reported as this one (far
+/// beyond `MAX_VOXELS` either way), so that the product of three stays within `u128`
+/// (`trust_geometry::checked_voxel_count` multiplies them unchecked; with the former
+/// placeholder `usize::MAX / 4` it overflowed, a panic in debug builds).
+const MAX_AXIS_VOXELS: usize = 1 << 40;
+
 /// Voxels per axis of an ESDF of `resolution` over `bounds`, as `Esdf::from_points` computes
-/// them (without allocating).
+/// them (without allocating), each at most [`MAX_AXIS_VOXELS`].
 pub(crate) fn esdf_dims(bounds: &Aabb, resolution: f64) -> [usize; 3] {
     let ext = bounds.extent();
     let mut dims = [0usize; 3];
     for i in 0..3 {
         let n = (ext[i] / resolution * (1.0 - 1e-12)).ceil().max(1.0);
-        dims[i] = if n < 1e15 { n as usize } else { usize::MAX / 4 };
+        dims[i] = if n < MAX_AXIS_VOXELS as f64 {
+            n as usize
+        } else {
+            MAX_AXIS_VOXELS
+        };
     }
     dims
 }
