@@ -8,6 +8,7 @@
 //! Each case is reproducible alone: `trust-fuzz --only <api> --replay <case seed>`.
 
 mod apis;
+mod files;
 mod inputs;
 mod minco_oracles;
 mod params;
@@ -17,7 +18,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use anyhow::Result;
+use anyhow::{Context as _, Result};
 use clap::Parser;
 
 use apis::{Api, Fixtures, Outcome};
@@ -44,9 +45,39 @@ struct Args {
     /// Replay one case seed (with --only) and print its outcome.
     #[arg(long)]
     replay: Option<u64>,
-    /// How many failing case seeds to print per API.
+    /// How many failing case seeds to print per API (per kind of failure for file groups).
     #[arg(long, default_value_t = 3)]
     show: usize,
+    /// Address-space limit of a file-group worker (MiB; 0: none): an allocation beyond it
+    /// aborts the worker, which the run counts and survives.
+    #[arg(long, default_value_t = 2048)]
+    mem_mb: u64,
+    /// A scenario that validates with a planner map of more ESDF voxels than this is counted
+    /// as heavy and not set up (file groups).
+    #[arg(long, default_value_t = 1_000_000.0)]
+    max_voxels: f64,
+    /// Parallel workers per file group.
+    #[arg(long, default_value_t = 1)]
+    jobs: usize,
+    /// Keep the file groups' folder here (the corpus logs, each worker's last case; with
+    /// --replay, the case's files) instead of a temporary one removed at the end.
+    #[arg(long)]
+    keep: Option<std::path::PathBuf>,
+    /// Internal: run as a file-group worker of this group.
+    #[arg(long, hide = true)]
+    worker: Option<String>,
+    /// Internal: the worker's first case.
+    #[arg(long, hide = true, default_value_t = 0)]
+    from: u64,
+    /// Internal: one past the worker's last case.
+    #[arg(long, hide = true, default_value_t = 0)]
+    to: u64,
+    /// Internal: the worker's folder.
+    #[arg(long, hide = true)]
+    work: Option<std::path::PathBuf>,
+    /// Internal: the corpus logs' folder.
+    #[arg(long, hide = true)]
+    base: Option<std::path::PathBuf>,
 }
 
 #[derive(Default, Clone)]
@@ -111,33 +142,239 @@ fn main() -> Result<()> {
     let args = Args::parse();
     // Panics are counted, not printed one by one.
     std::panic::set_hook(Box::new(|_| {}));
-    let fx = Fixtures::new()?;
+    if let Some(group) = &args.worker {
+        return files::worker::worker_main(&files::worker::Plan {
+            group: group.clone(),
+            from: args.from,
+            to: args.to,
+            seed: args.seed,
+            work: args.work.clone().context("--worker needs --work")?,
+            base: args.base.clone().context("--worker needs --base")?,
+            max_voxels: args.max_voxels,
+        });
+    }
+    let selected = |name: &str| args.only.as_ref().is_none_or(|o| name.contains(o.as_str()));
     let apis: Vec<Api> = registry()
         .into_iter()
-        .filter(|a| {
-            args.only
-                .as_ref()
-                .is_none_or(|o| a.name.contains(o.as_str()))
+        .filter(|a| selected(a.name))
+        .collect();
+    // File groups of weight 0 (the harness's self-test) run only when named exactly.
+    let file_groups: Vec<(usize, files::FileGroup)> = files::groups()
+        .into_iter()
+        .enumerate()
+        .filter(|(_, g)| {
+            if g.weight == 0 {
+                args.only.as_deref() == Some(g.name)
+            } else {
+                selected(g.name)
+            }
         })
         .collect();
-    anyhow::ensure!(!apis.is_empty(), "no API matches --only");
+    anyhow::ensure!(
+        !apis.is_empty() || !file_groups.is_empty(),
+        "no API or file group matches --only"
+    );
 
     if let Some(seed) = args.replay {
-        for api in &apis {
-            let (out, ms) = run_one(api, &fx, seed);
-            match out {
-                Ok(o) => println!("{}: {o:?} in {ms:.3} ms", api.name),
-                Err(p) => println!("{}: PANIC {} in {ms:.3} ms", api.name, panic_message(&*p)),
+        if !apis.is_empty() {
+            let fx = Fixtures::new()?;
+            for api in &apis {
+                let (out, ms) = run_one(api, &fx, seed);
+                match out {
+                    Ok(o) => println!("{}: {o:?} in {ms:.3} ms", api.name),
+                    Err(p) => println!("{}: PANIC {} in {ms:.3} ms", api.name, panic_message(&*p)),
+                }
             }
+        }
+        for (_, g) in &file_groups {
+            replay_file_case(&args, g, seed)?;
         }
         return Ok(());
     }
 
-    let total_weight: u64 = apis.iter().map(|a| u64::from(a.weight)).sum();
-    let calls_per_api: Vec<u64> = apis
-        .iter()
-        .map(|a| (args.cases * u64::from(a.weight) / total_weight).max(1))
-        .collect();
+    // A group of weight 0 runs only when named alone: it then takes every case.
+    let weight = |w: u32| u64::from(w.max(1));
+    let total_weight: u64 = apis.iter().map(|a| weight(a.weight)).sum::<u64>()
+        + file_groups
+            .iter()
+            .map(|(_, g)| weight(g.weight))
+            .sum::<u64>();
+    let share = |w: u32| (args.cases * weight(w) / total_weight.max(1)).max(1);
+    let mut bad = 0;
+    if !apis.is_empty() {
+        let calls_per_api: Vec<u64> = apis.iter().map(|a| share(a.weight)).collect();
+        bad += run_apis(&args, apis, &calls_per_api)?;
+    }
+    if !file_groups.is_empty() {
+        let cases: Vec<u64> = file_groups.iter().map(|(_, g)| share(g.weight)).collect();
+        bad += run_file_groups(&args, &file_groups, &cases)?;
+    }
+    if bad > 0 {
+        println!(
+            "FAIL: {bad} calls or cases panicked, aborted, hung, returned non-finite, wrong or \
+             unreadable output, disagreed, or were slow"
+        );
+        std::process::exit(1);
+    }
+    println!(
+        "OK: 0 panics, 0 aborts, 0 hangs, 0 non-finite outputs, 0 wrong answers, 0 unreadable \
+         messages, 0 disagreements, 0 slow calls"
+    );
+    Ok(())
+}
+
+/// Runs one case of a file group in this process (`--replay`) and prints its verdict; its files
+/// stay in `--keep` (or a temporary folder, printed).
+fn replay_file_case(args: &Args, g: &files::FileGroup, seed: u64) -> Result<()> {
+    let root = args.keep.clone().unwrap_or_else(|| {
+        std::env::temp_dir().join(format!("trust-fuzz-replay-{}", std::process::id()))
+    });
+    let base = root.join("base");
+    if g.needs_logs && !base.join("quickstart").is_dir() {
+        files::prepare(&base)?;
+    }
+    let ctx = files::Ctx::load(&base, args.max_voxels)?;
+    let dir = files::corpus::CaseDir::create(&root.join("work"), &ctx.corpus)?;
+    let (r, ms) = files::worker::run_case(g, &ctx, &dir, seed);
+    match r {
+        Ok(v) => {
+            println!(
+                "{}: {} in {ms:.1} ms{}",
+                g.name,
+                if v.accepted { "accepted" } else { "refused" },
+                if v.heavy { " (heavy: not set up)" } else { "" }
+            );
+            println!("  what it did: {}", v.note);
+            for (flag, detail) in &v.flags {
+                println!("  {}: {detail}", flag.name());
+            }
+        }
+        Err(p) => println!("{}: PANIC {} in {ms:.1} ms", g.name, panic_message(&*p)),
+    }
+    println!("  files: {}", dir.case.display());
+    Ok(())
+}
+
+/// Runs the file groups (`cases[i]` cases of `groups[i]`) in workers and prints their table;
+/// returns the number of bad cases.
+fn run_file_groups(
+    args: &Args,
+    groups: &[(usize, files::FileGroup)],
+    cases: &[u64],
+) -> Result<u64> {
+    let t0 = Instant::now();
+    let root = args
+        .keep
+        .clone()
+        .unwrap_or_else(|| std::env::temp_dir().join(format!("trust-fuzz-{}", std::process::id())));
+    let base = root.join("base");
+    if groups.iter().any(|(_, g)| g.needs_logs) {
+        files::prepare(&base)?;
+        eprintln!(
+            "file groups: corpus logs flown in {:.1} s",
+            t0.elapsed().as_secs_f64()
+        );
+    }
+    let opts = files::worker::Options {
+        seed: args.seed,
+        hang_ms: args.hang_ms,
+        mem_mb: args.mem_mb,
+        max_voxels: args.max_voxels,
+        base,
+        work: root.join("work"),
+        show: args.show,
+        jobs: args.jobs,
+    };
+    let exe = std::env::current_exe().context("locating trust-fuzz for its workers")?;
+    let mut stats = Vec::new();
+    for ((index, g), &n) in groups.iter().zip(cases) {
+        let t = Instant::now();
+        let s = files::worker::run_group(&exe, *index, n, &opts)?;
+        eprintln!(
+            "{}: {} cases in {:.1} s",
+            g.name,
+            s.cases,
+            t.elapsed().as_secs_f64()
+        );
+        stats.push((g.name, s));
+    }
+    let bad = print_file_table(&stats, args, t0);
+    if args.keep.is_none() {
+        std::fs::remove_dir_all(&root).ok();
+    }
+    Ok(bad)
+}
+
+/// Prints the file groups' table and failing examples; returns the number of bad cases.
+fn print_file_table(stats: &[(&str, files::worker::GroupStats)], args: &Args, t0: Instant) -> u64 {
+    println!(
+        "{:<16} {:>8} {:>9} {:>6} {:>7} {:>7} {:>6} {:>6} {:>11} {:>9} {:>9}",
+        "file group",
+        "cases",
+        "accepted",
+        "heavy",
+        "panics",
+        "aborts",
+        "hangs",
+        "wrong",
+        "unreadable",
+        "disagree",
+        "max ms"
+    );
+    let mut total = files::worker::GroupStats::default();
+    let row = |name: &str, s: &files::worker::GroupStats| {
+        println!(
+            "{:<16} {:>8} {:>9} {:>6} {:>7} {:>7} {:>6} {:>6} {:>11} {:>9} {:>9.1}",
+            name,
+            s.cases,
+            s.accepted,
+            s.heavy,
+            s.panics,
+            s.aborts,
+            s.hangs,
+            s.wrong,
+            s.unreadable,
+            s.disagree,
+            s.slowest.0
+        );
+    };
+    for (name, s) in stats {
+        row(name, s);
+        total.merge(s, 0);
+    }
+    row("TOTAL", &total);
+    println!(
+        "seed {}, {:.1} s wall; workers: {} MiB address space{}, hang after {} ms; heavy: \
+         validated with a map above {} ESDF voxels, not set up",
+        args.seed,
+        t0.elapsed().as_secs_f64(),
+        args.mem_mb,
+        if args.mem_mb == 0 { " (no limit)" } else { "" },
+        args.hang_ms,
+        args.max_voxels
+    );
+    for (name, s) in stats {
+        if s.slowest.0 > 0.0 {
+            println!(
+                "  {name}: slowest case {} ({:.0} ms)",
+                s.slowest.1, s.slowest.0
+            );
+        }
+        for (_, e) in &s.examples {
+            println!("  {name}: {e}");
+        }
+        if s.bad() > 0 {
+            println!("    replay: trust-fuzz --only '{name}' --replay <case> --keep DIR");
+        }
+    }
+    total.bad()
+}
+
+/// Runs the API groups (`calls_per_api[i]` calls of `apis[i]`) with the watchdog and prints their
+/// table; returns the number of bad calls.
+fn run_apis(args: &Args, apis: Vec<Api>, calls_per_api: &[u64]) -> Result<u64> {
+    let fx = Fixtures::new()?;
+    let calls_per_api = calls_per_api.to_vec();
     let names: Vec<&'static str> = apis.iter().map(|a| a.name).collect();
     let current = Arc::new(Current {
         api: AtomicUsize::new(0),
@@ -231,13 +468,7 @@ fn main() -> Result<()> {
         .map_err(|_| anyhow::anyhow!("worker thread died"))?;
 
     let stats = stats.lock().map_err(|_| anyhow::anyhow!("poisoned"))?;
-    let bad = print_table(&names, &stats, args.seed, run_start);
-    if bad > 0 {
-        println!("FAIL: {bad} calls panicked, returned non-finite or wrong output, or were slow");
-        std::process::exit(1);
-    }
-    println!("OK: 0 panics, 0 hangs, 0 non-finite outputs, 0 wrong answers, 0 slow calls");
-    Ok(())
+    Ok(print_table(&names, &stats, args.seed, run_start))
 }
 
 /// Prints the per-API table and the failing examples; returns the number of bad calls.
