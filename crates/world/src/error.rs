@@ -22,13 +22,13 @@ pub enum WorldError {
         source: std::io::Error,
     },
     /// A path the scenario reads is not a regular file (a folder, a device such as `/dev/zero`,
-    /// a pipe): only regular files are read ([`crate::scenario::files`]).
+    /// a pipe): only regular files are read ([`crate::files`]).
     #[error("cannot read {}: not a regular file", path.display())]
     NotAFile {
         /// The path.
         path: PathBuf,
     },
-    /// A file is larger than the cap for its kind ([`crate::scenario::files`]); nothing beyond
+    /// A file is larger than the cap for its kind ([`crate::files`]); nothing beyond
     /// the cap was read.
     #[error("cannot read {}: larger than the cap of {} for {what}", path.display(), fmt_bytes(*limit_bytes))]
     TooLarge {

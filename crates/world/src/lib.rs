@@ -36,7 +36,7 @@
 //! [`check`] (`trust-sim validate`) runs every check [`World::build`] and a flight's set-up run:
 //! the file's checks with the scale policy ([`scenario::scale`]), the layout, and the traffic,
 //! sensor, planner assembly and vehicle model of the flight; a file it accepts builds and
-//! starts. Files the scenario names are read under [`scenario::files`]' caps and path policy.
+//! starts. Files the scenario names are read under [`files`]' caps and path policy.
 //!
 //! ```no_run
 //! use std::path::Path;
@@ -51,6 +51,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod files;
 pub(crate) mod generate;
 mod kdtree;
 pub mod planner;

@@ -112,8 +112,8 @@ impl SamplesSpec {
     /// The samples of `file` (resolved by `resolve`) in place of the file name: inline samples
     /// are returned as they are.
     ///
-    /// The file is read incrementally under [`crate::scenario::files`]'s policy (a regular file
-    /// of at most [`crate::scenario::files::MAX_TRACK_BYTES`]), and at most [`MAX_SAMPLES`]
+    /// The file is read incrementally under [`crate::files`]'s policy (a regular file
+    /// of at most [`crate::files::MAX_TRACK_BYTES`]), and at most [`MAX_SAMPLES`]
     /// samples.
     ///
     /// # Errors
@@ -129,9 +129,9 @@ impl SamplesSpec {
         }
         let full = resolve(file);
         let mut csv = CsvTrack::default();
-        crate::scenario::files::for_each_line(
+        crate::files::for_each_line(
             &full,
-            crate::scenario::files::MAX_TRACK_BYTES,
+            crate::files::MAX_TRACK_BYTES,
             "a track file",
             |n, line| csv.line(n, line),
         )?;
@@ -518,7 +518,7 @@ struct CsvTrack {
 
 impl CsvTrack {
     fn line(&mut self, n: usize, raw: &str) -> Result<(), (usize, String)> {
-        use crate::scenario::files::echo;
+        use crate::files::echo;
         self.last_line = n;
         let line = raw.trim();
         if line.is_empty() || line.starts_with('#') {

@@ -136,7 +136,7 @@
 //! generated — once per world, in [`crate::World::build`] — or by [`crate::load_checked`]
 //! (`trust-sim validate`), which generates the layout without building the maps.
 
-pub mod files;
+pub use crate::files;
 pub(crate) mod generator;
 pub mod points;
 pub mod scale;

@@ -1,15 +1,15 @@
 //! Points files: one point per line, `x y z` (whitespace- or comma-separated), blank lines and
 //! lines starting with `#` ignored. Read incrementally, at most
-//! [`super::files::MAX_POINTS_BYTES`] bytes and [`super::scale::MAX_CLOUD_POINTS`] points
+//! [`crate::files::MAX_POINTS_BYTES`] bytes and [`super::scale::MAX_CLOUD_POINTS`] points
 //! ([`super::files`] for the policy).
 
 use std::path::Path;
 
 use trust_core::Vec3;
 
-use super::files::{MAX_POINTS_BYTES, echo, for_each_line};
 use super::scale::MAX_CLOUD_POINTS;
 use crate::error::WorldError;
+use crate::files::{MAX_POINTS_BYTES, echo, for_each_line};
 
 /// Reads a points file.
 ///

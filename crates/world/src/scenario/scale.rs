@@ -77,7 +77,7 @@ pub const MAX_STATIC_SHAPE_COUNT: usize = 10_000;
 /// Most points of a cloud (480 MB of coordinates).
 pub const MAX_CLOUD_POINTS: usize = 20_000_000;
 /// Most bytes of track files read for one scenario, over all its obstacles (a file named by
-/// several obstacles counts for each): four files at [`super::files::MAX_TRACK_BYTES`].
+/// several obstacles counts for each): four files at [`crate::files::MAX_TRACK_BYTES`].
 pub const MAX_TRACK_BYTES_TOTAL: u64 = 64 << 20;
 /// Most samples of all the tracks of one scenario: ten tracks at
 /// [`crate::script::MAX_SAMPLES`] (56 MB of interpolants); without it, 10 000 obstacles naming

@@ -229,7 +229,7 @@ impl Scenario {
                 ok.then(|| points.iter().map(|q| Vec3::from(*q)).collect())
             }
             PointCloudSpec::File { path, .. } => {
-                if let Some(why) = super::files::relative_path_problem(path) {
+                if let Some(why) = crate::files::relative_path_problem(path) {
                     p.push(
                         "static.point_cloud.path",
                         format!("{:?}", path.display().to_string()),
@@ -323,7 +323,7 @@ impl Scenario {
             }
             if let crate::traffic::Motion::Samples(s) = &o.motion {
                 if let Some(file) = &s.file
-                    && let Some(why) = super::files::relative_path_problem(file)
+                    && let Some(why) = crate::files::relative_path_problem(file)
                 {
                     p.push(
                         format!("{field}.motion.file"),

@@ -8,12 +8,12 @@
 //! * **A size cap per kind of file**, enforced while reading (the file is read through a
 //!   limit, so a file that grows while it is read cannot exceed it either):
 //!   [`MAX_SCENARIO_BYTES`] (4 MiB) for a scenario, [`MAX_TRACK_BYTES`] (16 MiB, room for
-//!   [`crate::script::MAX_SAMPLES`] lines of 160 bytes) for a track, [`MAX_POINTS_BYTES`]
+//!   `script::MAX_SAMPLES` lines of 160 bytes) for a track, [`MAX_POINTS_BYTES`]
 //!   (512 MiB, about 20 M lines of `x y z` with six decimals) for a points file. Beyond it,
 //!   [`WorldError::TooLarge`].
 //! * **Incremental**: tracks and points files are read line by line ([`for_each_line`]) and
 //!   parsed as they are read; the parsers stop at their count caps
-//!   ([`crate::script::MAX_SAMPLES`], [`super::scale::MAX_CLOUD_POINTS`]).
+//!   (`script::MAX_SAMPLES`, `scenario::scale::MAX_CLOUD_POINTS`).
 //! * **Relative paths** are resolved against the scenario file's folder and **may not leave
 //!   it**: `data/walker.csv` and `data/../walker.csv` are accepted, `../walker.csv` is not
 //!   ([`relative_path_problem`]; the check is on the path as written, so a symbolic link inside
