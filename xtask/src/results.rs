@@ -13,8 +13,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
-use trust_experiments::study::report::{PaperNumbers, PlannerSummary, StudySummary};
-use trust_experiments::study::stats::Mean;
+use trust_experiments::study::report::{
+    PaperNumbers, PlannerSummary, StudySummary, mean_text as mean, opt,
+};
 use trust_experiments::suite::{ClassSummary, SuiteRow, summarize};
 
 /// Where `cargo xtask ablate` writes its summary.
@@ -296,18 +297,6 @@ fn render(
         let _ = write!(md, "\n{note}\n");
     }
     md
-}
-
-fn mean(m: &Mean, digits: usize) -> String {
-    match (m.mean, m.ci95_half_width) {
-        (Some(x), Some(h)) => format!("{x:.digits$} ± {h:.digits$}"),
-        (Some(x), None) => format!("{x:.digits$}"),
-        _ => "–".to_string(),
-    }
-}
-
-fn opt(x: Option<f64>, digits: usize) -> String {
-    x.map_or("–".to_string(), |v| format!("{v:.digits$}"))
 }
 
 fn paper(p: &PaperNumbers) -> String {

@@ -190,7 +190,8 @@ fn pct(x: f64) -> String {
     format!("{:.0} %", 100.0 * x)
 }
 
-fn mean_text(m: &Mean, decimals: usize) -> String {
+/// A mean with its 95 % half-width (`"3.2 ± 0.4"`), the mean alone, or `–` without samples.
+pub fn mean_text(m: &Mean, decimals: usize) -> String {
     match (m.mean, m.ci95_half_width) {
         (Some(x), Some(h)) => format!("{x:.decimals$} ± {h:.decimals$}"),
         (Some(x), None) => format!("{x:.decimals$}"),
@@ -198,7 +199,8 @@ fn mean_text(m: &Mean, decimals: usize) -> String {
     }
 }
 
-fn opt(x: Option<f64>, decimals: usize) -> String {
+/// A value to `decimals` places, or `–` when there is none.
+pub fn opt(x: Option<f64>, decimals: usize) -> String {
     x.map_or("–".to_string(), |x| format!("{x:.decimals$}"))
 }
 
