@@ -92,7 +92,10 @@ pub fn voxel_index(dims: [usize; 3], x: usize, y: usize, z: usize) -> usize {
 
 /// Checks that `dims` has a positive number of voxels not above [`MAX_VOXELS`] and returns it.
 pub fn checked_voxel_count(dims: [usize; 3]) -> Result<usize, GeometryError> {
-    let count = dims.iter().map(|&d| d as u128).product::<u128>();
+    // Saturating: three `usize::MAX` dimensions overflow even a u128 product.
+    let count = dims
+        .iter()
+        .fold(1u128, |acc, &d| acc.saturating_mul(d as u128));
     if count == 0 || count > MAX_VOXELS as u128 {
         return Err(GeometryError::GridTooLarge {
             nx: dims[0],
@@ -896,5 +899,7 @@ mod tests {
         let mut v = vec![0.0; 3];
         assert!(edt_3d(&mut v, [2, 2, 1]).is_err());
         assert!(checked_voxel_count([usize::MAX, 2, 2]).is_err());
+        // A product beyond u128 (the file fuzzer found it through a world placeholder).
+        assert!(checked_voxel_count([usize::MAX; 3]).is_err());
     }
 }
