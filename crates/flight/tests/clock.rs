@@ -61,9 +61,15 @@ impl FlightObserver for Counts {
         self.cycles += 1;
         self.cycle_times.push(cycle.t);
         self.overrun_ticks += cycle.overrun_ticks;
+        // A plan takes effect when the planner is done (the charged time), never before the
+        // manager's latency; in real time that latency is the budget over `cpu_scale`.
+        let latency = cycle.manager.params().latency();
         assert!(
-            cycle.effective_t >= cycle.t + 0.05 - 1e-9,
-            "a plan before its start"
+            cycle.effective_t >= cycle.t + cycle.charged_s.max(latency) - 1e-9,
+            "a plan before it was done: t {} effective {} charged {} latency {latency}",
+            cycle.t,
+            cycle.effective_t,
+            cycle.charged_s
         );
         Ok(())
     }
