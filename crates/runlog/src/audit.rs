@@ -661,6 +661,15 @@ impl<'a> Auditor<'a> {
                     "a time within the flight".into(),
                 );
             }
+            // The outcome counts the cycles it ran (0: a log from before the field); a
+            // duplicated or dropped cycle line shows here.
+            if o.cycle_count > 0 && o.cycle_count != self.cycle_count {
+                self.flag(
+                    "outcome.cycle_count",
+                    format!("{} in the outcome", o.cycle_count),
+                    format!("{} cycle records in the log", self.cycle_count),
+                );
+            }
             if listed == MAX_LISTED_FINDINGS && self.late_cycle_count > listed {
                 // Some of the uncounted ones may be late too; say so rather than guess.
                 self.flag(

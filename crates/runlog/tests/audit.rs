@@ -170,6 +170,36 @@ fn an_untampered_log_passes_in_memory_and_streamed() {
 }
 
 #[test]
+fn with_cycles_a_dropped_or_duplicated_cycle_line_is_flagged() {
+    let dir = folder("cycle-count");
+    let mut log = consistent_log(header(None), states(500), &dir);
+    log.outcome.cycle_count = log.cycles.len();
+    let path = dir.join("run.jsonl");
+    write(&log, &path);
+    let a = audit_file(&path, AuditOptions { cycles: true }).unwrap();
+    assert!(a.passed(), "{:?}", a.findings);
+    for tamper in [0, 1] {
+        let mut bad = log.clone();
+        if tamper == 0 {
+            bad.cycles.remove(40);
+        } else {
+            let c = bad.cycles[40].clone();
+            bad.cycles.insert(40, c);
+        }
+        write(&bad, &path);
+        let a = audit_file(&path, AuditOptions { cycles: true }).unwrap();
+        assert!(
+            a.findings.iter().any(|f| f.field == "outcome.cycle_count"),
+            "{:?}",
+            a.findings
+        );
+        // Without `--cycles` the cycle records are not judged.
+        let a = audit_file(&path, AuditOptions { cycles: false }).unwrap();
+        assert!(a.passed(), "{:?}", a.findings);
+    }
+}
+
+#[test]
 fn a_velocity_of_1e300_is_flagged() {
     let dir = folder("v1e300");
     let mut log = consistent_log(header(None), states(200), &dir);
