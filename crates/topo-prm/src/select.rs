@@ -11,11 +11,7 @@ pub fn prune_equivalent(
     paths: Vec<Vec<trust_core::Vec3>>,
     mut equivalent: impl FnMut(&[trust_core::Vec3], &[trust_core::Vec3]) -> bool,
 ) -> Vec<Vec<trust_core::Vec3>> {
-    let mut scored: Vec<(f64, Vec<trust_core::Vec3>)> = paths
-        .into_iter()
-        .map(|p| (polyline_length(&p), p))
-        .collect();
-    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let scored = by_length(paths);
     let mut kept: Vec<Vec<trust_core::Vec3>> = Vec::new();
     for (_, p) in scored {
         if !kept.iter().any(|k| equivalent(k, &p)) {
@@ -32,11 +28,7 @@ pub fn select_short_paths(
     length_ratio: f64,
     max_paths: usize,
 ) -> Vec<Vec<trust_core::Vec3>> {
-    let mut scored: Vec<(f64, Vec<trust_core::Vec3>)> = paths
-        .into_iter()
-        .map(|p| (polyline_length(&p), p))
-        .collect();
-    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let scored = by_length(paths);
     let Some(shortest) = scored.first().map(|s| s.0) else {
         return Vec::new();
     };
@@ -59,11 +51,7 @@ pub fn select_distinct_short_paths(
     max_paths: usize,
     mut equivalent: impl FnMut(&[trust_core::Vec3], &[trust_core::Vec3]) -> bool,
 ) -> Vec<Vec<trust_core::Vec3>> {
-    let mut scored: Vec<(f64, Vec<trust_core::Vec3>)> = paths
-        .into_iter()
-        .map(|p| (polyline_length(&p), p))
-        .collect();
-    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let scored = by_length(paths);
     let Some(shortest) = scored.first().map(|s| s.0) else {
         return Vec::new();
     };
@@ -78,6 +66,16 @@ pub fn select_distinct_short_paths(
         }
     }
     kept
+}
+
+/// The paths with their lengths, shortest first (a stable sort: ties keep their order).
+fn by_length(paths: Vec<Vec<trust_core::Vec3>>) -> Vec<(f64, Vec<trust_core::Vec3>)> {
+    let mut scored: Vec<(f64, Vec<trust_core::Vec3>)> = paths
+        .into_iter()
+        .map(|p| (polyline_length(&p), p))
+        .collect();
+    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    scored
 }
 
 #[cfg(test)]
