@@ -313,6 +313,8 @@ fn without_branches_there_is_no_branch_channel_and_a_log_file_exports() {
                 forecasts: None,
                 charged_ms: None,
                 overrun_ticks: None,
+                worker_ms: None,
+                waited_ms: None,
             }
         })
         .collect();

@@ -14,7 +14,7 @@
 //!   after that, and the ticks in between are skipped: the cycle's `overrun_ticks`.
 
 use trust_core::{PolyTraj, Scene, Vec3};
-use trust_manager::StepReport;
+use trust_manager::{CycleTiming, StepReport};
 use trust_predict::Forecast;
 use trust_vehicle::{Reference, Vehicle, VehicleState};
 use trust_world::World;
@@ -59,6 +59,26 @@ impl Clock {
         match *self {
             Clock::Fixed { latency_s } => latency_s,
             Clock::RealTime { cpu_scale } => wall_ms.max(0.0) * 1e-3 * cpu_scale,
+        }
+    }
+}
+
+/// The time (s) the planner is charged for a cycle at `t` with `timing`
+/// ([`Clock::charged_s`]). In real time, the time the cycle waited for the manager's worker is
+/// not charged (a flight in real time would not have waited for a job done by then) but the
+/// worker's lateness is: the job started at `worker_since` and ran `worker_ms` (scaled by
+/// `cpu_scale`, on a core of its own), so its results were ready no earlier than that.
+pub fn charged_for(clock: Clock, timing: &CycleTiming, worker_since: Option<f64>, t: f64) -> f64 {
+    match clock {
+        Clock::Fixed { .. } => clock.charged_s(timing.wall_ms),
+        Clock::RealTime { cpu_scale } => {
+            let own = clock.charged_s(timing.wall_ms - timing.waited_ms);
+            let late = worker_since
+                .filter(|_| timing.worker_ms > 0.0)
+                .map_or(0.0, |since| {
+                    (since + timing.worker_ms * 1e-3 * cpu_scale - t).max(0.0)
+                });
+            own + late
         }
     }
 }
@@ -147,6 +167,9 @@ pub struct FlightState {
     pub t: f64,
     /// The planner is busy until this time (s) ([`Clock::RealTime`]).
     pub busy_until: f64,
+    /// When the planner's worker started its job, if the last cycle started one (s; the job's
+    /// lateness is charged to the cycle that merges it, [`Clock::RealTime`]).
+    pub worker_since: Option<f64>,
     /// Since when the manager has held that the goal cannot be reached (s), and why.
     pub unreachable_since: Option<(f64, String)>,
 }
@@ -398,7 +421,8 @@ fn plan(
             }));
         }
     };
-    let charged_s = params.clock.charged_s(report.timing.wall_ms);
+    let charged_s = charged_for(params.clock, &report.timing, state.worker_since.take(), t);
+    state.worker_since = report.worker_started.then_some(t + charged_s);
     // A plan starts `manager_latency_s` after its cycle (where it leaves the committed plan):
     // it takes effect then, or when the planner is done with it if that is later.
     let delay = charged_s.max(params.manager_latency_s);

@@ -302,7 +302,9 @@ pub struct Setup {
 pub fn set_up(world: &World, planner: &ResolvedPlanner) -> Result<Setup, FlightError> {
     let traffic = world.traffic()?;
     let mut sensing = world.sensing()?;
-    let manager = planner::build(planner, &world.planner_context())?;
+    let mut manager = planner::build(planner, &world.planner_context())?;
+    // The scenes are built on this map: the manager's worker may read it between cycles.
+    manager.share_map(world.planner_map_shared());
     sensing.update(0.0, traffic.positions())?;
     Ok(Setup {
         traffic,
@@ -365,6 +367,7 @@ pub fn fly(
         step: 0,
         t: 0.0,
         busy_until: 0.0,
+        worker_since: None,
         unreachable_since: None,
     };
 
@@ -715,6 +718,8 @@ fn cycle_record(
         })
         // A slice of a search still under way.
         || report.timing.route_ms > 0.0;
+    // A worker job was merged: its wall time is positive (a job always takes some).
+    let merged = report.timing.worker_ms > 0.0;
     CycleRecord {
         t: report.t,
         wall_ms: time(report.timing.wall_ms),
@@ -743,6 +748,8 @@ fn cycle_record(
         forecasts: None,
         charged_ms: None,
         overrun_ticks: None,
+        worker_ms: merged.then(|| time(report.timing.worker_ms)),
+        waited_ms: merged.then(|| time(report.timing.waited_ms)),
     }
 }
 

@@ -98,6 +98,7 @@ fn step_for(s: &Scenario, seconds: f64) -> (Counts, Option<Ending>) {
         step: 0,
         t: 0.0,
         busy_until: 0.0,
+        worker_since: None,
         unreachable_since: None,
     };
     let walls = trust_flight::obstacle_walls(&world);

@@ -1,5 +1,6 @@
 //! [`Manager`]: Algorithm 1 of the paper, one cycle per [`Manager::step`].
 
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use rand::SeedableRng;
@@ -24,6 +25,9 @@ use crate::safety::{
 use trust_route::{GlobalRoute, RoutePoint, RouteProgress, RouteSearch, UnreachableCause};
 
 use crate::routing::{RouteReason, Router, rerouted, route_failed};
+
+mod worker;
+use worker::{Job, JobInput, JobOutput};
 
 /// One kept trajectory branch.
 #[derive(Debug, Clone, PartialEq)]
@@ -203,8 +207,8 @@ fn narrowly_unsafe(v: &SafetyVerdict, margin: f64) -> bool {
 /// [`ManagerParams::enforce_budget`] to `false` and give the frontend count-based budgets for
 /// bit-reproducible runs).
 pub struct Manager<F, B, H> {
-    frontend: F,
-    backend: B,
+    frontend: Arc<F>,
+    backend: Arc<B>,
     checker: H,
     limits: Limits,
     params: ManagerParams,
@@ -229,6 +233,13 @@ pub struct Manager<F, B, H> {
     deferred_guides: Vec<GuidePath>,
     /// The route search under way, and why it started.
     route_search: Option<(RouteReason, RouteSearch)>,
+    /// The static map the scenes are built on, shared with the worker
+    /// ([`Manager::share_map`]).
+    shared_map: Option<Arc<StaticMap>>,
+    /// The worker's job under way ([`ManagerParams::background`]).
+    job: Option<Job>,
+    /// The time of the last cycle (s): the next cycle is predicted one period later.
+    last_now: Option<f64>,
 }
 
 impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
@@ -242,7 +253,9 @@ impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
     }
 }
 
-impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H> {
+impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyChecker>
+    Manager<F, B, H>
+{
     /// A manager with no branches and no plan yet.
     ///
     /// # Errors
@@ -257,8 +270,8 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         limits.validate()?;
         params.validate()?;
         Ok(Manager {
-            frontend,
-            backend,
+            frontend: Arc::new(frontend),
+            backend: Arc::new(backend),
             checker,
             limits,
             rng: Rng::seed_from_u64(params.seed),
@@ -276,7 +289,17 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             deferred_guides: Vec::new(),
             route_search: None,
             cycle_count: 0,
+            shared_map: None,
+            job: None,
+            last_now: None,
         })
+    }
+
+    /// Shares the static map every scene of this flight is built on, so that the worker of
+    /// [`ManagerParams::background`] can read it after the cycle that started it has returned.
+    /// A cycle whose scene is built on another map solves everything itself.
+    pub fn share_map(&mut self, map: Arc<StaticMap>) {
+        self.shared_map = Some(map);
     }
 
     /// The parameters.
@@ -421,6 +444,9 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
 
     /// Forgets every branch and the plan (a new flight); the random stream continues.
     pub fn reset(&mut self) {
+        // A job under way is left to finish on its own; its results are not merged.
+        self.job = None;
+        self.last_now = None;
         self.cycle_count = 0;
         self.progress.reset();
         self.routed_goal = None;
@@ -517,9 +543,13 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         // Algorithm 1, lines 5–8: FwdMarch of the main branch and BwdReplan of the sub-branches,
         // in parallel with FwdExplore.
         let warm = self.warm_branches();
-        let aim = self.aim(&cycle.start.p, goal, cycle.stalled, scene.map);
-        let (mut explored, resolved) =
-            self.solve_in_parallel(&cycle, &aim, scene, &warm, &mut spans);
+        let mut aim = self.aim(&cycle.start.p, goal, cycle.stalled, scene.map);
+        let merged = self.merge_job(&mut cycle, &mut aim, &mut spans);
+        let from_worker = merged.is_some();
+        let (mut explored, resolved) = match merged {
+            Some(out) => self.solve_main_with(out, &cycle, &aim, scene, &warm, &mut spans),
+            None => self.solve_in_parallel(&cycle, &aim, scene, &warm, &mut spans),
+        };
         self.deferred_guides = std::mem::take(&mut explored.deferred);
         if let Some(error) = explored.frontend_error {
             cycle.events.push(Event::FrontendFailed { error });
@@ -536,10 +566,11 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         }
 
         // The main branch (hysteresis), PopBack protecting it, and the fallback without one.
-        let main = self.select_main(&kept, &cycle.start, goal, cycle.stalled, &mut cycle.events);
+        let main = self.select_checked_main(&mut kept, &mut cycle, scene, from_worker, &mut spans);
         pop_back(&mut kept, self.params.max_branches, main, &mut cycle.events);
         let fallback = self.commit(main, &kept, &mut cycle, scene, &mut spans);
         self.branches = kept;
+        let worker_started = self.start_job(now, &cycle, scene);
         Ok(StepReport {
             t: now,
             replan_start: cycle.start,
@@ -555,6 +586,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             timing: spans.finish(),
             fallback,
             goal_unreachable: self.unreachable.clone(),
+            worker_started,
         })
     }
 
@@ -724,13 +756,7 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
         let newly_stalled = matches!(stall_event, Some(Event::Stalled { .. }));
         events.extend(stall_event);
         let stalled = self.progress.stalled();
-        let explore = stalled
-            || !self.params.history
-            || self
-                .cycle_count
-                .is_multiple_of(self.params.explore_period_cycles as u64)
-            || self.branches.len() < 2
-            || self.main.is_none();
+        let explore = self.explores(stalled);
         self.cycle_count += 1;
         Cycle {
             start,
@@ -739,15 +765,214 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             newly_stalled,
             reanchored,
             weights: self.params.ranking_weights(&self.limits),
-            deadline: self.params.enforce_budget.then(|| {
-                started
-                    + Duration::from_secs_f64(
-                        SOLVE_DEADLINE_FRACTION * self.params.cycle_budget_ms * 1e-3,
-                    )
-            }),
+            deadline: deadline_from(started, &self.params),
             explore,
             events,
             rejected: Vec::new(),
+        }
+    }
+
+    /// Whether the next cycle runs FwdExplore ([`ManagerParams::explore_period_cycles`]): every
+    /// period, while stalled, without history, and with fewer than two branches or no main one.
+    fn explores(&self, stalled: bool) -> bool {
+        stalled
+            || !self.params.history
+            || self
+                .cycle_count
+                .is_multiple_of(self.params.explore_period_cycles as u64)
+            || self.branches.len() < 2
+            || self.main.is_none()
+    }
+
+    /// The solver of this cycle's trajectories: from its replan start toward `aim`.
+    fn solver<'s, 'a>(
+        &'s self,
+        cycle: &Cycle,
+        aim: &Vec3,
+        scene: &'s Scene<'a>,
+    ) -> Solver<'s, 'a, B> {
+        Solver::new(
+            &*self.backend,
+            scene,
+            (cycle.start, *aim, self.limits),
+            &self.params,
+            cycle.deadline,
+            cycle.stalled,
+            self.route_guide(&cycle.start.p, aim),
+        )
+    }
+
+    /// The worker's job, if one is under way, waited for; its results if they apply to this
+    /// cycle — solved from this cycle's replan start toward its aim, with the same stall state
+    /// (the start and the aim are then taken from the job: equal to within rounding) — else
+    /// `None`, and the cycle solves everything itself as if there had been no job.
+    fn merge_job(
+        &mut self,
+        cycle: &mut Cycle,
+        aim: &mut Vec3,
+        spans: &mut Spans,
+    ) -> Option<JobOutput> {
+        /// Rounding of the predicted start time (s) and of positions (m).
+        const SAME_S: f64 = 1e-6;
+        const SAME_M: f64 = 1e-9;
+        let job = self.job.take()?;
+        let waiting = Instant::now();
+        // A job that panicked is dropped like a stale one (the cycle solves it all itself).
+        let out = job.handle.join().ok();
+        spans.timing.waited_ms += ms(waiting.elapsed());
+        let applies = !cycle.reanchored
+            && job.stalled == cycle.stalled
+            && (job.start.t - cycle.start.t).abs() <= SAME_S
+            && (job.start.p - cycle.start.p).norm() <= SAME_M
+            && (job.aim - *aim).norm() <= SAME_M;
+        let out = out.filter(|_| applies)?;
+        cycle.start = job.start;
+        *aim = job.aim;
+        self.rng = out.rng.clone();
+        Some(out)
+    }
+
+    /// The cycle's solves with the worker's results: the main branch marches here (FwdMarch),
+    /// the sub-branches come re-solved by the worker (re-solved here if one is missing), and
+    /// the explored candidates are the worker's; in `warm`'s order as
+    /// [`Manager::solve_in_parallel`].
+    fn solve_main_with(
+        &self,
+        out: JobOutput,
+        cycle: &Cycle,
+        aim: &Vec3,
+        scene: &Scene<'_>,
+        warm: &[(BranchId, Origin, PolyTraj)],
+        spans: &mut Spans,
+    ) -> (Explored, Vec<Candidate>) {
+        let solver = self.solver(cycle, aim, scene);
+        let mut subs = out.subs;
+        let resolved = warm
+            .iter()
+            .map(|(id, origin, traj)| {
+                if *origin == Origin::Marched {
+                    return solver.fwd_march(traj);
+                }
+                match subs.iter().position(|(s, _)| s == id) {
+                    Some(i) => subs.swap_remove(i).1,
+                    None => solver.bwd_replan(traj),
+                }
+            })
+            .collect();
+        spans.timing.frontend_ms += out.frontend_ms;
+        spans.timing.worker_ms += ms(out.elapsed);
+        (out.explored, resolved)
+    }
+
+    /// Starts the worker on the next cycle's sub-branch re-solves and exploration
+    /// ([`ManagerParams::background`]), from the next cycle's replan start as the committed plan
+    /// predicts it one period (the last cycle interval) ahead; whether it started one.
+    fn start_job(&mut self, now: f64, cycle: &Cycle, scene: &Scene<'_>) -> bool {
+        let period = self.last_now.replace(now).map(|last| now - last);
+        if !self.params.background || !self.params.history {
+            return false;
+        }
+        let shared = self
+            .shared_map
+            .clone()
+            .filter(|m| std::ptr::eq(Arc::as_ptr(m), scene.map));
+        let period = period.filter(|p| p.is_finite() && *p > 0.0);
+        let (Some(map), Some(period), Some(plan)) = (shared, period, self.committed.as_ref())
+        else {
+            return false;
+        };
+        let t_eff = now + period + self.params.latency();
+        let mut start = plan.state(t_eff);
+        start.t = t_eff;
+        let stalled = self.progress.stalled();
+        let aim = self.aim(&start.p, &cycle.goal, stalled, scene.map);
+        let input = JobInput {
+            frontend: Arc::clone(&self.frontend),
+            backend: Arc::clone(&self.backend),
+            map,
+            forecasts: scene.forecasts.to_vec(),
+            t0: scene.t0,
+            start,
+            aim,
+            limits: self.limits,
+            params: self.params.clone(),
+            explore: self.explores(stalled),
+            stalled,
+            subs: self
+                .branches
+                .iter()
+                .filter(|b| Some(b.id) != self.main)
+                .map(|b| (b.id, b.solution.traj.clone()))
+                .collect(),
+            deferred: self.deferred_guides.clone(),
+            route_guide: self.route_guide(&start.p, &aim),
+            rng: self.rng.clone(),
+        };
+        let spawned = std::thread::Builder::new()
+            .name("trust-manager-worker".into())
+            .spawn(move || worker::run(input));
+        match spawned {
+            Ok(handle) => {
+                self.job = Some(Job {
+                    start,
+                    aim,
+                    stalled,
+                    handle,
+                });
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// The main branch ([`Manager::select_main`]). With the worker's results merged, a leading
+    /// branch other than the marched main one was checked against the previous cycle's
+    /// forecasts: it is checked again against this cycle's first, and dropped if it fails.
+    fn select_checked_main(
+        &self,
+        kept: &mut Vec<Branch>,
+        cycle: &mut Cycle,
+        scene: &Scene<'_>,
+        from_worker: bool,
+        spans: &mut Spans,
+    ) -> Option<BranchId> {
+        let mut confirmed: Vec<BranchId> = Vec::new();
+        loop {
+            let mut events = Vec::new();
+            let (start, goal) = (cycle.start, cycle.goal);
+            let main = self.select_main(kept, &start, &goal, cycle.stalled, &mut events);
+            let unconfirmed = main.filter(|_| from_worker).and_then(|id| {
+                kept.iter()
+                    .position(|b| b.id == id && b.origin != Origin::Marched)
+                    .filter(|_| !confirmed.contains(&id))
+            });
+            let Some(i) = unconfirmed else {
+                cycle.events.extend(events);
+                return main;
+            };
+            let traj = kept[i].traj();
+            let verdict = spans.time(Span::Checks, || {
+                check_trajectory(
+                    traj,
+                    scene,
+                    start.t,
+                    traj.t_end(),
+                    &self.limits,
+                    &self.params.safety,
+                )
+            });
+            if verdict.safe {
+                confirmed.push(kept[i].id);
+                kept[i].verdict = verdict;
+            } else {
+                let dropped = kept.remove(i);
+                cycle
+                    .events
+                    .push(dropped_collision(Some(dropped.id), &verdict, &self.limits));
+                cycle
+                    .rejected
+                    .push((FallbackKind::Branch, dropped.solution.traj));
+            }
         }
     }
 
@@ -788,19 +1013,16 @@ impl<F: PathFrontend, B: TrajectoryBackend, H: HomotopyChecker> Manager<F, B, H>
             horizon_s: self.params.horizon_s,
             exploration: if cycle.stalled { 2.0 } else { 1.0 },
         };
-        let solver = Solver {
-            backend: &self.backend,
+        let solver = Solver::new(
+            &*self.backend,
             scene,
-            start: cycle.start,
-            goal: *goal,
-            limits: self.limits,
-            horizon_s: self.params.horizon_s,
-            deadline: cycle.deadline,
-            params: &self.params,
-            explored_paths: self.params.max_explored_paths * if cycle.stalled { 2 } else { 1 },
-            route_guide: self.route_guide(&cycle.start.p, goal),
-        };
-        let (frontend, rng) = (&self.frontend, &mut self.rng);
+            (cycle.start, *goal, self.limits),
+            &self.params,
+            cycle.deadline,
+            cycle.stalled,
+            self.route_guide(&cycle.start.p, goal),
+        );
+        let (frontend, rng) = (&*self.frontend, &mut self.rng);
         let pending = std::mem::take(&mut self.deferred_guides);
         rayon::join(
             || match cycle.explore {
@@ -1706,6 +1928,13 @@ fn dropped_collision(id: Option<BranchId>, verdict: &SafetyVerdict, limits: &Lim
     }
 }
 
+/// The solves' deadline of work started at `started` ([`ManagerParams::enforce_budget`]).
+fn deadline_from(started: Instant, params: &ManagerParams) -> Option<Instant> {
+    params.enforce_budget.then(|| {
+        started + Duration::from_secs_f64(SOLVE_DEADLINE_FRACTION * params.cycle_budget_ms * 1e-3)
+    })
+}
+
 /// Everything a parallel solve needs, shared read-only.
 struct Solver<'s, 'a, B> {
     backend: &'s B,
@@ -1724,7 +1953,31 @@ struct Solver<'s, 'a, B> {
     route_guide: Option<GuidePath>,
 }
 
-impl<B: TrajectoryBackend> Solver<'_, '_, B> {
+impl<'s, 'a, B: TrajectoryBackend> Solver<'s, 'a, B> {
+    /// The solver from `start` toward `goal`; `stalled` doubles the explored paths.
+    fn new(
+        backend: &'s B,
+        scene: &'s Scene<'a>,
+        (start, goal, limits): (State, Vec3, Limits),
+        params: &'s ManagerParams,
+        deadline: Option<Instant>,
+        stalled: bool,
+        route_guide: Option<GuidePath>,
+    ) -> Self {
+        Solver {
+            backend,
+            scene,
+            start,
+            goal,
+            limits,
+            horizon_s: params.horizon_s,
+            deadline,
+            params,
+            explored_paths: params.max_explored_paths * if stalled { 2 } else { 1 },
+            route_guide,
+        }
+    }
+
     /// FwdMarch (Algorithm 1, line 6): the main branch re-solved from the replan start,
     /// warm-started from its trajectory (its free terminal moves on toward the goal as the goal
     /// guidance surface shrinks), with [`ManagerParams::warm_max_evaluations`].

@@ -79,6 +79,17 @@ pub struct ManagerParams {
     /// Default 2 (beyond the paper): an exploring cycle no longer pays for all its cold solves
     /// at once, which made it the worst cycle (E4: 10–16 solves, 2–3× the 50 ms budget).
     pub cold_solves_per_cycle: Option<usize>,
+    /// Take the sub-branches' re-solves (BwdReplan) and FwdExplore (the frontend and its cold
+    /// solves) off the cycle's critical path (beyond the paper): as a cycle ends they start on a
+    /// worker thread from the next cycle's replan start as predicted by the committed plan, and
+    /// the next cycle merges them (waiting for them if need be, so a seed still gives one
+    /// flight) while it re-solves only the main branch itself. A merged branch that would become
+    /// the main branch is checked again against the newer forecasts first. The next cycle solves
+    /// everything itself when its start is not the predicted one (re-anchored, another period),
+    /// when its aim moved, and always without history or without a shared map
+    /// ([`crate::Manager::share_map`]). Default `true`: the paper's exploring cycle (frontend and
+    /// cold solves, 20–40 ms on E4's point-cloud ESDF) was the cycle's tail.
+    pub background: bool,
     /// Run FwdExplore (the frontend and the cold solves) every this many cycles, and in every cycle
     /// that starts with fewer than two kept branches or without a main branch. 1: every cycle (the
     /// paper's Algorithm 1). At least 1. Default 3 (beyond the paper): the kept branches carry
@@ -166,6 +177,7 @@ impl ManagerParams {
             sub_branch_max_evaluations: Some(50),
             cold_max_evaluations: None,
             cold_solves_per_cycle: Some(2),
+            background: true,
             explore_period_cycles: 3,
             repair_margin_m: 0.05,
             ranking: None,

@@ -386,6 +386,17 @@ pub struct CycleTiming {
     /// not, is in `solve_count` and the times.
     #[serde(default)]
     pub repair_count: usize,
+    /// Time the cycle waited for the worker's results ([`crate::ManagerParams::background`]);
+    /// part of `wall_ms`. A flight in real time would not have waited if the worker had
+    /// finished by the cycle's start: the simulator charges `wall_ms − waited_ms` plus any
+    /// lateness of the worker (`worker_ms` after it started) instead.
+    #[serde(default)]
+    pub waited_ms: f64,
+    /// Wall time of the worker's job merged this cycle (started at the end of the previous
+    /// cycle, off the cycle's critical path); 0 when none was merged. Its frontend and solve
+    /// times are in `frontend_ms`, `backend_ms` and `checker_ms`.
+    #[serde(default)]
+    pub worker_ms: f64,
 }
 
 impl CycleTiming {
@@ -448,6 +459,11 @@ pub struct StepReport {
     /// The manager's standing verdict that the goal cannot be reached, while it holds.
     #[serde(default)]
     pub goal_unreachable: Option<GoalUnreachable>,
+    /// Whether the cycle handed the next cycle's sub-branch re-solves and exploration to the
+    /// worker thread as it ended ([`crate::ManagerParams::background`]); the next cycle merges
+    /// them.
+    #[serde(default)]
+    pub worker_started: bool,
 }
 
 /// The manager's verdict that the goal cannot be reached (beyond the paper): the route planner

@@ -75,8 +75,8 @@ fn fly<F, B, H>(
     forecasts_at: impl Fn(f64) -> Vec<Forecast>,
 ) -> Vec<StepReport>
 where
-    F: PathFrontend,
-    B: TrajectoryBackend,
+    F: PathFrontend + 'static,
+    B: TrajectoryBackend + 'static,
     H: trust_core::HomotopyChecker,
 {
     let mut state = start;
@@ -1481,4 +1481,97 @@ fn a_stub_far_from_the_goal_is_dropped_and_the_fallback_flies() {
         "{:?}",
         r.events
     );
+}
+
+/// A manager flying `sc` with its worker on (the map shared), `cycles` cycles of 0.1 s.
+fn fly_with_worker(seed: u64, cycles: usize) -> (Vec<StepReport>, PolyTraj) {
+    let params = SceneParams {
+        size: Vec3::new(40.0, 20.0, 10.0),
+        r_safe: 0.3,
+        ..SceneParams::default()
+    };
+    let sc = random_dynamic_scene(8, &params, &mut Rng::seed_from_u64(seed)).unwrap();
+    let map = std::sync::Arc::new(sc.map);
+    let mut m = planner(ManagerParams {
+        seed,
+        ..ManagerParams::trust()
+    });
+    m.share_map(std::sync::Arc::clone(&map));
+    let reports = fly(&mut m, &map, sc.query.goal, sc.query.start, cycles, |_| {
+        sc.forecasts.clone()
+    });
+    (reports, m.plan().unwrap().clone())
+}
+
+#[test]
+fn the_worker_takes_the_sub_branches_and_exploration_off_the_cycle_and_keeps_a_seed_one_flight() {
+    for seed in [3u64, 11] {
+        let (reports, plan) = fly_with_worker(seed, 12);
+        // From the second cycle on (the first knows no period yet) every cycle starts a job,
+        // and from the third on each merges one (the period is regular and the plan tracked
+        // perfectly, so every job applies).
+        assert!(!reports[0].worker_started);
+        assert!(reports[1..].iter().all(|r| r.worker_started), "seed {seed}");
+        assert_eq!(reports[1].timing.worker_ms, 0.0);
+        for r in &reports[2..] {
+            assert!(r.timing.worker_ms > 0.0, "seed {seed}, t {}", r.t);
+        }
+        // The same seed gives the same flight, whatever the worker's timing.
+        let (again, plan_again) = fly_with_worker(seed, 12);
+        assert_eq!(summary(&reports), summary(&again), "seed {seed}");
+        assert_eq!(plan, plan_again, "seed {seed}");
+    }
+}
+
+#[test]
+fn a_cycle_off_the_predicted_period_solves_everything_itself() {
+    let map = std::sync::Arc::new(two_gap_corridor());
+    let mut m = planner(ManagerParams::trust());
+    m.share_map(std::sync::Arc::clone(&map));
+    let mut state = State::at_rest(0.0, START);
+    let mut merged = Vec::new();
+    // Cycles at 0, 0.1, 0.2, then 0.35 (a late tick: the job predicted 0.3), then 0.45.
+    for t in [0.0, 0.1, 0.2, 0.35, 0.45] {
+        let scene = Scene::new(&map, &[], t).unwrap();
+        let r = m.step(t, &state, &GOAL, &scene).expect("valid input");
+        assert!(r.main.is_some(), "t {t}: a plan");
+        merged.push(r.timing.worker_ms > 0.0);
+        state = m.plan().unwrap().state(t + 0.1);
+    }
+    // The late cycle dropped the job (its start was not the predicted one); the job that cycle
+    // started for 0.5 s does not apply at 0.45 s either.
+    assert_eq!(merged, vec![false, false, true, false, false]);
+}
+
+#[test]
+fn without_a_shared_map_or_history_there_is_no_worker() {
+    let map = two_gap_corridor();
+    for params in [
+        ManagerParams::trust(),
+        ManagerParams::multi_branch_without_history(),
+    ] {
+        let mut m = planner(params);
+        let reports = fly(
+            &mut m,
+            &map,
+            GOAL,
+            State::at_rest(0.0, START),
+            4,
+            |_| vec![],
+        );
+        assert!(reports.iter().all(|r| !r.worker_started));
+        assert!(reports.iter().all(|r| r.timing.worker_ms == 0.0));
+    }
+    // With history and the map shared, but the scenes built on another copy of the map.
+    let mut m = planner(ManagerParams::trust());
+    m.share_map(std::sync::Arc::new(two_gap_corridor()));
+    let reports = fly(
+        &mut m,
+        &map,
+        GOAL,
+        State::at_rest(0.0, START),
+        4,
+        |_| vec![],
+    );
+    assert!(reports.iter().all(|r| !r.worker_started));
 }

@@ -167,6 +167,8 @@ fn write_log(path: &Path, t_end: f64, with_branches: bool) {
                 }),
                 charged_ms: None,
                 overrun_ticks: None,
+                worker_ms: None,
+                waited_ms: None,
             }))
             .unwrap();
         }

@@ -144,6 +144,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ),
                 charged_ms: None,
                 overrun_ticks: None,
+                worker_ms: None,
+                waited_ms: None,
             }))?;
         }
     }

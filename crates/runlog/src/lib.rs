@@ -267,6 +267,15 @@ pub struct CycleRecord {
     /// still busy with this cycle (real-time latency mode).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub overrun_ticks: Option<u64>,
+    /// Added (issue 31), only in cycles that merged the manager's worker job (sub-branch
+    /// re-solves and exploration started at the end of the previous cycle, off the critical
+    /// path): the job's wall time (ms).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub worker_ms: Option<f64>,
+    /// Added (issue 31), with `worker_ms`: the part of `wall_ms` the cycle waited for the job
+    /// (ms). The real-time clock charges `wall_ms − waited_ms` plus the job's lateness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub waited_ms: Option<f64>,
 }
 
 /// One kept branch's trajectory, sampled (added, issue 20).
@@ -814,6 +823,8 @@ mod tests {
             forecasts: None,
             charged_ms: None,
             overrun_ticks: None,
+            worker_ms: None,
+            waited_ms: None,
         }
     }
 

@@ -69,6 +69,8 @@ fn parse_record(line: &str, light_cycles: bool) -> Result<Record, serde_json::Er
                 forecasts: None,
                 charged_ms: None,
                 overrun_ticks: None,
+                worker_ms: None,
+                waited_ms: None,
             }));
         }
         return serde_json::from_str(line).map(Record::Cycle);

@@ -93,6 +93,8 @@ fn cycle(t: f64) -> CycleRecord {
         forecasts: None,
         charged_ms: None,
         overrun_ticks: None,
+        worker_ms: None,
+        waited_ms: None,
     }
 }
 

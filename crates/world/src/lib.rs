@@ -327,6 +327,12 @@ impl World {
         &self.planner_map
     }
 
+    /// The planner's static map, shared (the manager's `share_map` takes it: its worker reads
+    /// the map between cycles).
+    pub fn planner_map_shared(&self) -> Arc<StaticMap> {
+        Arc::clone(&self.planner_map)
+    }
+
     /// How much the planner's map may overestimate the distance to a true static obstacle (m):
     /// 0 for analytic shapes; for an ESDF, [`esdf_error_bound`] (0.35 m at 0.2 m voxels).
     pub fn static_map_error_m(&self) -> f64 {

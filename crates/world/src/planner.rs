@@ -484,6 +484,9 @@ pub struct ManagerOverrides {
     /// Replaces `ManagerParams::cold_solves_per_cycle`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cold_solves_per_cycle: Option<usize>,
+    /// Replaces `ManagerParams::background`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub background: Option<bool>,
     /// Replaces `ManagerParams::explore_period_cycles`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub explore_period_cycles: Option<usize>,
@@ -562,6 +565,9 @@ impl ManagerOverrides {
         }
         if let Some(v) = self.cold_solves_per_cycle {
             p.cold_solves_per_cycle = Some(v);
+        }
+        if let Some(v) = self.background {
+            p.background = v;
         }
         if let Some(v) = self.explore_period_cycles {
             p.explore_period_cycles = v;
