@@ -112,7 +112,12 @@ impl Poly4d {
                 "a finite duration > 0 (s)",
             ));
         }
-        for (axis, c) in [("x", &self.x), ("y", &self.y), ("z", &self.z), ("yaw", &self.yaw)] {
+        for (axis, c) in [
+            ("x", &self.x),
+            ("y", &self.y),
+            ("z", &self.z),
+            ("yaw", &self.yaw),
+        ] {
             if let Some(k) = c.iter().position(|v| !v.is_finite()) {
                 return Err(FlightStackError::invalid(
                     format!("{field}.{axis}[{k}]"),
@@ -185,7 +190,10 @@ impl CrazyflieParams {
 /// uncontrolled yaw); [`FlightStackError::TooManyPieces`] above `params.max_pieces` (fly a shorter
 /// horizon, or upload the rest as a second trajectory when the first is done);
 /// [`FlightStackError::NotRepresentable`] naming `pieces[i].x[k]` etc. for a value beyond `f32`.
-pub fn to_poly4d(traj: &PolyTraj, params: &CrazyflieParams) -> Result<Vec<Poly4d>, FlightStackError> {
+pub fn to_poly4d(
+    traj: &PolyTraj,
+    params: &CrazyflieParams,
+) -> Result<Vec<Poly4d>, FlightStackError> {
     params.validate()?;
     if traj.piece_count() > params.max_pieces {
         return Err(FlightStackError::TooManyPieces {
@@ -388,7 +396,11 @@ pub fn upload_trajectory_request(
     max_pieces: usize,
 ) -> Result<UploadTrajectoryRequest, FlightStackError> {
     if pieces.is_empty() {
-        return Err(FlightStackError::invalid("pieces", "[]", "at least one piece"));
+        return Err(FlightStackError::invalid(
+            "pieces",
+            "[]",
+            "at least one piece",
+        ));
     }
     let end = piece_offset as usize + pieces.len();
     if end > max_pieces {
@@ -493,7 +505,11 @@ mod tests {
         // atan2(−0.1, 1) ≈ −0.0997 rad, which from π is nearer counter-clockwise (+3.04 rad, to
         // 2π − 0.0997) than clockwise (−3.24 rad).
         let mut pieces = Vec::new();
-        for v in [Vec3::new(-1.0, 0.0, 0.0), Vec3::zeros(), Vec3::new(1.0, -0.1, 0.0)] {
+        for v in [
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::zeros(),
+            Vec3::new(1.0, -0.1, 0.0),
+        ] {
             let mut c: Piece = [Vec3::zeros(); 6];
             c[1] = v;
             pieces.push(c);
@@ -509,7 +525,12 @@ mod tests {
         let p = to_poly4d(&tr, &params).unwrap();
         let ends: Vec<(f64, f64)> = p
             .iter()
-            .map(|q| (q.evaluate(0.0).yaw_rad, q.evaluate(f64::from(q.duration)).yaw_rad))
+            .map(|q| {
+                (
+                    q.evaluate(0.0).yaw_rad,
+                    q.evaluate(f64::from(q.duration)).yaw_rad,
+                )
+            })
             .collect();
         // Continuous across pieces.
         for w in ends.windows(2) {
@@ -527,7 +548,14 @@ mod tests {
         let tr = line(Vec3::new(0.1, 0.0, 0.0), &[0.5; 32]);
         let e = to_poly4d(&tr, &CrazyflieParams::default()).unwrap_err();
         assert!(
-            matches!(e, FlightStackError::TooManyPieces { count: 32, max: 31, .. }),
+            matches!(
+                e,
+                FlightStackError::TooManyPieces {
+                    count: 32,
+                    max: 31,
+                    ..
+                }
+            ),
             "{e}"
         );
         let more = CrazyflieParams {
@@ -540,7 +568,12 @@ mod tests {
                 max_pieces,
                 ..CrazyflieParams::default()
             };
-            assert!(to_poly4d(&tr, &bad).unwrap_err().to_string().contains("max_pieces"));
+            assert!(
+                to_poly4d(&tr, &bad)
+                    .unwrap_err()
+                    .to_string()
+                    .contains("max_pieces")
+            );
         }
         let uncontrolled = CrazyflieParams {
             yaw: YawPolicy::Uncontrolled,
@@ -571,7 +604,12 @@ mod tests {
         assert!(e.to_string().contains("pieces[1].z[3]"), "{e}");
         bad = p[0];
         bad.duration = 0.0;
-        assert!(uav_trajectories_csv(&[bad]).unwrap_err().to_string().contains("duration"));
+        assert!(
+            uav_trajectories_csv(&[bad])
+                .unwrap_err()
+                .to_string()
+                .contains("duration")
+        );
     }
 
     #[test]
@@ -580,7 +618,10 @@ mod tests {
         assert_eq!((d.sec, d.nanosec), (1, 250_000_000));
         let d = RosDuration::from_seconds("d", 2.999_999_999_7).unwrap();
         assert_eq!((d.sec, d.nanosec), (3, 0));
-        assert_relative_eq!(RosDuration::from_seconds("d", 0.7).unwrap().as_seconds(), 0.7);
+        assert_relative_eq!(
+            RosDuration::from_seconds("d", 0.7).unwrap().as_seconds(),
+            0.7
+        );
         for bad in [-1.0, f64::NAN, f64::INFINITY, 3e9] {
             assert!(RosDuration::from_seconds("d", bad).is_err());
         }
@@ -593,9 +634,18 @@ mod tests {
         let req = upload_trajectory_request(1, 28, &p, MAX_POLY4D_PIECES).unwrap();
         assert_eq!(req.pieces.len(), 3);
         assert_eq!(req.pieces[0].poly_x.len(), 8);
-        assert_eq!(req.pieces[2].duration, RosDuration { sec: 0, nanosec: 500_000_000 });
+        assert_eq!(
+            req.pieces[2].duration,
+            RosDuration {
+                sec: 0,
+                nanosec: 500_000_000
+            }
+        );
         let e = upload_trajectory_request(1, 29, &p, MAX_POLY4D_PIECES).unwrap_err();
-        assert!(matches!(e, FlightStackError::TooManyPieces { count: 32, .. }), "{e}");
+        assert!(
+            matches!(e, FlightStackError::TooManyPieces { count: 32, .. }),
+            "{e}"
+        );
         assert!(upload_trajectory_request(1, 0, &[], MAX_POLY4D_PIECES).is_err());
     }
 }

@@ -137,7 +137,9 @@ mod tests {
         assert_eq!(to_f32(|| "x".into(), 1.5).unwrap(), 1.5);
         assert_eq!(to_f32(|| "x".into(), 1e-50).unwrap(), 0.0);
         for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e39, -1e39] {
-            let e = to_f32(|| "position[2]".into(), bad).unwrap_err().to_string();
+            let e = to_f32(|| "position[2]".into(), bad)
+                .unwrap_err()
+                .to_string();
             assert!(e.contains("position[2]") && e.contains("f32"), "{e}");
         }
     }

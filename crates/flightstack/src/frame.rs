@@ -82,7 +82,11 @@ impl FrameTransform {
                 "a finite angle (rad)",
             ));
         }
-        scale::check_vec(&format!("{field}.offset_m"), &self.offset_m, Quantity::Position)?;
+        scale::check_vec(
+            &format!("{field}.offset_m"),
+            &self.offset_m,
+            Quantity::Position,
+        )?;
         Ok(())
     }
 
@@ -130,7 +134,10 @@ mod tests {
         // One metre north and up, moving east.
         let p = enu_to_ned(&Vec3::new(0.0, 1.0, 1.0));
         assert_eq!(p, Vec3::new(1.0, 0.0, -1.0));
-        assert_eq!(enu_to_ned(&Vec3::new(2.0, 0.0, 0.0)), Vec3::new(0.0, 2.0, 0.0));
+        assert_eq!(
+            enu_to_ned(&Vec3::new(2.0, 0.0, 0.0)),
+            Vec3::new(0.0, 2.0, 0.0)
+        );
         assert_eq!(yaw_rate_enu_to_ned(0.5), -0.5);
     }
 
@@ -170,12 +177,22 @@ mod tests {
             yaw_rad: f64::NAN,
             ..tf
         };
-        assert!(bad.validate("frame").unwrap_err().to_string().contains("frame.yaw_rad"));
+        assert!(
+            bad.validate("frame")
+                .unwrap_err()
+                .to_string()
+                .contains("frame.yaw_rad")
+        );
         let far = FrameTransform {
             offset_m: Vec3::new(0.0, 1e9, 0.0),
             ..tf
         };
-        assert!(far.validate("frame").unwrap_err().to_string().contains("frame.offset_m"));
+        assert!(
+            far.validate("frame")
+                .unwrap_err()
+                .to_string()
+                .contains("frame.offset_m")
+        );
     }
 
     #[test]
@@ -184,8 +201,10 @@ mod tests {
             serde_json::from_str(r#"{"yaw_rad": 0.5, "offset_m": [1, 2, 3]}"#).unwrap();
         assert_eq!(tf.offset_m, Vec3::new(1.0, 2.0, 3.0));
         assert!(
-            serde_json::from_str::<FrameTransform>(r#"{"yaw_rad": 0, "offset_m": [0,0,0], "x": 1}"#)
-                .is_err()
+            serde_json::from_str::<FrameTransform>(
+                r#"{"yaw_rad": 0, "offset_m": [0,0,0], "x": 1}"#
+            )
+            .is_err()
         );
     }
 

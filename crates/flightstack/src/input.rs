@@ -71,8 +71,9 @@ mod tests {
 
     #[test]
     fn zero_duration_pieces_are_dropped() {
-        let tr = trajectory_from_parts(2.0, &[1.0, 0.0, 0.5], &[piece(0.0), piece(9.0), piece(1.0)])
-            .unwrap();
+        let tr =
+            trajectory_from_parts(2.0, &[1.0, 0.0, 0.5], &[piece(0.0), piece(9.0), piece(1.0)])
+                .unwrap();
         assert_eq!(tr.piece_count(), 2);
         assert_eq!(tr.durations(), &[1.0, 0.5]);
     }
@@ -106,6 +107,11 @@ mod tests {
             let e = check_time(&tr, "t", t).unwrap_err();
             assert!(matches!(e, FlightStackError::TimeOutside { .. }), "{e}");
         }
-        assert!(check_time(&tr, "t", f64::NAN).unwrap_err().to_string().contains("NaN"));
+        assert!(
+            check_time(&tr, "t", f64::NAN)
+                .unwrap_err()
+                .to_string()
+                .contains("NaN")
+        );
     }
 }

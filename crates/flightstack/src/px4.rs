@@ -229,10 +229,7 @@ fn setpoint_unchecked(
         None => (f32::NAN, f32::NAN),
         Some(y) => (
             to_f32(|| "yaw".into(), yaw_enu_to_ned(world_to_enu.yaw(y.yaw_rad)))?,
-            to_f32(
-                || "yawspeed".into(),
-                yaw_rate_enu_to_ned(y.yaw_rate_rad_s),
-            )?,
+            to_f32(|| "yawspeed".into(), yaw_rate_enu_to_ned(y.yaw_rate_rad_s))?,
         ),
     };
     Ok(TrajectorySetpoint {
@@ -439,7 +436,10 @@ mod tests {
             vec![1_000_000, 1_250_000, 1_500_000, 1_750_000, 2_000_000]
         );
         // Fixed yaw 0 (east) is 90° in NED.
-        assert!(sps.iter().all(|s| s.yaw == FRAC_PI_2 as f32 && s.yawspeed == 0.0));
+        assert!(
+            sps.iter()
+                .all(|s| s.yaw == FRAC_PI_2 as f32 && s.yawspeed == 0.0)
+        );
         let e = sample_setpoints(&tr, u64::MAX - 10, 4.0, &Px4Params::default()).unwrap_err();
         assert!(e.to_string().contains("timestamp"), "{e}");
         let bad = Px4Params {
@@ -466,7 +466,10 @@ mod tests {
         let mut yaw = tracker(YawPolicy::Uncontrolled);
         let sp = setpoint_at(&tr, 10.5, 0, &FrameTransform::identity(), &mut yaw).unwrap();
         let m = sp.to_mavlink(1, 1).unwrap();
-        assert_eq!(m.type_mask, TYPE_MASK_YAW_IGNORE | TYPE_MASK_YAW_RATE_IGNORE);
+        assert_eq!(
+            m.type_mask,
+            TYPE_MASK_YAW_IGNORE | TYPE_MASK_YAW_RATE_IGNORE
+        );
         assert_eq!(m.type_mask, 0x0C00);
         assert_eq!((m.yaw, m.yaw_rate), (0.0, 0.0));
 
@@ -478,9 +481,19 @@ mod tests {
 
         let mut inf = sp;
         inf.acceleration[1] = f32::INFINITY;
-        assert!(inf.to_mavlink(1, 1).unwrap_err().to_string().contains("acceleration[1]"));
+        assert!(
+            inf.to_mavlink(1, 1)
+                .unwrap_err()
+                .to_string()
+                .contains("acceleration[1]")
+        );
         let mut late = sp;
         late.timestamp = (u32::MAX as u64 + 1) * 1000;
-        assert!(late.to_mavlink(1, 1).unwrap_err().to_string().contains("time_boot_ms"));
+        assert!(
+            late.to_mavlink(1, 1)
+                .unwrap_err()
+                .to_string()
+                .contains("time_boot_ms")
+        );
     }
 }

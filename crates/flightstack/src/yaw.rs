@@ -178,7 +178,10 @@ mod tests {
         assert_eq!((s.yaw_rad, s.yaw_rate_rad_s), (0.0, 0.0));
         let mut t = YawTracker::new(YawPolicy::Fixed { yaw_rad: 3.0 * PI }).unwrap();
         assert_relative_eq!(
-            t.next(&Vec3::zeros(), &Vec3::zeros()).unwrap().yaw_rad.abs(),
+            t.next(&Vec3::zeros(), &Vec3::zeros())
+                .unwrap()
+                .yaw_rad
+                .abs(),
             PI,
             epsilon = 1e-12
         );
@@ -190,7 +193,9 @@ mod tests {
     fn faces_the_velocity_and_holds_when_slow() {
         let mut t = YawTracker::new(face(0.1, 0.5)).unwrap();
         // Hovering: the initial yaw.
-        let s = t.next(&Vec3::new(0.01, 0.05, 1.0), &Vec3::new(1.0, 0.0, 0.0)).unwrap();
+        let s = t
+            .next(&Vec3::new(0.01, 0.05, 1.0), &Vec3::new(1.0, 0.0, 0.0))
+            .unwrap();
         assert_eq!((s.yaw_rad, s.yaw_rate_rad_s), (0.5, 0.0));
         // Flying north.
         let s = t.next(&Vec3::new(0.0, 2.0, 0.0), &Vec3::zeros()).unwrap();
