@@ -16,8 +16,9 @@ use crate::yaw::{YawPolicy, YawTracker};
 /// constant and not a field.
 pub const PX4_RELEASE: &str = "v1.15";
 
-/// The slowest stream PX4 accepts in offboard mode (Hz): it leaves offboard when setpoints (or
-/// `OffboardControlMode`) arrive at 2 Hz or less (PX4 user guide, "Offboard Mode").
+/// The slowest sampling rate accepted (Hz): PX4 leaves offboard mode unless setpoints (or
+/// `OffboardControlMode`) keep arriving faster than 2 Hz (PX4 user guide, "Offboard Mode"), so
+/// this is a floor; stream faster in practice (MAVSDK resends at 20 Hz).
 pub const MIN_STREAM_RATE_HZ: f64 = 2.0;
 
 /// The fastest sampling rate (Hz): one setpoint per microsecond, the timestamp's resolution.

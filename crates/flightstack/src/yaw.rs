@@ -244,5 +244,9 @@ mod tests {
         let p: YawPolicy = serde_json::from_str(r#"{"kind": "uncontrolled"}"#).unwrap();
         assert_eq!(p, YawPolicy::Uncontrolled);
         assert!(serde_json::from_str::<YawPolicy>(r#"{"kind": "fixed", "yaw": 1}"#).is_err());
+        assert!(
+            serde_json::from_str::<YawPolicy>(r#"{"kind": "fixed", "yaw_rad": 1, "x": 2}"#)
+                .is_err()
+        );
     }
 }
