@@ -1,10 +1,10 @@
 //! Crazyflie: the firmware's `poly4d` pieces (x, y, z, yaw polynomials of degree 7 and a
 //! duration), the Crazyswarm `uav_trajectories` CSV, and the Crazyswarm2 upload message.
 //!
-//! Our pieces are quintics in local time `s ∈ [0, T]` (ascending powers, [`trust_core::Piece`]),
-//! which is exactly the firmware's form one degree-7 polynomial per axis, also in local time and
-//! ascending powers (`pptraj.h`: `PP_DEGREE 7`, `p[0]` the constant term): the conversion pads
-//! `s⁶` and `s⁷` with zeros and rounds to `f32`, nothing else.
+//! Our pieces are quintics in local time `s ∈ [0, T]` (ascending powers, [`trust_core::Piece`]);
+//! the firmware's are one degree-7 polynomial per axis, also in local time and ascending powers
+//! (`pptraj.h`: `PP_DEGREE 7`, `p[0]` the constant term). So the conversion pads `s⁶` and `s⁷`
+//! with zeros and rounds to `f32`, nothing else.
 
 use serde::{Deserialize, Serialize};
 use std::io::Write;
@@ -12,7 +12,6 @@ use trust_core::{PolyTraj, Vec3, eval_piece};
 
 use crate::error::{FlightStackError, to_f32};
 use crate::frame::{FrameTransform, wrap_angle};
-use crate::input::sci;
 use crate::yaw::{YawPolicy, YawTracker};
 
 /// Bytes of the firmware's trajectory memory (`TRAJECTORY_MEMORY_SIZE 4096` in
@@ -236,7 +235,12 @@ pub fn to_poly4d(
 /// consecutive values differ by at most π.
 fn boundary_yaws(traj: &PolyTraj, params: &CrazyflieParams) -> Result<Vec<f64>, FlightStackError> {
     let mut tracker = YawTracker::new(params.yaw)?;
-    let states = std::iter::once((&traj.pieces()[0], 0.0))
+    // The first piece at its start, then every piece at its end.
+    let states = traj
+        .pieces()
+        .first()
+        .map(|p| (p, 0.0))
+        .into_iter()
         .chain(traj.pieces().iter().zip(traj.durations().iter().copied()));
     let mut yaws: Vec<f64> = Vec::with_capacity(traj.piece_count() + 1);
     for (piece, s) in states {
@@ -317,7 +321,7 @@ impl RosDuration {
         if !(seconds.is_finite() && (0.0..f64::from(i32::MAX)).contains(&seconds)) {
             return Err(FlightStackError::invalid(
                 field,
-                sci(seconds),
+                seconds,
                 "a finite duration in [0, 2^31) s",
             ));
         }

@@ -1,6 +1,5 @@
 //! What the exporters read: the planner's [`PolyTraj`], or raw pieces checked into one.
 
-use trust_core::scale::Sci;
 use trust_core::{Piece, PolyTraj};
 
 use crate::error::FlightStackError;
@@ -50,11 +49,6 @@ pub(crate) fn check_time(traj: &PolyTraj, field: &str, t: f64) -> Result<(), Fli
         });
     }
     Ok(())
-}
-
-/// `Sci` of an `f64`, for messages built outside `thiserror`.
-pub(crate) fn sci(x: f64) -> String {
-    Sci(x).to_string()
 }
 
 #[cfg(test)]
