@@ -68,7 +68,9 @@ fn members() -> Vec<Member> {
 /// the scenario's static shapes are its `StaticShape`); `vehicle` knows nothing of the planner;
 /// `route` (the global route, issue 19) sits beside `minco`/`topo-prm` on `geometry` (and may use
 /// `core`); `replay` (issue 20) reads run logs and draws with `plot`, and only the binary uses it;
-/// `export` (MCAP, issue 20) reads logs only (`runlog`), and only `sim` uses it.
+/// `export` (MCAP, issue 20) reads logs only (`runlog`), and only `sim` uses it;
+/// `flightstack` (PX4/Crazyflie outputs, issue 35) reads the planner's trajectory type (`core`)
+/// and knows no simulator type, its tests build MINCO trajectories (`minco`).
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
     const PLANNING: &[&str] = &[
         "trust-geometry",
@@ -150,6 +152,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
             ]),
         ),
         ("trust-replay", &["trust-runlog", "trust-plot"][..]),
+        ("trust-flightstack", &["trust-core", "trust-minco"][..]),
         (
             "trust-sim",
             with(&[
