@@ -832,9 +832,11 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         Some(out)
     }
 
-    /// The cycle's solves with the worker's results: the main branch marches here (FwdMarch),
-    /// the sub-branches come re-solved by the worker (re-solved here if one is missing), and
-    /// the explored candidates are the worker's; in `warm`'s order as
+    /// The cycle's solves with the worker's results: the main branch is re-solved here against
+    /// this cycle's forecasts, from the worker's re-solve of it
+    /// ([`ManagerParams::merge_max_evaluations`]; FwdMarch from its trajectory if the worker's
+    /// failed), the sub-branches come re-solved by the worker (re-solved here if one is
+    /// missing), and the explored candidates are the worker's; in `warm`'s order as
     /// [`Manager::solve_in_parallel`].
     fn solve_main_with(
         &self,
@@ -847,11 +849,25 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     ) -> (Explored, Vec<Candidate>) {
         let solver = self.solver(cycle, aim, scene);
         let mut subs = out.subs;
+        if let Some(main) = &out.main {
+            // The worker's re-solve counts in this cycle's work.
+            spans.solved(main, false);
+        }
+        let marched = out.main.and_then(|c| c.result.ok()).map(|(s, _)| s.traj);
+        let budget = self
+            .params
+            .merge_max_evaluations
+            .or(self.params.warm_max_evaluations);
         let resolved = warm
             .iter()
             .map(|(id, origin, traj)| {
                 if *origin == Origin::Marched {
-                    return solver.fwd_march(traj);
+                    return match &marched {
+                        Some(from) => {
+                            solver.repaired(solver.solve_with(InitialGuess::WarmStart(from), budget))
+                        }
+                        None => solver.fwd_march(traj),
+                    };
                 }
                 match subs.iter().position(|(s, _)| s == id) {
                     Some(i) => subs.swap_remove(i).1,
@@ -898,6 +914,10 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             params: self.params.clone(),
             explore: self.explores(stalled),
             stalled,
+            main: self
+                .main
+                .and_then(|id| self.branches.iter().find(|b| b.id == id))
+                .map(|b| b.solution.traj.clone()),
             subs: self
                 .branches
                 .iter()

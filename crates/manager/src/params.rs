@@ -90,6 +90,12 @@ pub struct ManagerParams {
     /// ([`crate::Manager::share_map`]). Default `true`: the paper's exploring cycle (frontend and
     /// cold solves, 20–40 ms on E4's point-cloud ESDF) was the cycle's tail.
     pub background: bool,
+    /// Evaluation budget of the main branch's re-solve in a cycle that merged the worker's job
+    /// ([`ManagerParams::background`]); `None`: [`ManagerParams::warm_max_evaluations`]. The
+    /// worker has re-solved the main branch from this cycle's start already (FwdMarch with the
+    /// warm budget, against the previous cycle's forecasts), so the cycle's own re-solve starts
+    /// from that and only takes in the newest forecasts. Default 30 (beyond the paper).
+    pub merge_max_evaluations: Option<usize>,
     /// Run FwdExplore (the frontend and the cold solves) every this many cycles, and in every cycle
     /// that starts with fewer than two kept branches or without a main branch. 1: every cycle (the
     /// paper's Algorithm 1). At least 1. Default 3 (beyond the paper): the kept branches carry
@@ -178,6 +184,7 @@ impl ManagerParams {
             cold_max_evaluations: None,
             cold_solves_per_cycle: Some(2),
             background: true,
+            merge_max_evaluations: Some(30),
             explore_period_cycles: 3,
             repair_margin_m: 0.05,
             ranking: None,

@@ -487,6 +487,9 @@ pub struct ManagerOverrides {
     /// Replaces `ManagerParams::background`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub background: Option<bool>,
+    /// Replaces `ManagerParams::merge_max_evaluations`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub merge_max_evaluations: Option<usize>,
     /// Replaces `ManagerParams::explore_period_cycles`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub explore_period_cycles: Option<usize>,
@@ -568,6 +571,9 @@ impl ManagerOverrides {
         }
         if let Some(v) = self.background {
             p.background = v;
+        }
+        if let Some(v) = self.merge_max_evaluations {
+            p.merge_max_evaluations = Some(v);
         }
         if let Some(v) = self.explore_period_cycles {
             p.explore_period_cycles = v;

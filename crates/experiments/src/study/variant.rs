@@ -33,6 +33,9 @@ pub enum Variant {
     NoHistory,
     /// `no-hysteresis`: the main branch switches to any better challenger (factor 1).
     NoHysteresis,
+    /// `no-worker`: every solve in the cycle (`manager.background = false`): the sub-branches'
+    /// re-solves and FwdExplore are not taken off the cycle's critical path.
+    NoWorker,
     /// `perfect`: perfect tracking instead of the scenario's vehicle model.
     Perfect,
     /// `quadrotor`: the rigid-body quadrotor with its SE(3) controller.
@@ -61,7 +64,7 @@ pub enum Variant {
 impl Variant {
     /// Every variant name, for help texts.
     pub const NAMES: &'static str = "none, vprm, minco, uvd, no-pdc, no-ggs, no-history, \
-                                     no-hysteresis, perfect, quadrotor, mu=X, fault=X, \
+                                     no-hysteresis, no-worker, perfect, quadrotor, mu=X, fault=X, \
                                      explore=K, route, real-time, real-time=X";
 
     /// Applies the variant to `scenario` (whose planner preset is already chosen): replaces the
@@ -125,6 +128,7 @@ impl Variant {
             },
             Variant::NoHistory => manager_overrides(planner).history = Some(false),
             Variant::NoHysteresis => manager_overrides(planner).hysteresis = Some(1.0),
+            Variant::NoWorker => manager_overrides(planner).background = Some(false),
             Variant::Perfect => scenario.vehicle.model = VehicleModel::Perfect,
             Variant::Quadrotor => scenario.vehicle.model = VehicleModel::Quadrotor,
             Variant::Mu(x) => scenario.sensing.ekf.sigma_scale *= x,
@@ -155,6 +159,7 @@ impl fmt::Display for Variant {
             Variant::NoGgs => f.write_str("no-ggs"),
             Variant::NoHistory => f.write_str("no-history"),
             Variant::NoHysteresis => f.write_str("no-hysteresis"),
+            Variant::NoWorker => f.write_str("no-worker"),
             Variant::Perfect => f.write_str("perfect"),
             Variant::Quadrotor => f.write_str("quadrotor"),
             Variant::Mu(x) => write!(f, "mu={x}"),
@@ -191,6 +196,7 @@ impl FromStr for Variant {
             "no-ggs" => Variant::NoGgs,
             "no-history" => Variant::NoHistory,
             "no-hysteresis" => Variant::NoHysteresis,
+            "no-worker" => Variant::NoWorker,
             "perfect" => Variant::Perfect,
             "quadrotor" => Variant::Quadrotor,
             "real-time" => Variant::RealTime(1.0),
@@ -266,6 +272,7 @@ mod tests {
             "no-ggs",
             "no-history",
             "no-hysteresis",
+            "no-worker",
             "perfect",
             "quadrotor",
             "mu=2",

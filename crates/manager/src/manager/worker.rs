@@ -49,6 +49,8 @@ pub(super) struct JobInput<F, B> {
     /// Run FwdExplore (else solve the deferred guides).
     pub(super) explore: bool,
     pub(super) stalled: bool,
+    /// The main branch's trajectory (re-solved first, FwdMarch).
+    pub(super) main: Option<PolyTraj>,
     /// The sub-branches to re-solve, in rank order.
     pub(super) subs: Vec<(BranchId, PolyTraj)>,
     pub(super) deferred: Vec<GuidePath>,
@@ -60,6 +62,8 @@ pub(super) struct JobInput<F, B> {
 pub(super) struct JobOutput {
     /// The random stream after the frontend's draws (the manager continues it).
     pub(super) rng: Rng,
+    /// The main branch re-solved (FwdMarch), if there was one.
+    pub(super) main: Option<Candidate>,
     /// The sub-branches re-solved, in the input's order.
     pub(super) subs: Vec<(BranchId, Candidate)>,
     pub(super) explored: Explored,
@@ -85,6 +89,7 @@ pub(super) fn run<F: PathFrontend, B: TrajectoryBackend>(input: JobInput<F, B>) 
         params,
         explore,
         stalled,
+        main,
         subs,
         deferred,
         route_guide,
@@ -112,19 +117,25 @@ pub(super) fn run<F: PathFrontend, B: TrajectoryBackend>(input: JobInput<F, B>) 
         horizon_s: params.horizon_s,
         exploration: if stalled { 2.0 } else { 1.0 },
     };
-    let (explored, subs) = rayon::join(
+    let (explored, (main, subs)) = rayon::join(
         || match explore {
             true => fwd_explore(&*frontend, &mut rng, &query, &solver, &mut spans),
             false => solve_deferred(deferred, &solver),
         },
         || {
-            subs.par_iter()
-                .map(|(id, traj)| (*id, solver.bwd_replan(traj)))
-                .collect()
+            rayon::join(
+                || main.map(|traj| solver.fwd_march(&traj)),
+                || {
+                    subs.par_iter()
+                        .map(|(id, traj)| (*id, solver.bwd_replan(traj)))
+                        .collect()
+                },
+            )
         },
     );
     JobOutput {
         rng,
+        main,
         subs,
         explored,
         frontend_ms: spans.timing.frontend_ms,
