@@ -36,6 +36,35 @@ fn the_clock_charges_the_fixed_latency_or_the_scaled_wall_time() {
     assert_eq!(default_scale, Clock::RealTime { cpu_scale: 1.0 });
 }
 
+#[test]
+fn the_real_time_clock_charges_the_cycles_own_time_and_the_workers_lateness() {
+    use trust_flight::closed_loop::charged_for;
+    use trust_manager::CycleTiming;
+    let timing = CycleTiming {
+        wall_ms: 30.0,
+        waited_ms: 25.0,
+        worker_ms: 40.0,
+        ..CycleTiming::default()
+    };
+    // Fixed latency: the latency, whatever the cycle did.
+    let fixed = Clock::Fixed { latency_s: 0.05 };
+    assert_eq!(charged_for(fixed, &timing, Some(0.0), 0.1), 0.05);
+    // Real time: the 5 ms of its own; the job started at 0.01 s and ran 40 ms (done at 0.05 s),
+    // before this cycle at 0.1 s: no lateness.
+    let real = Clock::RealTime { cpu_scale: 1.0 };
+    assert!((charged_for(real, &timing, Some(0.01), 0.1) - 0.005).abs() < 1e-12);
+    // Three times slower: the job runs 120 ms from 0.01 s, 30 ms past this cycle's start; its
+    // own part is 15 ms.
+    let slow = Clock::RealTime { cpu_scale: 3.0 };
+    assert!((charged_for(slow, &timing, Some(0.01), 0.1) - 0.045).abs() < 1e-12);
+    // No job merged: only its own time.
+    let alone = CycleTiming {
+        worker_ms: 0.0,
+        ..timing
+    };
+    assert!((charged_for(slow, &alone, None, 0.1) - 0.015).abs() < 1e-12);
+}
+
 /// Counts what the loop reports.
 #[derive(Default)]
 struct Counts {

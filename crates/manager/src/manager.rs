@@ -863,9 +863,8 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             .map(|(id, origin, traj)| {
                 if *origin == Origin::Marched {
                     return match &marched {
-                        Some(from) => {
-                            solver.repaired(solver.solve_with(InitialGuess::WarmStart(from), budget))
-                        }
+                        Some(from) => solver
+                            .repaired(solver.solve_with(InitialGuess::WarmStart(from), budget)),
                         None => solver.fwd_march(traj),
                     };
                 }

@@ -269,6 +269,41 @@ fn re_solves_respect_their_evaluation_budgets() {
     );
 }
 
+#[test]
+fn with_the_worker_the_main_branch_is_re_solved_within_the_merge_budget() {
+    // A cycle that merges the worker's job re-solves the main branch from the worker's re-solve
+    // with `merge_max_evaluations`; the sub-branches come from the worker with theirs.
+    let map = std::sync::Arc::new(two_gap_corridor());
+    let mut m = planner(ManagerParams {
+        warm_max_evaluations: Some(40),
+        merge_max_evaluations: Some(6),
+        sub_branch_max_evaluations: Some(9),
+        repair_margin_m: 0.0,
+        ..ManagerParams::trust()
+    });
+    m.share_map(std::sync::Arc::clone(&map));
+    let reports = fly(&mut m, &map, GOAL, State::at_rest(0.0, START), 10, |_| {
+        Vec::new()
+    });
+    let mut merged_mains = 0;
+    for r in reports.iter().filter(|r| r.timing.worker_ms > 0.0) {
+        for b in &r.branches {
+            match b.origin {
+                Origin::Marched => {
+                    assert!(b.evaluation_count <= 7, "main branch: {b:?}");
+                    merged_mains += 1;
+                }
+                Origin::Replanned => assert!(b.evaluation_count <= 10, "sub-branch: {b:?}"),
+                _ => {}
+            }
+        }
+    }
+    assert!(
+        merged_mains >= 5,
+        "merged cycles with a main branch: {merged_mains}"
+    );
+}
+
 fn summary(reports: &[StepReport]) -> Vec<String> {
     reports
         .iter()
