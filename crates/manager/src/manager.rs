@@ -833,9 +833,9 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     }
 
     /// The cycle's solves with the worker's results: the main branch is re-solved here against
-    /// this cycle's forecasts, from the worker's re-solve of it
-    /// ([`ManagerParams::merge_max_evaluations`]; FwdMarch from its trajectory if the worker's
-    /// failed), the sub-branches come re-solved by the worker (re-solved here if one is
+    /// this cycle's forecasts, from the worker's re-solve of it with
+    /// [`ManagerParams::merge_max_evaluations`] (from its own trajectory with the warm budget if
+    /// the worker's failed; a repair with the warm budget), the sub-branches come re-solved by the worker (re-solved here if one is
     /// missing), and the explored candidates are the worker's; in `warm`'s order as
     /// [`Manager::solve_in_parallel`].
     fn solve_main_with(
@@ -862,11 +862,13 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             .iter()
             .map(|(id, origin, traj)| {
                 if *origin == Origin::Marched {
-                    return match &marched {
-                        Some(from) => solver
-                            .repaired(solver.solve_with(InitialGuess::WarmStart(from), budget)),
-                        None => solver.fwd_march(traj),
+                    let warm = self.params.warm_max_evaluations;
+                    let cand = match &marched {
+                        Some(from) => solver.solve_with(InitialGuess::WarmStart(from), budget),
+                        None => solver.solve_with(InitialGuess::WarmStart(traj), warm),
                     };
+                    // On the critical path a repair gets the warm budget, not the cold one.
+                    return solver.repaired_within(cand, warm);
                 }
                 match subs.iter().position(|(s, _)| s == id) {
                     Some(i) => subs.swap_remove(i).1,
@@ -883,7 +885,12 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     /// ([`ManagerParams::background`]), from the next cycle's replan start as the committed plan
     /// predicts it one period (the last cycle interval) ahead; whether it started one.
     fn start_job(&mut self, now: f64, cycle: &Cycle, scene: &Scene<'_>) -> bool {
-        let period = self.last_now.replace(now).map(|last| now - last);
+        // Before a second cycle the period is unknown: the budget is half of it
+        // ([`ManagerParams::cycle_budget_ms`]); a wrong guess only makes the job stale.
+        let period = self
+            .last_now
+            .replace(now)
+            .map_or(2.0 * self.params.cycle_budget_ms * 1e-3, |last| now - last);
         if !self.params.background || !self.params.history {
             return false;
         }
@@ -891,7 +898,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             .shared_map
             .clone()
             .filter(|m| std::ptr::eq(Arc::as_ptr(m), scene.map));
-        let period = period.filter(|p| p.is_finite() && *p > 0.0);
+        let period = Some(period).filter(|p| p.is_finite() && *p > 0.0);
         let (Some(map), Some(period), Some(plan)) = (shared, period, self.committed.as_ref())
         else {
             return false;
@@ -2015,16 +2022,18 @@ impl<'s, 'a, B: TrajectoryBackend> Solver<'s, 'a, B> {
     /// `cand` again, warm-started from its own trajectory, if it failed the safety check by at
     /// most `repair_margin_m` and the re-solve passes; otherwise `cand` unchanged.
     fn repaired(&self, cand: Candidate) -> Candidate {
+        // With the cold budget: a repair is rare and its first solve stopped short of clean.
+        self.repaired_within(cand, self.params.cold_max_evaluations)
+    }
+
+    /// [`Solver::repaired`] with the repair's evaluation budget given.
+    fn repaired_within(&self, cand: Candidate, max_evaluations: Option<usize>) -> Candidate {
         let margin = self.params.repair_margin_m;
         let first = match &cand.result {
             Ok((first, verdict)) if margin > 0.0 && narrowly_unsafe(verdict, margin) => first,
             _ => return cand,
         };
-        // With the cold budget: a repair is rare and its first solve stopped short of clean.
-        let again = self.solve_with(
-            InitialGuess::WarmStart(&first.traj),
-            self.params.cold_max_evaluations,
-        );
+        let again = self.solve_with(InitialGuess::WarmStart(&first.traj), max_evaluations);
         let spent = |c: &Candidate| {
             c.result
                 .as_ref()
