@@ -180,7 +180,7 @@ pub struct E4Params {
     /// Smallest horizontal gap between the footprints of two static obstacles (m), so that
     /// there are passages everywhere. Default 2.5 m (about eight vehicle radii; the backend's
     /// static clearance at 0.2 m voxels is 0.3 + 0.1 + 0.35 = 0.75 m on each side, so a 1 m wide
-    /// corridor remains — see `crate::planner` and `World::static_map_error_m`).
+    /// corridor remains — see `trust_planner::assemble` and `World::static_map_error_m`).
     pub min_gap_m: f64,
     /// No static footprint comes within this horizontal distance of the start or the goal (m).
     /// Default 10 m.
