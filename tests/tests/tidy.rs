@@ -221,8 +221,14 @@ const PLANNER_CRATES: &[&str] = &[
 fn the_world_depends_on_no_planner_crate() {
     let allowed = allowed();
     let world = allowed["trust-world"];
-    let listed: Vec<&&str> = PLANNER_CRATES.iter().filter(|c| world.contains(c)).collect();
-    assert!(listed.is_empty(), "the layering lets trust-world use {listed:?}");
+    let listed: Vec<&&str> = PLANNER_CRATES
+        .iter()
+        .filter(|c| world.contains(c))
+        .collect();
+    assert!(
+        listed.is_empty(),
+        "the layering lets trust-world use {listed:?}"
+    );
     let m = members()
         .into_iter()
         .find(|m| m.name() == "trust-world")
