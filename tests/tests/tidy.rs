@@ -60,9 +60,12 @@ fn members() -> Vec<Member> {
 
 /// The allowed internal dependencies of each crate (design.md §2, ARCHITECTURE.md "Dependency
 /// order"): the planning libraries
-/// `geometry ← predict ← core ← {lbfgs, minco, topo-prm} ← manager`, then the simulator along its
-/// data path `{plot, vehicle, runlog} ; world (+ runlog) ← flight (+ plot) ← experiments ← sim (the
-/// binary)`. `lbfgs` depends on nothing of ours; `minco` and `topo-prm` never depend on each other;
+/// `geometry ← predict ← core ← {lbfgs, minco, topo-prm} ← manager ← planner`, then the simulator
+/// along its data path `{plot, vehicle, runlog} ; world (+ runlog) ← flight (+ plot, planner) ←
+/// experiments ← sim (the binary)`. `world` depends on no planner crate ([`PLANNER_CRATES`]: the
+/// scenario's `[planner]` section is a type parameter it never looks inside); `overrides` (the
+/// derive) sits under `core`, `scenes` (the paper's experiment scenes) on `core` under `minco`,
+/// `topo-prm` and `world`. `lbfgs` depends on nothing of ours; `minco` and `topo-prm` never depend on each other;
 /// `plot` knows no simulator or planner type (the flight summary uses its `quantile_sorted`);
 /// `runlog` knows none of the simulator's types either (a log is read without building a world;
 /// the scenario's static shapes are its `StaticShape`); `vehicle` knows nothing of the planner;
@@ -73,14 +76,17 @@ fn members() -> Vec<Member> {
 /// and knows no simulator type, its tests build MINCO trajectories (`minco`).
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
     const PLANNING: &[&str] = &[
+        "trust-overrides",
         "trust-geometry",
         "trust-predict",
         "trust-core",
+        "trust-scenes",
         "trust-lbfgs",
         "trust-minco",
         "trust-topo-prm",
         "trust-route",
         "trust-manager",
+        "trust-planner",
     ];
     fn with(extra: &[&'static str]) -> &'static [&'static str] {
         let mut v: Vec<&'static str> = PLANNING.to_vec();
@@ -88,9 +94,14 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
         Vec::leak(v)
     }
     BTreeMap::from([
+        ("trust-overrides", &[][..]),
         ("trust-geometry", &[][..]),
         ("trust-predict", &["trust-geometry"][..]),
-        ("trust-core", &["trust-geometry", "trust-predict"][..]),
+        (
+            "trust-core",
+            &["trust-geometry", "trust-predict", "trust-overrides"][..],
+        ),
+        ("trust-scenes", &["trust-geometry", "trust-core"][..]),
         ("trust-lbfgs", &[][..]),
         ("trust-route", &["trust-geometry", "trust-core"][..]),
         (
@@ -99,12 +110,18 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-geometry",
                 "trust-predict",
                 "trust-core",
+                "trust-scenes",
                 "trust-lbfgs",
             ][..],
         ),
         (
             "trust-topo-prm",
-            &["trust-geometry", "trust-predict", "trust-core"][..],
+            &[
+                "trust-geometry",
+                "trust-predict",
+                "trust-core",
+                "trust-scenes",
+            ][..],
         ),
         (
             "trust-manager",
@@ -116,6 +133,19 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-minco",
                 "trust-topo-prm",
                 "trust-route",
+            ][..],
+        ),
+        (
+            "trust-planner",
+            &[
+                "trust-geometry",
+                "trust-predict",
+                "trust-core",
+                "trust-lbfgs",
+                "trust-minco",
+                "trust-topo-prm",
+                "trust-route",
+                "trust-manager",
             ][..],
         ),
         // The fuzz driver is a tool at the top, like the simulator: it drives the library APIs
@@ -136,7 +166,17 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
         ("trust-runlog", &[][..]),
         ("trust-export", &["trust-runlog"][..]),
         ("trust-vehicle", &["trust-core"][..]),
-        ("trust-world", with(&["trust-vehicle", "trust-runlog"])),
+        (
+            "trust-world",
+            &[
+                "trust-geometry",
+                "trust-predict",
+                "trust-core",
+                "trust-scenes",
+                "trust-vehicle",
+                "trust-runlog",
+            ][..],
+        ),
         (
             "trust-flight",
             with(&["trust-vehicle", "trust-world", "trust-runlog", "trust-plot"]),
@@ -167,6 +207,44 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
             ]),
         ),
     ])
+}
+
+/// The crates that plan (frontends, backends, the manager, the route, the assembled planner):
+/// `trust-world` may depend on none of them, in any dependency table.
+const PLANNER_CRATES: &[&str] = &[
+    "trust-lbfgs",
+    "trust-minco",
+    "trust-topo-prm",
+    "trust-route",
+    "trust-manager",
+    "trust-planner",
+];
+
+#[test]
+fn the_world_depends_on_no_planner_crate() {
+    let allowed = allowed();
+    let world = allowed["trust-world"];
+    let listed: Vec<&&str> = PLANNER_CRATES
+        .iter()
+        .filter(|c| world.contains(c))
+        .collect();
+    assert!(
+        listed.is_empty(),
+        "the layering lets trust-world use {listed:?}"
+    );
+    let m = members()
+        .into_iter()
+        .find(|m| m.name() == "trust-world")
+        .expect("trust-world is a member");
+    for table in ["dependencies", "build-dependencies", "dev-dependencies"] {
+        for dep in m.internal_deps(table) {
+            assert!(
+                !PLANNER_CRATES.contains(&dep.as_str()),
+                "trust-world [{table}] depends on {dep}: the scenario's [planner] section is read \
+                 where the planner is known (trust_flight::scenario), not in the world"
+            );
+        }
+    }
 }
 
 /// Every workspace member is either in [`allowed`] or one of the automation crates, so that a new

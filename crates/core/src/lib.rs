@@ -54,6 +54,7 @@ mod bernstein;
 mod curve;
 mod error;
 mod guidance;
+mod overrides;
 mod path;
 mod scene;
 mod solution;
@@ -69,6 +70,7 @@ pub use error::{
     check_scaled, check_scaled_vec,
 };
 pub use guidance::{guidance_radius, straight_end};
+pub use overrides::Overridable;
 pub use path::GuidePath;
 pub use scene::Scene;
 pub use solution::{CostBreakdown, RankingWeights, Solution, SolveStats, SolveStatus};
@@ -78,6 +80,8 @@ pub use traits::{
     SearchStats, TrajRequest, TrajectoryBackend,
 };
 pub use traj::{Derivative, MAX_DERIVATIVE_BOUND, Piece, PolyTraj, eval_piece};
+/// `#[derive(Overridable)]` for params structs (`trust-overrides`; [`Overridable`]).
+pub use trust_overrides::Overridable;
 pub use verify::{VERIFY_MAX_SAMPLES, VERIFY_STEP_S, Violation, verify_trajectory};
 
 pub use trust_geometry::{Aabb, MapWork, StaticMap, Vec3, scale};

@@ -15,7 +15,7 @@ use std::process::ExitCode;
 
 use nalgebra::Point2;
 use trust_plot::{Bounds, Color, Figure, ForecastRings, MapView, Marker, Shape};
-use trust_world::scenario::{PointCloudSpec, Scenario};
+use trust_world::scenario::PointCloudSpec;
 use trust_world::{World, sample_shapes};
 
 fn peak_rss_mb() -> Option<f64> {
@@ -47,7 +47,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             .get(1)
             .map_or("target/world-view", String::as_str),
     );
-    let mut scenario = Scenario::load(&path)?;
+    let mut scenario = trust_flight::scenario::load(&path)?;
     if let Some(s) = seed {
         scenario = scenario.with_seed(s);
     }

@@ -16,9 +16,9 @@ use trust_core::{Scene, SearchStats, State};
 
 use crate::ExperimentError;
 use crate::study::{create_dir, write_json, write_text};
+use trust_flight::scenario::Scenario;
 use trust_plot::{Color, Figure, ForecastRings, Marker, Plane, Polyline};
 use trust_world::World;
-use trust_world::scenario::Scenario;
 
 /// The paper's Table Sim-B-1: `(H_t s, H_s, I_e, J, CPU ms)` of τ0…τ4.
 pub const PAPER_TABLE: [(f64, f64, f64, f64, f64); 5] = [
@@ -99,7 +99,7 @@ pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, ExperimentEr
     let world = World::build(scenario)?;
     // The paper's table: the branches of one cycle aimed at the final goal, no global route,
     // constant-velocity forecasts without their wall images.
-    let mut resolved = scenario.resolve_planner();
+    let mut resolved = trust_flight::scenario::resolve_planner(&scenario);
     resolved.route = None;
     resolved.manager.wall_images = false;
     // One cycle shows every branch: all its cold solves in that cycle.

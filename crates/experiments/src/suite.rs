@@ -19,10 +19,11 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use trust_flight::scenario::Scenario;
+use trust_planner::PlannerPreset;
 use trust_plot::{Bar, BarChart, Color, Figure};
 use trust_world::World;
-use trust_world::planner::PlannerPreset;
-use trust_world::scenario::{Latency, Scenario};
+use trust_world::scenario::Latency;
 
 use crate::ExperimentError;
 use crate::study::{create_dir, fly_logged, write_json, write_text};
@@ -276,7 +277,7 @@ pub fn run_suite(
     config.validate()?;
     let mut jobs = Vec::new();
     for file in &config.files {
-        let base = Scenario::load(file)?;
+        let base = trust_flight::scenario::load(file)?;
         let presets: Vec<Option<PlannerPreset>> = if config.planners.is_empty() {
             vec![None]
         } else {
@@ -373,7 +374,7 @@ fn flight_scenario(
 
 fn fly_one(class: &str, s: &Scenario, out: &Path) -> Result<SuiteRow, ExperimentError> {
     let world = World::build(s)?;
-    let planner = s.resolve_planner();
+    let planner = trust_flight::scenario::resolve_planner(&s);
     let rel = format!(
         "logs/{class}/{}-seed{}.jsonl",
         s.planner.name.name(),

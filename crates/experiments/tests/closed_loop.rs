@@ -7,12 +7,12 @@ use std::path::{Path, PathBuf};
 use trust_experiments::study::{
     RunRow, RunStudyOptions, Shard, StudyConfig, Variant, merge, read_runs_csv, run_study,
 };
+use trust_flight::scenario::Scenario;
 use trust_flight::{RunOptions, fly};
+use trust_planner::PlannerPreset;
 use trust_runlog::audit::audit;
 use trust_runlog::{Record, RunLog, Status};
 use trust_world::World;
-use trust_world::planner::PlannerPreset;
-use trust_world::scenario::Scenario;
 
 fn scenarios_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios")
@@ -26,7 +26,8 @@ fn temp_dir(name: &str) -> PathBuf {
 }
 
 fn quickstart() -> Scenario {
-    Scenario::load(&scenarios_dir().join("quickstart.toml")).expect("quickstart loads")
+    trust_flight::scenario::load(&scenarios_dir().join("quickstart.toml"))
+        .expect("quickstart loads")
 }
 
 #[test]
@@ -40,7 +41,13 @@ fn quickstart_arrives_and_its_log_passes_the_independent_audit() {
         progress_every_s: None,
         log_branches: false,
     };
-    let flight = fly(&world, &s.resolve_planner(), &options, |_| {}).unwrap();
+    let flight = fly(
+        &world,
+        &trust_flight::scenario::resolve_planner(&s),
+        &options,
+        |_| {},
+    )
+    .unwrap();
     let o = &flight.summary.outcome;
     assert_eq!(o.status, Status::Arrived, "{o:?}");
     assert!(o.min_clearance_static_m > 0.0 && o.min_clearance_dynamic_m > 0.0);
@@ -67,7 +74,7 @@ fn quickstart_arrives_and_its_log_passes_the_independent_audit() {
 fn the_same_seed_gives_a_byte_identical_log() {
     let s = quickstart().with_seed(7);
     let world = World::build(&s).unwrap();
-    let planner = s.resolve_planner();
+    let planner = trust_flight::scenario::resolve_planner(&s);
     let dir = temp_dir("identical");
     let mut texts = Vec::new();
     for k in 0..2 {
@@ -120,7 +127,13 @@ fn the_same_seed_gives_a_byte_identical_log() {
         progress_every_s: None,
         log_branches: false,
     };
-    fly(&w8, &other.resolve_planner(), &options, |_| {}).unwrap();
+    fly(
+        &w8,
+        &trust_flight::scenario::resolve_planner(&other),
+        &options,
+        |_| {},
+    )
+    .unwrap();
     assert!(std::fs::read(&path).unwrap() != texts[0]);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -136,7 +149,8 @@ fn every_shipped_scenario_validates_and_flies_with_every_planner() {
     names.sort();
     assert!(names.len() >= 6, "{names:?}");
     for path in names {
-        let s = Scenario::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let s = trust_flight::scenario::load(&path)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         assert!(s.validate().is_empty(), "{}", path.display());
         // E4's world takes seconds in a test build: fly it once, the others with every preset.
         let presets: &[PlannerPreset] = if s.name == "e4" {
@@ -161,8 +175,13 @@ fn every_shipped_scenario_validates_and_flies_with_every_planner() {
                 progress_every_s: None,
                 log_branches: false,
             };
-            let f = fly(&w, &t.resolve_planner(), &options, |_| {})
-                .unwrap_or_else(|e| panic!("{} with {}: {e}", s.name, p.name()));
+            let f = fly(
+                &w,
+                &trust_flight::scenario::resolve_planner(&t),
+                &options,
+                |_| {},
+            )
+            .unwrap_or_else(|e| panic!("{} with {}: {e}", s.name, p.name()));
             let o = &f.summary.outcome;
             assert!(
                 o.status != Status::Invalid && o.status != Status::Collided,
@@ -276,7 +295,7 @@ fn a_sharded_study_merges_into_the_single_run_and_jobs_do_not_matter() {
 
 #[test]
 fn e3_keeps_several_ranked_distinct_branches_and_writes_its_report() {
-    let base = Scenario::load(&scenarios_dir().join("e3.toml")).expect("e3 loads");
+    let base = trust_flight::scenario::load(&scenarios_dir().join("e3.toml")).expect("e3 loads");
     let dir = temp_dir("e3");
     // Seeds whose cold cycle keeps several branches (scenarios/e3.toml, measured: 4 each).
     for seed in [6, 8] {

@@ -21,11 +21,11 @@
 
 use std::path::{Path, PathBuf};
 
+use trust_flight::scenario::Scenario;
 use trust_flight::{Flight, RunOptions, fly};
 use trust_runlog::audit::audit;
 use trust_runlog::{RunLog, Status};
 use trust_world::World;
-use trust_world::scenario::Scenario;
 
 fn suite(name: &str) -> Scenario {
     load("suite", name)
@@ -36,7 +36,7 @@ fn load(folder: &str, name: &str) -> Scenario {
         .join("../../scenarios")
         .join(folder)
         .join(format!("{name}.toml"));
-    Scenario::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    trust_flight::scenario::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -57,7 +57,13 @@ fn fly_audited(s: &Scenario, tag: &str) -> (Flight, Vec<String>) {
         log_branches: false,
     };
     let world = World::build(s).unwrap();
-    let flight = fly(&world, &s.resolve_planner(), &options, |_| {}).unwrap();
+    let flight = fly(
+        &world,
+        &trust_flight::scenario::resolve_planner(&s),
+        &options,
+        |_| {},
+    )
+    .unwrap();
     let log = RunLog::read(&log_path).unwrap();
     let a = audit(&log, &dir).unwrap();
     assert!(a.passed(), "{tag}: {:?}", a.findings);

@@ -15,10 +15,10 @@
 
 use trust_core::{PolyTraj, Scene, Vec3};
 use trust_manager::{CycleTiming, StepReport};
+use trust_planner::{AnyManager, ResolvedPlanner};
 use trust_predict::Forecast;
 use trust_vehicle::{Reference, Vehicle, VehicleState};
 use trust_world::World;
-use trust_world::planner::{AnyManager, ResolvedPlanner};
 use trust_world::scenario::Latency;
 use trust_world::sensing::Sensing;
 use trust_world::traffic::Traffic;

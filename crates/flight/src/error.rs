@@ -10,6 +10,9 @@ pub enum FlightError {
     /// The scenario, the world or the planner could not be set up.
     #[error(transparent)]
     World(#[from] trust_world::WorldError),
+    /// The planner could not be assembled for the world's vehicle.
+    #[error(transparent)]
+    Planner(#[from] trust_planner::PlannerError),
     /// Invalid input to a vehicle model or controller.
     #[error(transparent)]
     Vehicle(#[from] trust_vehicle::VehicleError),

@@ -1,8 +1,9 @@
 //! # trust-flight — the closed loop: one flight of one planner through one world, written as a run log
 //!
 //! The simulator's middle stage (paper Sec. IV): it takes a [`World`] built by `trust-world`,
-//! assembles the planner the scenario names ([`trust_world::planner::build`]), flies it and writes
-//! the run log of `trust-runlog`. Use [`fly`] for one flight; studies and experiments
+//! assembles the planner the scenario names ([`trust_planner::build`]), flies it and writes the
+//! run log of `trust-runlog`. The world and the planner meet here: [`scenario`] reads a
+//! scenario file with its `[planner]` section as `trust-planner`'s spec and checks both halves. Use [`fly`] for one flight; studies and experiments
 //! (`trust-experiments`) call it once per trial and planner. To drive the loop yourself (another
 //! observer, a flight paused and inspected), use [`closed_loop::step`] with a [`FlightState`].
 //!
@@ -25,13 +26,14 @@
 //!
 //! ```no_run
 //! use std::path::{Path, PathBuf};
+//! use trust_flight::scenario::{load_checked, resolve_planner};
 //! use trust_flight::{RunOptions, fly};
-//! use trust_world::{World, load_checked};
+//! use trust_world::World;
 //!
 //! let scenario = load_checked(Path::new("scenarios/quickstart.toml"))?;
 //! let world = World::build(&scenario)?;
 //! let options = RunOptions { log_path: Some(PathBuf::from("out/run.jsonl")), ..RunOptions::default() };
-//! let flight = fly(&world, &scenario.resolve_planner(), &options, |_| {})?;
+//! let flight = fly(&world, &resolve_planner(&scenario), &options, |_| {})?;
 //! println!("{:?}", flight.summary.outcome.status);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -43,6 +45,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use trust_core::{PolyTraj, Vec3};
 use trust_manager::{Event, Hit, StepReport};
+use trust_planner::{AnyManager, FrontendSpec, ResolvedPlanner};
 use trust_plot::quantile_sorted;
 use trust_predict::{Forecast, ObstacleShape};
 use trust_route::GlobalRoute;
@@ -53,13 +56,13 @@ use trust_runlog::{
 };
 use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle, VehicleState};
 use trust_world::World;
-use trust_world::planner::{self, AnyManager, FrontendSpec, ResolvedPlanner};
 use trust_world::scenario::VehicleModel;
 use trust_world::sensing::Sensing;
 use trust_world::traffic::{MovingShape, Traffic};
 
 pub mod closed_loop;
 mod error;
+pub mod scenario;
 pub use closed_loop::{
     Clearances, Clock, Contact, CycleEvent, Ending, FlightObserver, FlightState, LoopParams,
     UNREACHABLE_SETTLE_S, obstacle_walls,
@@ -304,7 +307,7 @@ pub struct Setup {
 pub fn set_up(world: &World, planner: &ResolvedPlanner) -> Result<Setup, FlightError> {
     let traffic = world.traffic()?;
     let mut sensing = world.sensing()?;
-    let mut manager = planner::build(planner, &world.planner_context())?;
+    let mut manager = trust_planner::build(planner, &scenario::planner_context(world))?;
     // The scenes are built on this map: the manager's worker may read it between cycles.
     manager.share_map(world.planner_map_shared());
     sensing.update(0.0, traffic.positions())?;
@@ -905,8 +908,7 @@ mod tests {
             [[random_obstacles]]\ncount = 1\nspeed_m_s = [0.5, 1.0]\n\
             [[obstacles]]\nshape = \"sphere\"\nradius_m = 0.5\nposition = [30, 5, 5]\nvelocity = [0, 1, 0]\n";
         let s =
-            trust_world::scenario::Scenario::from_toml_str(text, std::path::Path::new("r.toml"))
-                .unwrap();
+            crate::scenario::Scenario::from_toml_str(text, std::path::Path::new("r.toml")).unwrap();
         let world = World::build(&s).unwrap();
         let walls = obstacle_walls(&world);
         let region = Aabb::new(Vec3::new(8.0, 0.0, 0.0), Vec3::new(52.0, 20.0, 10.0)).unwrap();

@@ -4,7 +4,7 @@
 //!
 //! The reference cruises at `a_from`, swings linearly (a quintic with matched ends) to `a_to`
 //! within `swing_s`, and holds. The planner plans with `a_max·(1 − h)`
-//! (`trust_world::planner::DEFAULT_ACCEL_HEADROOM`) and penalizes jerk above `a_max / ramp`
+//! (`trust_planner::DEFAULT_ACCEL_HEADROOM`) and penalizes jerk above `a_max / ramp`
 //! (`PRESET_JERK_RAMP_S`): the worst swing it plans is a full reversal of `0.9 a_max` at that
 //! jerk, which must stay within `1.05 a_max` on the true vehicle — at a Crazyflie's 3 m/s² and at
 //! E4's 15 m/s². The fallbacks and the feedback are not as gentle: a swing to the full `a_max`
@@ -14,8 +14,8 @@
 
 use trust_core::{PolyTraj, Vec3};
 use trust_manager::hermite_quintic;
+use trust_planner::{DEFAULT_ACCEL_HEADROOM, PRESET_JERK_RAMP_S};
 use trust_vehicle::{ControlledQuadrotor, QuadrotorParams, Reference, Se3Gains, Vehicle};
-use trust_world::planner::{DEFAULT_ACCEL_HEADROOM, PRESET_JERK_RAMP_S};
 
 /// Peak true acceleration (m/s²) of the default quadrotor, with the controller capped at
 /// `a_max`, on a reference whose acceleration swings from `a_from` to `a_to` (along x) in

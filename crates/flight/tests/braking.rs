@@ -2,13 +2,13 @@
 //! vehicle creeps into the wall"): the default quadrotor model, cruising at `v_max` toward a wall,
 //! brakes with the manager's braking manoeuvre (`trust_manager::brake_straight`) and must stop
 //! clear of the wall by the tracking margin the planner assumes by default
-//! (`trust_world::planner::tracking_margin_for`): its deviation from the braking plan stays below
+//! (`trust_planner::tracking_margin_for`): its deviation from the braking plan stays below
 //! that margin, at E4's limits and at a Crazyflie's.
 
 use trust_core::{PolyTraj, State, Vec3};
 use trust_manager::{brake_straight, hermite_quintic};
+use trust_planner::{PlannerSpec, tracking_margin_for};
 use trust_vehicle::{ControlledQuadrotor, QuadrotorParams, Reference, Se3Gains, Vehicle};
-use trust_world::planner::{PlannerSpec, tracking_margin_for};
 
 /// Largest distance (m) between the true vehicle and its plan while it cruises at `v_max` for
 /// 2 s and then brakes to rest in front of a wall; and how far the true vehicle got beyond the

@@ -3,12 +3,13 @@
 //! measured wall time (times `cpu_scale`) and a busy planner skips ticks, which the log says.
 
 use trust_flight::closed_loop::{self, FlightObserver};
+use trust_flight::scenario::Scenario;
 use trust_flight::{
     Clearances, Clock, Contact, CycleEvent, Ending, FlightError, LoopParams, RunOptions, fly,
 };
 use trust_runlog::RunLog;
 use trust_world::World;
-use trust_world::scenario::{Latency, Scenario, VehicleModel};
+use trust_world::scenario::{Latency, VehicleModel};
 
 /// The quickstart scene with a perfect-tracking vehicle, flown for at most `limit_s`.
 fn quickstart(latency: Latency, limit_s: f64) -> Scenario {
@@ -16,7 +17,7 @@ fn quickstart(latency: Latency, limit_s: f64) -> Scenario {
         env!("CARGO_MANIFEST_DIR"),
         "/../../scenarios/quickstart.toml"
     );
-    let mut s = Scenario::load(std::path::Path::new(path)).expect("quickstart loads");
+    let mut s = trust_flight::scenario::load(std::path::Path::new(path)).expect("quickstart loads");
     s.vehicle.model = VehicleModel::Perfect;
     s.time_limit_s = limit_s;
     s.sim.latency = latency;
@@ -109,9 +110,9 @@ fn step_for(s: &Scenario, seconds: f64) -> (Counts, Option<Ending>) {
     let world = World::build(s).expect("world");
     let planner = match Clock::from_latency(s.sim.latency, 0.05) {
         Clock::RealTime { cpu_scale } => {
-            trust_flight::real_time_planner(&s.resolve_planner(), cpu_scale)
+            trust_flight::real_time_planner(&trust_flight::scenario::resolve_planner(&s), cpu_scale)
         }
-        Clock::Fixed { .. } => s.resolve_planner(),
+        Clock::Fixed { .. } => trust_flight::scenario::resolve_planner(&s),
     };
     let params = LoopParams::new(&world, &planner);
     let setup = trust_flight::set_up(&world, &planner).expect("setup");
@@ -176,7 +177,13 @@ fn a_real_time_flight_logs_its_charged_time_and_skipped_ticks() {
         log_path: Some(log_path.clone()),
         ..RunOptions::default()
     };
-    let flight = fly(&world, &s.resolve_planner(), &options, |_| {}).expect("flight");
+    let flight = fly(
+        &world,
+        &trust_flight::scenario::resolve_planner(&s),
+        &options,
+        |_| {},
+    )
+    .expect("flight");
     let log = RunLog::read(&log_path).expect("log reads");
     assert!(log.cycles.iter().all(|c| c.charged_ms.is_some()));
     let skipped: u64 = log.cycles.iter().filter_map(|c| c.overrun_ticks).sum();

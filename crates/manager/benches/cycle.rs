@@ -115,14 +115,14 @@ fn planner(config: Config) -> Planner {
         params.warm_max_evaluations = None;
         params.sub_branch_max_evaluations = None;
     }
-    // As the simulator's presets fly it (`trust_world::planner::closed_loop_backend`).
+    // As the simulator's presets fly it (`trust_planner::closed_loop_backend`).
     let mut backend = trust_minco::UtfMincoParams::default();
     backend.weights.time = 60.0;
     backend.weights.terminal = 60.0;
     backend.penalty.static_clearance_m = 0.5;
     params.safety.static_clearance_m = 0.3;
     Manager::new(
-        // As the reproducible presets fly it (`trust_world::planner::preset_dev_prm`): a 15 ms
+        // As the reproducible presets fly it (`trust_planner::preset_dev_prm`): a 15 ms
         // budget counted in work units, no wall clock.
         DevPrm::new(DevPrmParams {
             clearance: 0.3,

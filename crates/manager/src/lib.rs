@@ -65,9 +65,10 @@ pub use brake::{
 };
 pub use manager::{Branch, HOLD_CLEARANCE_M, MainDecision, Manager, choose_main};
 pub use params::{
-    GROWTH_FRACTION, ManagerParams, ReanchorParams, SOLVE_DEADLINE_FRACTION, SafetyParams,
+    GROWTH_FRACTION, ManagerOverrides, ManagerParams, ReanchorOverrides, ReanchorParams,
+    SOLVE_DEADLINE_FRACTION, SafetyOverrides, SafetyParams,
 };
-pub use progress::{ProgressMonitor, ProgressParams, StallRule};
+pub use progress::{ProgressMonitor, ProgressOverrides, ProgressParams, StallRule};
 pub use report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackKind, FallbackReport, FrontendReport,
     GoalUnreachable, LimitExcess, Origin, STUB_FRACTION, StepReport, SwitchReason,

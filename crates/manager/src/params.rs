@@ -2,7 +2,9 @@
 
 use crate::ProgressParams;
 use serde::{Deserialize, Serialize};
-use trust_core::{Limits, PlanError, RankingWeights, check_non_negative, check_positive};
+use trust_core::{
+    Limits, Overridable, PlanError, RankingWeights, check_non_negative, check_positive,
+};
 
 /// The default time the forecasts' uncertainty grows, as a fraction of the planning horizon
 /// ([`ManagerParams::forecast_growth`]): 1/16, 0.25 s at `T_h` = 4 s. Measured against 1/4 (the
@@ -18,7 +20,7 @@ pub const GROWTH_FRACTION: f64 = 1.0 / 16.0;
 /// 5`, `history = false`), baselines 1 and 2 (`max_branches = 1`, `history = false`, one explored
 /// path per cycle). See [`ManagerParams::trust`], [`ManagerParams::multi_branch_without_history`]
 /// and [`ManagerParams::single_branch`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Overridable)]
 #[serde(deny_unknown_fields, default)]
 pub struct ManagerParams {
     /// `N`, the most branches kept (Algorithm 1's `PopBack` beyond it). Paper: five
@@ -154,7 +156,10 @@ pub struct ManagerParams {
     pub progress: ProgressParams,
     /// The safety check every kept branch passes each cycle.
     pub safety: SafetyParams,
-    /// Seed of the manager's random number generator (handed to the frontend every cycle).
+    /// Seed of the manager's random number generator (handed to the frontend every cycle). Not
+    /// overridable: a trial seeds it ([`ManagerOverrides`] has no `seed`, so a scenario that
+    /// sets one gets an unknown-field error instead of a value silently replaced).
+    #[overrides(skip)]
     pub seed: u64,
 }
 
@@ -333,7 +338,7 @@ impl ManagerParams {
 }
 
 /// When the replan starts from the measured state instead of the committed trajectory.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Overridable)]
 #[serde(deny_unknown_fields, default)]
 pub struct ReanchorParams {
     /// Position drift (m) beyond which the manager re-anchors.
@@ -364,7 +369,7 @@ impl ReanchorParams {
 
 /// The safety check of a trajectory against the static map and the current forecasts
 /// ([`crate::check_trajectory`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Overridable)]
 #[serde(deny_unknown_fields, default)]
 pub struct SafetyParams {
     /// Largest time step (s) between checked instants where the clearance does not prove a larger
@@ -518,5 +523,34 @@ mod tests {
         p.brake_hold_s = Some(0.0);
         let e = p.validate().unwrap_err().to_string();
         assert!(e.contains("manager.brake_hold_s"), "{e}");
+    }
+    #[test]
+    fn overrides_are_derived_field_by_field_and_keep_the_rest() {
+        let o: ManagerOverrides = toml::from_str(
+            "horizon_s = 3.0\nwarm_max_evaluations = 20\nforecast_growth_s = inf\n\
+             [safety]\nrest_hold_s = 1.5\n[progress]\nwindow_horizon_fraction = 0.25\n",
+        )
+        .unwrap();
+        let mut p = ManagerParams::single_branch();
+        p.apply(&o);
+        assert_eq!(p.horizon_s, 3.0);
+        assert_eq!(p.warm_max_evaluations, Some(20));
+        assert_eq!(p.forecast_growth_s, Some(f64::INFINITY));
+        assert_eq!(p.safety.rest_hold_s, 1.5);
+        assert_eq!(p.safety.max_step_s, SafetyParams::default().max_step_s);
+        assert_eq!(p.progress.window_horizon_fraction, 0.25);
+        assert_eq!(p.max_branches, 1, "the preset's other fields stay");
+        assert!(ManagerOverrides::default().is_empty() && !o.is_empty());
+        // Unknown keys, and the seed a trial sets, are errors naming the key.
+        let e = toml::from_str::<ManagerOverrides>("seed = 3\n").unwrap_err();
+        assert!(e.to_string().contains("unknown field `seed`"), "{e}");
+        let e = toml::from_str::<ManagerOverrides>("[safety]\nmax_step = 0.1\n").unwrap_err();
+        assert!(e.to_string().contains("unknown field `max_step`"), "{e}");
+        // Written back, only the given fields appear.
+        let text = toml::to_string(&o).unwrap();
+        assert!(
+            text.contains("horizon_s = 3.0") && !text.contains("max_branches"),
+            "{text}"
+        );
     }
 }

@@ -19,12 +19,12 @@
 use std::collections::VecDeque;
 
 use serde::{Deserialize, Serialize};
-use trust_core::{Limits, PlanError, check_positive};
+use trust_core::{Limits, Overridable, PlanError, check_positive};
 
 use crate::Event;
 
 /// The thresholds of the progress monitor, relative to the vehicle and the horizon.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Overridable)]
 #[serde(deny_unknown_fields, default)]
 pub struct ProgressParams {
     /// The window as a fraction of the planning horizon `T_h`. Default 0.5 (beyond the paper):

@@ -60,7 +60,12 @@ pub mod banded;
 pub mod costs;
 pub mod error;
 pub mod minco;
-pub mod scenes;
+
+/// The deterministic and random E2 scenes (`trust-scenes`, re-exported: the tests, benches and
+/// `examples/e2_compare.rs` fly them).
+pub mod scenes {
+    pub use trust_scenes::e2::*;
+}
 
 pub use backend::{
     Minco, MincoObjective, MincoParams, PieceParams, SolverParams, UtfMinco, UtfMincoObjective,

@@ -29,10 +29,11 @@ use clap::{Parser, Subcommand, ValueEnum};
 use trust_experiments::flight_plots::write_flight_plots;
 use trust_experiments::study::{RunStudyOptions, Shard, StudyConfig, merge, run_study};
 use trust_experiments::suite::{SuiteConfig, SuiteOptions, expand_paths, run_suite};
+use trust_flight::scenario::Scenario;
 use trust_flight::{RunOptions, fly, header};
-use trust_world::World;
-use trust_world::planner::PlannerPreset;
-use trust_world::scenario::{Latency, MAX_CPU_SCALE, Scenario, VehicleModel};
+use trust_planner::PlannerPreset;
+use trust_world::scenario::{Latency, MAX_CPU_SCALE, VehicleModel};
+use trust_world::{World, WorldError};
 
 #[derive(Parser)]
 #[command(
@@ -371,7 +372,7 @@ fn run_cli() -> Result<ExitCode> {
             no_plots,
         } => {
             let planners = parse_presets(&planners)?;
-            let scenario_name = Scenario::load(&scenario)?.name;
+            let scenario_name = trust_flight::scenario::load(&scenario)?.name;
             let config = StudyConfig {
                 scenario,
                 scenario_name,
@@ -472,7 +473,7 @@ fn run_cli() -> Result<ExitCode> {
         Cmd::Validate { scenarios } => {
             let mut bad = 0;
             for path in &scenarios {
-                match trust_world::load_checked(path) {
+                match trust_flight::scenario::load_checked(path) {
                     Ok(_) => out!("{}: ok", path.display()),
                     Err(e) => {
                         bad += 1;
@@ -580,8 +581,17 @@ fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let tty = std::io::stderr().is_terminal();
     eprintln!("building the world of `{}` (seed {})...", s.name, s.seed);
+    // The world checks its sections; the planner's are checked here, where both are known.
+    let problems = trust_flight::scenario::problems(s);
+    if !problems.is_empty() {
+        return Err(WorldError::Invalid {
+            path: s.origin(),
+            problems,
+        }
+        .into());
+    }
     let world = World::build(s)?;
-    let planner = s.resolve_planner();
+    let planner = trust_flight::scenario::resolve_planner(&s);
     let log_path = out.join("run.jsonl");
     let options = RunOptions {
         log_path: Some(log_path.clone()),

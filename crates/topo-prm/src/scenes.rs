@@ -53,13 +53,13 @@ impl Default for SceneParams {
     fn default() -> Self {
         SceneParams {
             size: Vec3::new(20.0, 20.0, 10.0),
-            speed: (0.5, 3.0),
-            radius: (0.5, 1.5),
+            speed: trust_scenes::e1::SPEED_M_S,
+            radius: trust_scenes::e1::RADIUS_M,
             mu: (0.1, 0.3),
             r_safe: 0.0,
-            cylinder_fraction: 0.5,
+            cylinder_fraction: trust_scenes::e1::CYLINDER_FRACTION,
             margin: 1.0,
-            endpoint_clearance: 1.0,
+            endpoint_clearance: trust_scenes::e1::ENDPOINT_CLEARANCE_M,
             horizon_s: 2.0,
             limits: Limits::default(),
         }

@@ -95,7 +95,11 @@ struct Endpoints {
 /// Generates the layout of `s` in `bounds` from `seed` (the world stream). Assumes the sections
 /// it reads passed validation; errors are problems naming the generator or group that could not
 /// be placed.
-pub(crate) fn generate(s: &Scenario, bounds: &Aabb, seed: u64) -> Result<Layout, Vec<Problem>> {
+pub(crate) fn generate<P>(
+    s: &Scenario<P>,
+    bounds: &Aabb,
+    seed: u64,
+) -> Result<Layout, Vec<Problem>> {
     let mut rng = Rng::seed_from_u64(seed);
     let ends = Endpoints {
         start: Vec3::from(s.mission.start),
@@ -183,9 +187,9 @@ fn run_generator(
         }
         GeneratorSpec::E2Static(_) | GeneratorSpec::E2Dynamic(_) => {
             let case = if matches!(g, GeneratorSpec::E2Static(_)) {
-                trust_minco::scenes::e2_static()
+                trust_scenes::e2::e2_static()
             } else {
-                trust_minco::scenes::e2_dynamic()
+                trust_scenes::e2::e2_dynamic()
             };
             layout.shapes.extend(case.map.shapes().iter().copied());
             for (k, f) in case.forecasts.iter().enumerate() {
@@ -573,8 +577,8 @@ fn e4_static(
 
 /// Start and goal of `scenario` against its generated (true) geometry; `cloud` is the truth
 /// cloud read by the file checks.
-pub(crate) fn check_layout(
-    scenario: &Scenario,
+pub(crate) fn check_layout<P>(
+    scenario: &Scenario<P>,
     p: &mut Problems,
     layout: &Layout,
     cloud: Option<&[Vec3]>,

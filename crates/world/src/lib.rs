@@ -3,15 +3,16 @@
 //! The first stage of the simulator's data path (scenario file → world → closed loop → run log →
 //! experiments; paper Sec. IV): [`scenario`] parses and checks the TOML file, [`World::build`]
 //! generates the layout and the planner's map from the seeds, [`traffic`] moves the true obstacles
-//! (scripted ones along [`script`]), [`sensing`] turns them into the forecasts the planner sees, and
-//! [`planner`] turns the scenario's `[planner]` section into the parameters of the parts it names
-//! (the closed loop in `trust-flight` assembles them). Errors are [`WorldError`]s naming the file,
-//! field and value.
+//! (scripted ones along [`script`]) and [`sensing`] turns them into the forecasts the planner
+//! sees. The planner is not the world's: the scenario's `[planner]` section is a type parameter
+//! of [`Scenario`] the world never looks inside, read and assembled by `trust-planner` where the
+//! closed loop composes the two (`trust_flight::scenario`). Errors are [`WorldError`]s naming
+//! the file, field and value.
 //!
 //! Use it to load a scenario and build its world: [`World::build`] validates the scenario, generates
 //! the layout from the world seed ([`Seeds::world`]) and builds the planner's map. Everything that
 //! varies between planners of one trial is created from the world afterwards: [`World::traffic`],
-//! [`World::sensing`], [`World::planner_context`]. A world is immutable and `Send + Sync`: build it
+//! [`World::sensing`]. A world is immutable and `Send + Sync`: build it
 //! once per trial and share it read-only (`Arc<World>`); E4's voxel map takes about 5 s and 0.9 GB.
 //!
 //! # Truth and the planner's view
@@ -33,16 +34,17 @@
 //!
 //! # Validation
 //!
-//! [`check`] (`trust-sim validate`) runs every check [`World::build`] and a flight's set-up run:
+//! [`check`] runs every check [`World::build`] and a flight's set-up run on the world's part:
 //! the file's checks with the scale policy ([`scenario::scale`]), the layout, and the traffic,
-//! sensor, planner assembly and vehicle model of the flight; a file it accepts builds and
-//! starts. Files the scenario names are read under [`files`]' caps and path policy.
+//! sensor and vehicle model of the flight (`trust_flight::scenario::check` adds the planner's
+//! section and its assembly: `trust-sim validate`). Files the scenario names are read under [`files`]' caps and path policy.
 //!
 //! ```no_run
 //! use std::path::Path;
-//! use trust_world::{World, load_checked};
+//! use trust_world::{Scenario, World, load_checked};
 //!
-//! let scenario = load_checked(Path::new("scenarios/quickstart.toml"))?;
+//! // The `[planner]` section read as a plain table (the simulator reads it typed).
+//! let scenario: Scenario = load_checked(Path::new("scenarios/quickstart.toml"))?;
 //! let world = World::build(&scenario)?;
 //! println!("{} static shapes", world.static_shapes().len());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -54,7 +56,6 @@ pub mod error;
 pub mod files;
 pub(crate) mod generate;
 mod kdtree;
-pub mod planner;
 pub mod problem;
 mod sampling;
 pub mod scenario;
@@ -76,8 +77,8 @@ pub use sampling::sample_shapes;
 pub use seeds::{Seeds, mix_seed};
 
 pub use crate::error::WorldError;
-use crate::planner::PlannerContext;
-use crate::scenario::{PointCloudSpec, Scenario, StaticShape};
+pub use crate::scenario::Scenario;
+use crate::scenario::{PointCloudSpec, StaticShape};
 use crate::sensing::Sensing;
 use crate::traffic::{MovingObstacle, Traffic};
 
@@ -109,7 +110,8 @@ pub struct BuildStats {
 /// The world of one trial (module docs).
 #[derive(Debug, Clone)]
 pub struct World {
-    scenario: Scenario,
+    /// The scenario without its `[planner]` section (the flight's, not the world's).
+    scenario: Scenario<()>,
     bounds: Aabb,
     shapes: Vec<Shape>,
     truth_map: StaticMap,
@@ -129,7 +131,7 @@ impl World {
     /// [`WorldError::Invalid`] with every problem of the scenario; [`WorldError::Read`] /
     /// [`WorldError::PointsFile`] for the points file; [`WorldError::Geometry`] if a map cannot be
     /// built (only for inputs validation lets through by mistake).
-    pub fn build(scenario: &Scenario) -> Result<World, WorldError> {
+    pub fn build<P: Clone>(scenario: &Scenario<P>) -> Result<World, WorldError> {
         let t0 = Instant::now();
         let origin = scenario.origin();
         let Prepared {
@@ -223,7 +225,7 @@ impl World {
             total_ms: ms_since(t0),
         };
         Ok(World {
-            scenario: scenario.clone(),
+            scenario: scenario.with_planner(()),
             bounds,
             shapes: layout.shapes,
             truth_map,
@@ -245,7 +247,7 @@ impl World {
     ///
     /// # Errors
     /// As [`World::build`] when a rebuild is needed.
-    pub fn with_scenario(mut self, scenario: &Scenario) -> Result<World, WorldError> {
+    pub fn with_scenario<P: Clone>(mut self, scenario: &Scenario<P>) -> Result<World, WorldError> {
         let (a, b) = (&self.scenario, scenario);
         let same_world = a.seed == b.seed
             && a.world == b.world
@@ -265,12 +267,13 @@ impl World {
                 problems,
             });
         }
-        self.scenario = scenario.clone();
+        self.scenario = scenario.with_planner(());
         Ok(self)
     }
 
-    /// The scenario it was built from.
-    pub fn scenario(&self) -> &Scenario {
+    /// The scenario it was built from, without its `[planner]` section (a flight is given its
+    /// planner separately: `trust_flight::fly`).
+    pub fn scenario(&self) -> &Scenario<()> {
         &self.scenario
     }
 
@@ -405,17 +408,6 @@ impl World {
         s.warm_up(&positions, &velocities)?;
         Ok(s)
     }
-
-    /// What [`crate::planner::build`] needs: limits, vehicle radius, map error and the planner
-    /// seed.
-    pub fn planner_context(&self) -> PlannerContext {
-        PlannerContext {
-            limits: self.limits(),
-            vehicle_radius_m: self.vehicle_radius_m(),
-            static_map_error_m: self.static_map_error_m,
-            seed: self.seeds.planner,
-        }
-    }
 }
 
 /// What [`World::build`] starts from: the checked scenario's bounds, its generated layout and the
@@ -427,8 +419,9 @@ struct Prepared {
 }
 
 /// The planner map's error bound of `scenario`'s static map ([`esdf_error_bound`] of its cloud,
-/// 0 without one): what [`World::static_map_error_m`] will be, known before the map is built.
-fn static_map_error_for(scenario: &Scenario) -> f64 {
+/// 0 without one): what [`World::static_map_error_m`] will be, known before the map is built
+/// (the planner's assembly is checked with it before a world exists).
+pub fn static_map_error_for<P>(scenario: &Scenario<P>) -> f64 {
     match &scenario.static_map.point_cloud {
         None => 0.0,
         Some(PointCloudSpec::Shapes {
@@ -443,11 +436,12 @@ fn static_map_error_for(scenario: &Scenario) -> f64 {
 
 /// What a flight sets up before its first step (`trust_flight::set_up` and the vehicle), run
 /// on the generated layout so that validation rejects what the flight would: the true traffic,
-/// the warmed-up sensor and its first round, the assembled planner ([`planner::build`]) and the
-/// vehicle model at rest on the start. Their errors are reported on the section the file wrote
-/// (`obstacles`, `sensing`, `planner`, `vehicle`); the scale policy keeps every derived
-/// parameter in range, so these are a backstop, not the usual message.
-fn preflight(scenario: &Scenario, layout: &generate::Layout, p: &mut problem::Problems) {
+/// the warmed-up sensor and its first round and the vehicle model at rest on the start (the
+/// planner's assembly is checked where the planner is known, `trust_flight::scenario::check`).
+/// Their errors are reported on the section the file wrote (`obstacles`, `sensing`, `vehicle`);
+/// the scale policy keeps every derived parameter in range, so these are a backstop, not the
+/// usual message.
+fn preflight<P>(scenario: &Scenario<P>, layout: &generate::Layout, p: &mut problem::Problems) {
     let seeds = scenario.seeds();
     let mut problem = |section: &str, what: &str, e: &dyn std::fmt::Display| {
         p.push(
@@ -486,19 +480,6 @@ fn preflight(scenario: &Scenario, layout: &generate::Layout, p: &mut problem::Pr
     if let Err(e) = sensed {
         problem("sensing", "the sensor and tracker", &e);
     }
-    let ctx = PlannerContext {
-        limits: scenario.vehicle.limits,
-        vehicle_radius_m: scenario.vehicle.radius_m,
-        static_map_error_m: static_map_error_for(scenario),
-        seed: seeds.planner,
-    };
-    if let Err(e) = planner::build(&scenario.resolve_planner(), &ctx) {
-        problem(
-            "planner",
-            "the planner assembly (with vehicle.limits and vehicle.radius_m)",
-            &e,
-        );
-    }
     let hover = trust_vehicle::Reference::hover(Vec3::from(scenario.mission.start));
     let vehicle = match scenario.vehicle.model {
         scenario::VehicleModel::Quadrotor => {
@@ -529,7 +510,7 @@ fn preflight(scenario: &Scenario, layout: &generate::Layout, p: &mut problem::Pr
 /// valid, start and goal against the generated layout, and then what a flight sets up before
 /// its first step ([`preflight`]). The layout is generated once and the points file read once;
 /// `Err` holds every problem, in file order, layout problems last.
-fn prepare(scenario: &Scenario) -> Result<Prepared, Vec<scenario::Problem>> {
+fn prepare<P>(scenario: &Scenario<P>) -> Result<Prepared, Vec<scenario::Problem>> {
     let file = scenario.check_file();
     let mut problems = file.problems;
     let mut layout = None;
@@ -564,20 +545,22 @@ fn prepare(scenario: &Scenario) -> Result<Prepared, Vec<scenario::Problem>> {
 
 /// Every problem of `scenario`, as [`World::build`] finds them, without building the maps:
 /// [`Scenario::validate`]'s (with the scale policy, [`scenario::scale`]), start and goal against
-/// the generated layout, and what a flight sets up before its first step (traffic, sensing,
-/// [`planner::build`], the vehicle model) — `trust-sim validate`. Empty: [`World::build`] will
-/// not reject the scenario and a flight of it starts (its maps are within the caps checked
-/// here: ESDF voxels, cloud points).
-pub fn check(scenario: &Scenario) -> Vec<scenario::Problem> {
+/// the generated layout, and what a flight sets up before its first step (traffic, sensing, the
+/// vehicle model). Empty: [`World::build`] will not reject the scenario (its maps are within the
+/// caps checked here: ESDF voxels, cloud points); `trust_flight::scenario::check` adds the
+/// planner's section — `trust-sim validate`.
+pub fn check<P>(scenario: &Scenario<P>) -> Vec<scenario::Problem> {
     prepare(scenario).err().unwrap_or_default()
 }
 
-/// Reads, parses and fully checks a scenario file ([`Scenario::parse_file`], then [`check`]):
-/// what `trust-sim validate` reports, without building the maps.
+/// Reads, parses and checks a scenario file ([`Scenario::parse_file`], then [`check`]) without
+/// building the maps; its `[planner]` section is read as `P` and not checked.
 ///
 /// # Errors
 /// [`WorldError::Read`], [`WorldError::Parse`], or [`WorldError::Invalid`] with every problem.
-pub fn load_checked(path: &Path) -> Result<Scenario, WorldError> {
+pub fn load_checked<P: serde::de::DeserializeOwned + Default + Clone>(
+    path: &Path,
+) -> Result<Scenario<P>, WorldError> {
     let s = Scenario::parse_file(path)?;
     let problems = check(&s);
     if problems.is_empty() {

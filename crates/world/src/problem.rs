@@ -92,7 +92,7 @@ pub fn fmt_num(x: f64) -> String {
 /// A value another crate formatted (`{:?}` of an `f64` or a vector of them:
 /// `-1.7976931348623157e308`, `[0.30000000000000004, 2.0]`) with every number of more than 6
 /// significant digits or 12 characters written by [`fmt_num`]; other text (and `-5.0`) is kept.
-pub(crate) fn readable_value(value: &str) -> String {
+pub fn readable_value(value: &str) -> String {
     let mut out = String::with_capacity(value.len());
     let mut word = String::new();
     let flush = |word: &mut String, out: &mut String| {

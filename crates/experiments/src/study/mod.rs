@@ -31,11 +31,11 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::ExperimentError;
+use trust_flight::scenario::Scenario;
 use trust_flight::{RunOptions, fly};
+use trust_planner::PlannerPreset;
 use trust_world::World;
 use trust_world::WorldError;
-use trust_world::planner::PlannerPreset;
-use trust_world::scenario::Scenario;
 
 pub use variant::Variant;
 
@@ -409,7 +409,7 @@ pub fn run_study(
     options: &RunStudyOptions,
 ) -> Result<Vec<RunRow>, ExperimentError> {
     config.validate()?;
-    let base = Scenario::load(&config.scenario)?;
+    let base = trust_flight::scenario::load(&config.scenario)?;
     // Fail early on a variant or planner that does not apply, before any world is built.
     for &p in &config.planners {
         let s = config.trial_scenario(&base, 0, p)?;
@@ -471,7 +471,7 @@ fn run_trial(
             Some(w) => w.with_scenario(&s)?,
             None => World::build(&s)?,
         };
-        let planner_spec = s.resolve_planner();
+        let planner_spec = trust_flight::scenario::resolve_planner(&s);
         let rel = format!("logs/{}/trial-{trial:04}.jsonl", planner.name());
         let flight = fly_logged(&w, &s, &planner_spec, &out.join(&rel))?;
         let s = &flight.summary;
@@ -521,7 +521,7 @@ fn sort_rows(rows: &mut [RunRow], planners: &[PlannerPreset]) {
 pub(crate) fn fly_logged(
     world: &World,
     scenario: &Scenario,
-    planner: &trust_world::planner::ResolvedPlanner,
+    planner: &trust_planner::ResolvedPlanner,
     log_path: &Path,
 ) -> Result<trust_flight::Flight, ExperimentError> {
     if let Some(dir) = log_path.parent() {

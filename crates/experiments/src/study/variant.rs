@@ -8,8 +8,9 @@ use trust_minco::MincoParams;
 use trust_topo_prm::{UvdParams, VprmParams};
 
 use crate::ExperimentError;
-use trust_world::planner::{BackendSpec, CheckerSpec, FrontendSpec};
-use trust_world::scenario::{Latency, MAX_CPU_SCALE, Scenario, VehicleModel};
+use trust_flight::scenario::Scenario;
+use trust_planner::{BackendSpec, CheckerSpec, FrontendSpec};
+use trust_world::scenario::{Latency, MAX_CPU_SCALE, VehicleModel};
 
 /// An ablation: one component changed for every planner it concerns (the others fly as they
 /// are). Written and parsed as in the list below.
@@ -143,8 +144,8 @@ impl Variant {
 
 /// The scenario's `[planner.manager]` overrides, created empty if absent.
 fn manager_overrides(
-    planner: &mut trust_world::planner::PlannerSpec,
-) -> &mut trust_world::planner::ManagerOverrides {
+    planner: &mut trust_planner::PlannerSpec,
+) -> &mut trust_planner::ManagerOverrides {
     planner.manager.get_or_insert_default()
 }
 
@@ -251,10 +252,10 @@ impl<'de> Deserialize<'de> for Variant {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use trust_world::planner::PlannerPreset;
+    use trust_planner::PlannerPreset;
 
     fn scenario() -> Scenario {
-        Scenario::load(std::path::Path::new(concat!(
+        trust_flight::scenario::load(std::path::Path::new(concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../scenarios/quickstart.toml"
         )))

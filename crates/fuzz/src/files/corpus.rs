@@ -1,7 +1,7 @@
 //! What the file groups mutate, and where a case's files live.
 //!
 //! * **Scenarios**: every `scenarios/**/*.toml` of the repository, and the broken and probe files
-//!   of `crates/world/tests/data` (lower weight), parsed as TOML documents. A file whose planner
+//!   of `crates/flight/tests/data` (lower weight), parsed as TOML documents. A file whose planner
 //!   map would have more than [`CORPUS_MAX_VOXELS`] ESDF voxels (E4 and the point-cloud forests
 //!   at 0.1–0.3 m) is coarsened in the corpus (its `esdf_voxel_m` and `spacing_m` raised until it
 //!   fits), so that a case builds in milliseconds; mutations still drive voxel sizes to their
@@ -19,7 +19,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, Result, bail};
-use trust_world::scenario::{PointCloudSpec, Scenario};
+use trust_flight::scenario::Scenario;
+use trust_world::scenario::PointCloudSpec;
 
 /// Largest planner-map ESDF of a corpus scenario (voxels); larger ones are coarsened.
 pub const CORPUS_MAX_VOXELS: f64 = 250_000.0;
@@ -140,8 +141,8 @@ pub fn load_scenarios(root: &Path) -> Result<Vec<ScenarioBase>> {
     let mut out = Vec::new();
     for (dir, weight) in [
         ("scenarios", 10),
-        ("crates/world/tests/data/broken", 2),
-        ("crates/world/tests/data/probe", 2),
+        ("crates/flight/tests/data/broken", 2),
+        ("crates/flight/tests/data/probe", 2),
     ] {
         let mut files = Vec::new();
         toml_files(&root.join(dir), &mut files)?;
@@ -267,7 +268,7 @@ pub fn generate_logs(scenarios: &[ScenarioBase], dir: &Path) -> Result<Vec<BaseL
         let mut s = Scenario::from_toml_str(&text, &scenario_path)?;
         s.time_limit_s = time_limit;
         let world = trust_world::World::build(&s)?;
-        let planner = s.resolve_planner();
+        let planner = trust_flight::scenario::resolve_planner(&s);
         let log_path = folder.join("run.jsonl");
         let options = RunOptions {
             log_path: Some(log_path.clone()),

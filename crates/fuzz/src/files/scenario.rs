@@ -16,10 +16,11 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use trust_flight::scenario::Scenario;
 use trust_flight::{Clock, LoopParams, header, real_time_planner, set_up};
 use trust_runlog::{LogWriter, Record};
 use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference};
-use trust_world::scenario::{Scenario, VehicleModel};
+use trust_world::scenario::VehicleModel;
 use trust_world::{World, WorldError};
 
 use super::corpus::{CaseDir, esdf_voxels};
@@ -41,7 +42,7 @@ const SCENARIO: &str = "scenario.toml";
 pub fn run_set_up(path: &Path, log: &Path) -> Result<(), String> {
     let s = Scenario::parse_file(path).map_err(|e| e.to_string())?;
     let world = World::build(&s).map_err(|e| e.to_string())?;
-    let planner = s.resolve_planner();
+    let planner = trust_flight::scenario::resolve_planner(&s);
     let params = LoopParams::new(&world, &planner);
     let planner = match params.clock {
         Clock::RealTime { cpu_scale } => real_time_planner(&planner, cpu_scale),
@@ -74,7 +75,7 @@ pub fn run_set_up(path: &Path, log: &Path) -> Result<(), String> {
 /// `input` is every file the case wrote (for the readability oracle).
 fn judge(ctx: &Ctx, dir: &CaseDir, input: &str, v: &mut Verdict) {
     let path = dir.case.join(SCENARIO);
-    let validate = trust_world::load_checked(&path);
+    let validate = trust_flight::scenario::load_checked(&path);
     if let Err(e) = &validate {
         v.readable(&e.to_string(), input);
     }

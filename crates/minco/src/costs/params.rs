@@ -151,7 +151,7 @@ pub struct PenaltyParams {
     /// `a_max / jerk_ramp_s` ([`PenaltyParams::jerk_limit`]); 0 (the default, the paper's
     /// `I_d`) switches it off. Beyond the paper: a quadrotor's attitude lags a reference whose
     /// acceleration swings faster than that, and its true acceleration overshoots the plan's
-    /// (`trust_world::planner::closed_loop_backend` sets 0.3 s).
+    /// (`trust_planner::closed_loop_backend` sets 0.3 s).
     pub jerk_ramp_s: f64,
 }
 

@@ -17,9 +17,9 @@ pub enum GeneratorSpec {
     /// Sim-A-1-1(c)), a 20 × 20 × 10 m box with random moving obstacles.
     E1(E1Params),
     /// `{ kind = "e2-static" }`: the static case of experiment E2 (paper Sec. IV-B, Table
-    /// Sim-A-2), `trust_minco::scenes::e2_static`.
+    /// Sim-A-2), `trust_scenes::e2::e2_static`.
     E2Static(E2Params),
-    /// `{ kind = "e2-dynamic" }`: the dynamic case of E2, `trust_minco::scenes::e2_dynamic`.
+    /// `{ kind = "e2-dynamic" }`: the dynamic case of E2, `trust_scenes::e2::e2_dynamic`.
     E2Dynamic(E2Params),
     /// `{ kind = "e3" }`: experiment E3 (paper Sec. IV-C, Table Sim-B-1), the setting of Fig.
     /// Sim-A-1-1(a): goal 65 m ahead, moving obstacles near the start.
@@ -107,7 +107,7 @@ pub(crate) fn check_motion(field: &str, m: &Motion, p: &mut Problems) {
 pub struct E2Params {}
 
 /// Parameters of the E1 generator. The obstacle distributions are E1's random scenes
-/// (`trust_topo_prm::scenes::SceneParams::default()`, see
+/// (`trust_scenes::e1`, see
 /// [`crate::scenario::RandomObstacles`]'s defaults).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -180,7 +180,7 @@ pub struct E4Params {
     /// Smallest horizontal gap between the footprints of two static obstacles (m), so that
     /// there are passages everywhere. Default 2.5 m (about eight vehicle radii; the backend's
     /// static clearance at 0.2 m voxels is 0.3 + 0.1 + 0.35 = 0.75 m on each side, so a 1 m wide
-    /// corridor remains — see `crate::planner` and `World::static_map_error_m`).
+    /// corridor remains — see `trust_planner::assemble` and `World::static_map_error_m`).
     pub min_gap_m: f64,
     /// No static footprint comes within this horizontal distance of the start or the goal (m).
     /// Default 10 m.

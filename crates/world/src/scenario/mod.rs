@@ -78,14 +78,14 @@
 //! limits = { v_max = 10.0, a_max = 15.0 }
 //! model = "quadrotor"            # quadrotor | perfect; [vehicle.quadrotor], [vehicle.gains]
 //!
-//! [planner]
+//! [planner]                      # read by the planner's crate (trust_planner::PlannerSpec)
 //! name = "trust"                 # trust | baseline1 | baseline2 | baseline3
-//! reproducible = true            # no wall-clock budgets (crate::planner)
+//! reproducible = true            # no wall-clock budgets (trust_planner::assemble)
 //! # frontend = { kind = "v-prm", budget_ms = 20 }   # dev-prm | v-prm | straight-line | sparse-a-star
 //! # backend = { kind = "minco" }                    # utf-minco | minco
 //! # checker = { kind = "uvd" }                      # tvd | uvd
-//! # tracking_margin_m = 0.02                        # default 0.01 + 0.0015 a_max (crate::planner)
-//! # [planner.manager]                               # merged onto the preset's ManagerParams
+//! # tracking_margin_m = 0.02                        # default 0.01 + 0.0015 a_max (trust_planner)
+//! # [planner.manager]                               # single fields of the preset's ManagerParams
 //! # horizon_s = 3.0
 //! # [planner.route]                                 # the global route, on by default;
 //! # enabled = false                                 # false: the paper's setting (aim at the goal)
@@ -146,6 +146,7 @@ mod validate;
 
 use std::path::{Path, PathBuf};
 
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use trust_core::Aabb;
 
@@ -161,15 +162,22 @@ pub use sections::{
 pub use trust_runlog::StaticShape;
 
 use crate::error::WorldError;
-use crate::planner::{PlannerSpec, ResolvedPlanner};
 use crate::seeds::Seeds;
 use crate::sensing::SensingParams;
 use crate::traffic::TrafficParams;
 
 /// One scenario file (module docs for the format).
+///
+/// `P` is the `[planner]` section as the crate that assembles the planner reads it: the world
+/// never looks inside (it depends on no planner crate). The simulator reads files as
+/// `Scenario<trust_planner::PlannerSpec>` (`trust_flight::scenario::Scenario`), so a wrong
+/// planner field is a parse error with its line like any other, and checks it with the rest
+/// (`trust_flight::scenario::check`); the default, a plain TOML table, reads any `[planner]`
+/// section unchecked (the world's own tests and tools). [`Scenario::validate`] and
+/// [`crate::check`] check everything but that section.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Scenario {
+pub struct Scenario<P = toml::Table> {
     /// Name, for reports and the run log header's `scenario`.
     pub name: String,
     /// Free text: what the scenario reproduces.
@@ -198,9 +206,9 @@ pub struct Scenario {
     /// `[vehicle]`: radius, limits and model.
     #[serde(default)]
     pub vehicle: VehicleSection,
-    /// `[planner]`: preset and overrides.
+    /// `[planner]`: preset and overrides, read by the planner's crate (`P`, type docs).
     #[serde(default)]
-    pub planner: PlannerSpec,
+    pub planner: P,
     /// `[sensing]`: obstacle sensor and tracker.
     #[serde(default)]
     pub sensing: SensingParams,
@@ -243,14 +251,14 @@ impl LogSection {
     }
 }
 
-impl Scenario {
+impl<P: DeserializeOwned + Default + Clone> Scenario<P> {
     /// Parses scenario text; `origin` names it in errors and gives the folder relative paths are
     /// resolved against (its parent). Does not validate.
     ///
     /// # Errors
     /// [`WorldError::Parse`] with toml's message (line, column, snippet).
-    pub fn from_toml_str(text: &str, origin: &Path) -> Result<Scenario, WorldError> {
-        let mut s: Scenario = toml::from_str(text).map_err(|e| WorldError::Parse {
+    pub fn from_toml_str(text: &str, origin: &Path) -> Result<Scenario<P>, WorldError> {
+        let mut s: Scenario<P> = toml::from_str(text).map_err(|e| WorldError::Parse {
             path: origin.to_path_buf(),
             message: files::parser_message(e.to_string().trim_end()),
         })?;
@@ -264,7 +272,7 @@ impl Scenario {
     /// # Errors
     /// [`WorldError::Read`], [`WorldError::NotAFile`], [`WorldError::TooLarge`],
     /// [`WorldError::Parse`].
-    pub fn parse_file(path: &Path) -> Result<Scenario, WorldError> {
+    pub fn parse_file(path: &Path) -> Result<Scenario<P>, WorldError> {
         let text = files::read_text(path, files::MAX_SCENARIO_BYTES, "a scenario file")?;
         Scenario::from_toml_str(&text, path)
     }
@@ -276,7 +284,7 @@ impl Scenario {
     /// # Errors
     /// [`WorldError::Read`], [`WorldError::Parse`], or [`WorldError::Invalid`] with every problem
     /// [`Scenario::validate`] found.
-    pub fn load(path: &Path) -> Result<Scenario, WorldError> {
+    pub fn load(path: &Path) -> Result<Scenario<P>, WorldError> {
         let s = Scenario::parse_file(path)?;
         let problems = s.validate();
         if problems.is_empty() {
@@ -288,10 +296,12 @@ impl Scenario {
             })
         }
     }
+}
 
+impl<P: Clone> Scenario<P> {
     /// The same scenario with another trial seed (Monte Carlo trials).
     #[must_use]
-    pub fn with_seed(&self, seed: u64) -> Scenario {
+    pub fn with_seed(&self, seed: u64) -> Scenario<P> {
         let mut s = Scenario {
             seed,
             ..self.clone()
@@ -340,7 +350,9 @@ impl Scenario {
         }
         s
     }
+}
 
+impl<P> Scenario<P> {
     /// The seeds of this trial's random streams.
     pub fn seeds(&self) -> Seeds {
         Seeds::from_trial(self.seed)
@@ -368,23 +380,52 @@ impl Scenario {
             .clone()
             .unwrap_or_else(|| PathBuf::from(format!("<scenario {}>", self.name)))
     }
+}
 
-    /// The planner with every part chosen ([`PlannerSpec::resolve`]). A fixed `sim.latency`
-    /// with `seconds` is the one owner of the delay: it becomes the manager's `latency_s`, so the
-    /// manager plans for the delay the loop applies (validation rejects a different
-    /// `[planner.manager] latency_s`), so the loop's `sim.latency.seconds` and the manager's
-    /// `latency()` are one value wherever both exist.
-    pub fn resolve_planner(&self) -> ResolvedPlanner {
-        let mut r = self.planner.resolve();
-        if let Latency::Fixed {
-            seconds: Some(seconds),
-        } = self.sim.latency
-        {
-            r.manager.latency_s = Some(seconds);
+impl<P: Clone> Scenario<P> {
+    /// The same scenario with its `[planner]` section replaced by `planner` (of any type): a
+    /// world keeps its scenario without the planner (`Scenario<()>`, [`crate::World::scenario`]).
+    pub fn with_planner<Q>(&self, planner: Q) -> Scenario<Q> {
+        let Scenario {
+            name,
+            description,
+            seed,
+            time_limit_s,
+            world,
+            static_map,
+            obstacles,
+            random_obstacles,
+            mission,
+            vehicle,
+            planner: _,
+            sensing,
+            traffic,
+            sim,
+            log,
+            path,
+        } = self.clone();
+        Scenario {
+            name,
+            description,
+            seed,
+            time_limit_s,
+            world,
+            static_map,
+            obstacles,
+            random_obstacles,
+            mission,
+            vehicle,
+            planner,
+            sensing,
+            traffic,
+            sim,
+            log,
+            path,
         }
-        r
     }
+}
 
+impl<P: Serialize> Scenario<P> {
     /// The scenario as TOML text (round-trips through [`Scenario::from_toml_str`]).
     ///
     /// # Errors
@@ -404,8 +445,9 @@ mod log_section_tests {
 
     #[test]
     fn the_log_section_is_optional_typed_and_closed() {
-        let parse =
-            |extra: &str| Scenario::from_toml_str(&format!("{BASE}{extra}"), Path::new("t.toml"));
+        let parse = |extra: &str| {
+            Scenario::<toml::Table>::from_toml_str(&format!("{BASE}{extra}"), Path::new("t.toml"))
+        };
         let none = parse("").unwrap();
         assert_eq!(none.log.branches, None);
         assert!(none.log.branches_or(true) && !none.log.branches_or(false));

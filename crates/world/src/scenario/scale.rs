@@ -127,7 +127,7 @@ pub(crate) fn check_sampled_points(p: &mut Problems, field: &str, value: f64, co
     }
 }
 
-impl Scenario {
+impl<P> Scenario<P> {
     /// The scale policy (module docs) on every value the file sets; `bounds` are the world
     /// bounds if valid.
     pub(crate) fn check_scale(&self, p: &mut Problems, bounds: Option<&Aabb>) {

@@ -337,7 +337,7 @@ impl ObstacleSpec {
 /// the horizontal. Placements that come within `vehicle.radius_m + endpoint_clearance_m` of the
 /// start or the goal, or (with `avoid_static`) overlap a static shape, are redrawn (up to 1000
 /// times per obstacle). Defaults are those of experiment E1's random scenes
-/// (`trust_topo_prm::scenes::SceneParams::default()`: radii 0.5–1.5 m, speeds 0.5–3 m/s, half
+/// (`trust_scenes::e1`: radii 0.5–1.5 m, speeds 0.5–3 m/s, half
 /// cylinders, full-height cylinders, directions uniform on the sphere, 1 m endpoint clearance).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -370,17 +370,17 @@ pub struct RandomObstacles {
 
 impl Default for RandomObstacles {
     fn default() -> Self {
-        let e1 = trust_topo_prm::scenes::SceneParams::default();
+        use trust_scenes::e1;
         RandomObstacles {
             count: 10,
-            cylinder_fraction: e1.cylinder_fraction,
-            sphere_radius_m: [e1.radius.0, e1.radius.1],
-            cylinder_radius_m: [e1.radius.0, e1.radius.1],
+            cylinder_fraction: e1::CYLINDER_FRACTION,
+            sphere_radius_m: [e1::RADIUS_M.0, e1::RADIUS_M.1],
+            cylinder_radius_m: [e1::RADIUS_M.0, e1::RADIUS_M.1],
             cylinder_half_height_m: None,
-            speed_m_s: [e1.speed.0, e1.speed.1],
+            speed_m_s: [e1::SPEED_M_S.0, e1::SPEED_M_S.1],
             max_climb_deg: 90.0,
             region: None,
-            endpoint_clearance_m: e1.endpoint_clearance,
+            endpoint_clearance_m: e1::ENDPOINT_CLEARANCE_M,
             avoid_static: true,
             motion: Motion::default(),
         }

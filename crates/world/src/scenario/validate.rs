@@ -42,9 +42,9 @@ impl TrackTotals {
     /// Whether obstacle `o` (`field`) may have its track file read: always without one; with
     /// one, while the totals, this file's size included, stay within the policy (reported on
     /// the first obstacle beyond them).
-    fn admit(
+    fn admit<P>(
         &mut self,
-        s: &Scenario,
+        s: &Scenario<P>,
         o: &super::ObstacleSpec,
         field: &str,
         p: &mut Problems,
@@ -107,7 +107,7 @@ impl TrackTotals {
     }
 }
 
-impl Scenario {
+impl<P> Scenario<P> {
     /// Every semantic problem of the scenario that the file alone shows, in file order (empty:
     /// valid). The checks against the generated layout (start and goal clear of generated shapes
     /// and cloud points) run where the layout is generated, in [`crate::World::build`] and
@@ -118,8 +118,7 @@ impl Scenario {
     /// static shape or cloud point, the start within the vehicle radius of a moving obstacle at
     /// `t = 0`; moving obstacles not fitting their region; rates whose periods are not integer
     /// multiples of the physics step (within 1e-9 relative); a log rate below 50 Hz; bad
-    /// parameters of the frontend, backend, checker and manager (their own `validate()`, with
-    /// field paths under `planner.`), of the vehicle model, the EKF and the generators; a missing
+    /// parameters of the vehicle model, the EKF and the generators; a missing
     /// or malformed points file; an empty inline cloud; an ESDF grid above
     /// `trust_geometry::MAX_VOXELS` voxels (computed without allocating); a dropout probability
     /// outside `[0, 1)`. Names (planner, kinds) are checked when the file is parsed.
@@ -146,7 +145,6 @@ impl Scenario {
         let geometry_ok = p.list.len() == geometry_start && radius_ok;
 
         self.check_vehicle(&mut p);
-        p.list.extend(self.planner.problems());
         self.sensing.check("sensing", &mut p);
         p.non_negative("traffic.fault_level", self.traffic.fault_level);
         self.check_sim(&mut p);
@@ -492,62 +490,6 @@ impl Scenario {
         }
     }
 
-    /// In real time the loop divides the planner's budgets by the CPU scale
-    /// (`trust_flight::real_time_planner`: the cycle budget and the frontend's `budget_ms`); the
-    /// divided budgets must stay within the ranges the planning crates accept, or the flight's
-    /// set-up would refuse what validation accepted (found by `trust-fuzz`'s file groups:
-    /// `budget_ms = 200` at `cpu_scale = 1e-5` is 2e7 ms). Reported on the scale, with the
-    /// budget it breaks.
-    fn check_real_time_budgets(&self, p: &mut Problems, scale: f64) {
-        use crate::planner::FrontendSpec;
-        if !(scale > 0.0 && scale <= MAX_CPU_SCALE) {
-            return;
-        }
-        let r = self.resolve_planner();
-        let frontend_ms = match &r.frontend {
-            FrontendSpec::DevPrm(x) => Some(x.budget_ms),
-            FrontendSpec::VPrm(x) => Some(x.budget_ms),
-            FrontendSpec::SparseAStar(x) => Some(x.budget_ms),
-            FrontendSpec::StraightLine(_) => None,
-        };
-        let max = trust_topo_prm::ranges::MAX_BUDGET_MS;
-        let min = trust_geometry::scale::MIN_POSITIVE;
-        let budgets = [
-            (
-                "planner.manager.cycle_budget_ms",
-                Some(r.manager.cycle_budget_ms),
-                (f64::MIN_POSITIVE, f64::MAX),
-                "finite and > 0".to_string(),
-            ),
-            (
-                "planner.frontend.budget_ms",
-                frontend_ms,
-                (min, max),
-                format!("in [{}, {}] ms", fmt_num(min), fmt_num(max)),
-            ),
-        ];
-        for (field, budget, (lo, hi), range) in budgets {
-            let Some(b) = budget.filter(|b| b.is_finite() && *b > 0.0) else {
-                // A bad budget is its own field's problem.
-                continue;
-            };
-            let scaled = b / scale;
-            if !(scaled >= lo && scaled <= hi) {
-                p.push(
-                    "sim.latency.cpu_scale",
-                    fmt_num(scale),
-                    format!(
-                        "a CPU scale that keeps the planner's budgets in range in real time \
-                         ({field} {} ms / {} = {} ms; expected {range})",
-                        fmt_num(b),
-                        fmt_num(scale),
-                        fmt_num(scaled)
-                    ),
-                );
-            }
-        }
-    }
-
     fn check_sim(&self, p: &mut Problems) {
         let s = &self.sim;
         let dt_ok = p.positive("sim.physics_dt_s", s.physics_dt_s);
@@ -604,32 +546,11 @@ impl Scenario {
                 format!("a number in (0, {MAX_CPU_SCALE}]"),
             );
         }
-        if let Latency::Measured { cpu_scale } = s.latency {
-            self.check_real_time_budgets(p, cpu_scale.unwrap_or(1.0));
-        }
         if let Latency::Fixed {
             seconds: Some(seconds),
         } = s.latency
         {
             p.non_negative("sim.latency.seconds", seconds);
-            // One owner: the loop's delay and the delay the manager plans for must agree.
-            if let Some(manager) = self
-                .planner
-                .manager
-                .as_ref()
-                .and_then(|m| m.latency_s)
-                .filter(|m| *m != seconds)
-            {
-                p.push(
-                    "planner.manager.latency_s",
-                    fmt_num(manager),
-                    format!(
-                        "the same value as sim.latency.seconds ({}) or no value: the manager \
-                         plans for the delay the loop applies; set it in one place",
-                        fmt_num(seconds)
-                    ),
-                );
-            }
         }
     }
 }

@@ -8,9 +8,10 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use trust_flight::scenario::Scenario;
+use trust_planner as planner;
+use trust_world::World;
 use trust_world::error::WorldError;
-use trust_world::scenario::Scenario;
-use trust_world::{World, planner};
 
 fn probe(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -32,7 +33,7 @@ fn dir_files(dir: &str) -> Vec<PathBuf> {
 /// `trust-sim validate`'s message for a probe file (it must fail), and how long it took.
 fn validate(name: &str) -> (String, Duration) {
     let t = Instant::now();
-    let e = trust_world::load_checked(&probe(name))
+    let e = trust_flight::scenario::load_checked(&probe(name))
         .err()
         .unwrap_or_else(|| panic!("{name} validated"));
     (e.to_string(), t.elapsed())
@@ -40,7 +41,7 @@ fn validate(name: &str) -> (String, Duration) {
 
 /// The problems `validate` reports on `field` (exact field name).
 fn problems_on(name: &str, field: &str) -> Vec<String> {
-    match trust_world::load_checked(&probe(name)) {
+    match trust_flight::scenario::load_checked(&probe(name)) {
         Err(WorldError::Invalid { problems, .. }) => problems
             .iter()
             .filter(|p| p.field == field)
@@ -182,7 +183,7 @@ fn many_static_spheres_with_an_unmeetable_random_mission_stay_fast() {
     }
     let t = Instant::now();
     let s = Scenario::from_toml_str(&crowd, Path::new("crowd.toml")).unwrap();
-    let problems = trust_world::check(&s);
+    let problems = trust_flight::scenario::check(&s);
     assert!(t.elapsed() < Duration::from_secs(5), "{:?}", t.elapsed());
     assert!(
         problems
@@ -196,7 +197,7 @@ fn many_static_spheres_with_an_unmeetable_random_mission_stay_fast() {
     }
     let t = Instant::now();
     let s = Scenario::from_toml_str(&text, Path::new("crowd.toml")).unwrap();
-    let problems = trust_world::check(&s);
+    let problems = trust_flight::scenario::check(&s);
     assert!(t.elapsed() < Duration::from_secs(5), "{:?}", t.elapsed());
     let p = problems
         .iter()
@@ -250,7 +251,7 @@ fn huge_numbers_print_in_scientific_notation() {
 fn every_probe_file_is_refused() {
     for path in dir_files("tests/data/probe") {
         assert!(
-            trust_world::load_checked(&path).is_err(),
+            trust_flight::scenario::load_checked(&path).is_err(),
             "{} validated",
             path.display()
         );
@@ -258,8 +259,8 @@ fn every_probe_file_is_refused() {
 }
 
 /// One validation: for every bad file (broken and probe), `trust-sim validate`'s checks and what
-/// `run` does before flying — `World::build`, then the traffic, the sensor and
-/// `planner::build` — agree: both refuse, with the same problems. For every shipped scenario
+/// `run` does before flying — the planner's section, `World::build`, then the traffic, the
+/// sensor and `planner::build` — agree: both refuse, with the same problems. For every shipped scenario
 /// both accept (`tests/scenario.rs` builds them).
 #[test]
 fn validate_and_build_agree() {
@@ -268,20 +269,33 @@ fn validate_and_build_agree() {
     for path in files {
         let Ok(s) = Scenario::parse_file(&path) else {
             // Syntax, unknown names: refused by the parser, before either.
-            assert!(trust_world::load_checked(&path).is_err());
+            assert!(trust_flight::scenario::load_checked(&path).is_err());
             continue;
         };
-        let checked = trust_world::check(&s);
-        let run = World::build(&s).and_then(|w| {
-            w.traffic()?;
-            w.sensing()?;
-            planner::build(&s.resolve_planner(), &w.planner_context()).map(|_| ())
-        });
-        match run {
-            Err(WorldError::Invalid { problems, .. }) => {
-                assert_eq!(problems, checked, "{}", path.display())
+        let checked = trust_flight::scenario::check(&s);
+        // `run` checks the planner's section, builds the world (which checks the rest), then
+        // sets up the traffic, the sensor and the planner.
+        let planner_problems = trust_flight::scenario::problems(&s);
+        let run = match World::build(&s) {
+            Err(WorldError::Invalid { mut problems, .. }) => {
+                problems.extend(planner_problems);
+                Err(problems)
             }
             Err(e) => panic!("{}: run fails outside validation: {e}", path.display()),
+            Ok(_) if !planner_problems.is_empty() => Err(planner_problems),
+            Ok(w) => {
+                w.traffic().unwrap();
+                w.sensing().unwrap();
+                let ctx = trust_flight::scenario::planner_context(&w);
+                let resolved = trust_flight::scenario::resolve_planner(&s);
+                if let Err(e) = planner::build(&resolved, &ctx) {
+                    panic!("{}: run fails outside validation: {e}", path.display());
+                }
+                Ok(())
+            }
+        };
+        match run {
+            Err(problems) => assert_eq!(problems, checked, "{}", path.display()),
             Ok(()) => panic!(
                 "{}: run starts but validate says {checked:?}",
                 path.display()

@@ -6,13 +6,15 @@ use std::path::{Path, PathBuf};
 
 use trust_core::HomotopyChecker;
 use trust_core::{Limits, PathFrontend, TrajectoryBackend};
+use trust_flight::scenario::Scenario;
 use trust_manager::ManagerParams;
+use trust_planner as planner;
+use trust_planner::{
+    AnyBackend, AnyChecker, AnyFrontend, FrontendSpec, PlannerContext, PlannerPreset,
+};
 use trust_world::World;
 use trust_world::error::WorldError;
-use trust_world::planner::{
-    self, AnyBackend, AnyChecker, AnyFrontend, FrontendSpec, PlannerContext, PlannerPreset,
-};
-use trust_world::scenario::{PointCloudSpec, Scenario, StaticShape};
+use trust_world::scenario::{PointCloudSpec, StaticShape};
 
 fn scenarios_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios")
@@ -46,14 +48,14 @@ fn every_shipped_scenario_validates_and_builds() {
         );
     }
     for path in files {
-        let mut s = Scenario::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let mut s = trust_flight::scenario::load(&path).unwrap_or_else(|e| panic!("{e}"));
         assert!(s.validate().is_empty());
         assert!(
             !s.description.is_empty(),
             "{}: describe what it reproduces",
             path.display()
         );
-        let resolved = s.resolve_planner();
+        let resolved = trust_flight::scenario::resolve_planner(&s);
         // The full E4 ESDF (47 M voxels) is built by the release CLI and the world_view example;
         // a debug test builds E4 at 0.5 m voxels (3 M voxels).
         if let Some(PointCloudSpec::Shapes { esdf_voxel_m, .. }) = &mut s.static_map.point_cloud
@@ -62,7 +64,8 @@ fn every_shipped_scenario_validates_and_builds() {
             *esdf_voxel_m = 0.5;
         }
         let world = World::build(&s).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let manager = planner::build(&resolved, &world.planner_context()).unwrap();
+        let manager =
+            planner::build(&resolved, &trust_flight::scenario::planner_context(&world)).unwrap();
         // The manager plans with the acceleration headroom below the vehicle's limit.
         let headroom = resolved
             .accel_headroom
@@ -91,7 +94,7 @@ fn the_minimal_scenario_of_the_docs_is_valid() {
 #[test]
 fn scenarios_round_trip_through_toml() {
     for path in toml_files(&scenarios_dir()) {
-        let s = Scenario::load(&path).unwrap();
+        let s = trust_flight::scenario::load(&path).unwrap();
         let text = s.to_toml_string().unwrap();
         let back = Scenario::from_toml_str(&text, &path).unwrap();
         assert_eq!(back, s, "{}", path.display());
@@ -120,7 +123,7 @@ fn broken_files_give_the_expected_messages() {
             "{} has no `# expect:` line",
             path.display()
         );
-        let message = match trust_world::load_checked(path) {
+        let message = match trust_flight::scenario::load_checked(path) {
             Ok(_) => {
                 failures.push(format!("{}: loaded without error", path.display()));
                 continue;
@@ -142,7 +145,7 @@ fn broken_files_give_the_expected_messages() {
 #[test]
 fn validation_reports_every_problem_not_just_the_first() {
     let path = broken_dir().join("many_problems.toml");
-    match trust_world::load_checked(&path) {
+    match trust_flight::scenario::load_checked(&path) {
         Err(WorldError::Invalid { problems, path: p }) => {
             assert_eq!(p, path);
             assert_eq!(problems.len(), 10, "{problems:#?}");
@@ -196,7 +199,7 @@ fn static_shapes_are_the_run_log_type_tagged_by_kind_in_the_scenario() {
 #[test]
 fn parse_errors_keep_the_file_and_the_line() {
     let path = broken_dir().join("syntax_error.toml");
-    let e = Scenario::load(&path).unwrap_err();
+    let e = trust_flight::scenario::load(&path).unwrap_err();
     assert!(matches!(e, WorldError::Parse { .. }), "{e:?}");
     let msg = e.to_string();
     assert!(msg.starts_with(&path.display().to_string()), "{msg}");
@@ -212,7 +215,7 @@ fn ctx(radius: f64) -> PlannerContext {
     }
 }
 
-fn spec(text: &str) -> trust_world::planner::PlannerSpec {
+fn spec(text: &str) -> trust_planner::PlannerSpec {
     toml::from_str(text).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -290,7 +293,7 @@ fn clearances_follow_the_vehicle_radius_and_reproducibility_removes_budgets() {
         other => panic!("{other:?}"),
     }
     match &e.backend {
-        trust_world::planner::BackendSpec::UtfMinco(p) => {
+        trust_planner::BackendSpec::UtfMinco(p) => {
             assert!((p.penalty.static_clearance_m - (0.45 + 0.1 + 0.17)).abs() < 1e-12)
         }
         other => panic!("{other:?}"),
@@ -333,7 +336,8 @@ fn clearances_follow_the_vehicle_radius_and_reproducibility_removes_budgets() {
 
 #[test]
 fn an_unknown_frontend_kind_lists_the_accepted_names() {
-    let e = Scenario::load(&broken_dir().join("unknown_frontend_kind.toml")).unwrap_err();
+    let e =
+        trust_flight::scenario::load(&broken_dir().join("unknown_frontend_kind.toml")).unwrap_err();
     let msg = e.to_string();
     for name in ["`dev-prm`", "`v-prm`", "`straight-line`", "`sparse-a-star`"] {
         assert!(msg.contains(name), "{msg}");
@@ -346,7 +350,12 @@ fn a_fixed_latency_has_one_owner_and_reaches_the_manager() {
                 [mission]\nstart = [1, 10, 5]\ngoal = [19, 10, 5]\n\
                 [sim]\nlatency = { kind = \"fixed\", seconds = 0.03 }\n";
     let s = Scenario::from_toml_str(text, Path::new("latency.toml")).unwrap();
-    assert_eq!(s.resolve_planner().manager.latency_s, Some(0.03));
+    assert_eq!(
+        trust_flight::scenario::resolve_planner(&s)
+            .manager
+            .latency_s,
+        Some(0.03)
+    );
     // One owner: a different manager latency is a problem of the file, not silently kept.
     let conflicting = format!("{text}[planner.manager]\nlatency_s = 0.01\n");
     let s = Scenario::from_toml_str(&conflicting, Path::new("latency.toml")).unwrap();
@@ -360,7 +369,12 @@ fn a_fixed_latency_has_one_owner_and_reaches_the_manager() {
     let agreeing = format!("{text}[planner.manager]\nlatency_s = 0.03\n");
     let s = Scenario::from_toml_str(&agreeing, Path::new("latency.toml")).unwrap();
     assert!(s.validate().is_empty(), "{:?}", s.validate());
-    assert_eq!(s.resolve_planner().manager.latency_s, Some(0.03));
+    assert_eq!(
+        trust_flight::scenario::resolve_planner(&s)
+            .manager
+            .latency_s,
+        Some(0.03)
+    );
 }
 
 #[test]
@@ -398,10 +412,13 @@ fn plan_once(world: &World, require_main: bool) {
     assert_eq!(forecasts.len(), world.obstacles().len());
     let scene = Scene::new(world.planner_map(), &forecasts, 0.0).unwrap();
     for preset in PlannerPreset::ALL {
-        let mut s = world.scenario().clone();
+        let mut s = world
+            .scenario()
+            .with_planner(trust_planner::PlannerSpec::default());
         s.planner.name = preset;
-        let resolved = s.resolve_planner();
-        let mut manager = planner::build(&resolved, &world.planner_context()).unwrap();
+        let resolved = trust_flight::scenario::resolve_planner(&s);
+        let mut manager =
+            planner::build(&resolved, &trust_flight::scenario::planner_context(&world)).unwrap();
         let report = manager
             .step(
                 0.0,
@@ -428,11 +445,12 @@ fn plan_once(world: &World, require_main: bool) {
 
 #[test]
 fn assembled_planners_plan_in_the_shipped_worlds() {
-    let e2 = Scenario::load(&scenarios_dir().join("e2_static.toml")).unwrap();
+    let e2 = trust_flight::scenario::load(&scenarios_dir().join("e2_static.toml")).unwrap();
     plan_once(&World::build(&e2).unwrap(), true);
-    let quickstart = Scenario::load(&scenarios_dir().join("quickstart.toml")).unwrap();
+    let quickstart =
+        trust_flight::scenario::load(&scenarios_dir().join("quickstart.toml")).unwrap();
     plan_once(&World::build(&quickstart).unwrap(), false);
-    let mut e4 = Scenario::load(&scenarios_dir().join("e4.toml")).unwrap();
+    let mut e4 = trust_flight::scenario::load(&scenarios_dir().join("e4.toml")).unwrap();
     if let Some(PointCloudSpec::Shapes { esdf_voxel_m, .. }) = &mut e4.static_map.point_cloud {
         *esdf_voxel_m = 0.5;
     }
@@ -519,7 +537,7 @@ radius_m = 0.1
 #[test]
 fn every_seed_of_a_random_flight_is_valid() {
     for name in ["room_static.toml", "room_people.toml"] {
-        let s = Scenario::load(&scenarios_dir().join("suite").join(name)).unwrap();
+        let s = trust_flight::scenario::load(&scenarios_dir().join("suite").join(name)).unwrap();
         for seed in 0..200 {
             let t = s.with_seed(seed);
             let problems = t.validate();
@@ -537,7 +555,7 @@ fn every_suite_and_variant_file_validates() {
         let files = toml_files(&scenarios_dir().join(dir));
         assert!(files.len() >= 11, "{dir}: {files:?}");
         for path in files {
-            let s = Scenario::load(&path).unwrap_or_else(|e| panic!("{e}"));
+            let s = trust_flight::scenario::load(&path).unwrap_or_else(|e| panic!("{e}"));
             assert!(s.validate().is_empty(), "{}", path.display());
         }
     }

@@ -189,7 +189,7 @@ const RANDOM_GUIDE_CLEARANCE_M: f64 = 0.5;
 ///
 /// ```
 /// use rand::SeedableRng;
-/// use trust_minco::scenes::random_e2_static;
+/// use trust_scenes::e2::random_e2_static;
 ///
 /// let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
 /// let case = random_e2_static(&mut rng);
@@ -262,7 +262,7 @@ fn try_random_static<R: Rng + ?Sized>(rng: &mut R) -> Option<E2Case> {
 ///
 /// ```
 /// use rand::SeedableRng;
-/// use trust_minco::scenes::random_e2_dynamic;
+/// use trust_scenes::e2::random_e2_dynamic;
 ///
 /// let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
 /// let case = random_e2_dynamic(&mut rng);

@@ -4,13 +4,13 @@
 //! `v_max/a_max` at a room's 1.3 m/s and at E4's 10 m/s, so every trip started and ended late
 //! (issue 19: rooms missed 1.3 × `d/v_max` with nobody in them). The bound here is what the
 //! presets' jerk limit leaves: `2 v_max/a_max` plus one jerk ramp. It fails with the energy
-//! weight at 1 (`trust_world::planner::PRESET_ENERGY_WEIGHT`).
+//! weight at 1 (`trust_planner::PRESET_ENERGY_WEIGHT`).
 
 use trust_core::{
     Aabb, GuidePath, InitialGuess, Limits, PolyTraj, Scene, State, StaticMap, TrajRequest,
     TrajectoryBackend, Vec3,
 };
-use trust_world::planner::{
+use trust_planner::{
     DEFAULT_ACCEL_HEADROOM, PRESET_JERK_RAMP_S, PlannerContext, PlannerSpec, effective,
     planning_limits,
 };
