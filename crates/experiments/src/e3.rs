@@ -99,7 +99,7 @@ pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, ExperimentEr
     let world = World::build(scenario)?;
     // The paper's table: the branches of one cycle aimed at the final goal, no global route,
     // constant-velocity forecasts without their wall images.
-    let mut resolved = trust_flight::scenario::resolve_planner(&scenario);
+    let mut resolved = trust_flight::scenario::resolve_planner(scenario);
     resolved.route = None;
     resolved.manager.wall_images = false;
     // One cycle shows every branch: all its cold solves in that cycle.

@@ -374,7 +374,7 @@ fn flight_scenario(
 
 fn fly_one(class: &str, s: &Scenario, out: &Path) -> Result<SuiteRow, ExperimentError> {
     let world = World::build(s)?;
-    let planner = trust_flight::scenario::resolve_planner(&s);
+    let planner = trust_flight::scenario::resolve_planner(s);
     let rel = format!(
         "logs/{class}/{}-seed{}.jsonl",
         s.planner.name.name(),

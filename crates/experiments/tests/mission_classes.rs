@@ -59,7 +59,7 @@ fn fly_audited(s: &Scenario, tag: &str) -> (Flight, Vec<String>) {
     let world = World::build(s).unwrap();
     let flight = fly(
         &world,
-        &trust_flight::scenario::resolve_planner(&s),
+        &trust_flight::scenario::resolve_planner(s),
         &options,
         |_| {},
     )

@@ -110,9 +110,9 @@ fn step_for(s: &Scenario, seconds: f64) -> (Counts, Option<Ending>) {
     let world = World::build(s).expect("world");
     let planner = match Clock::from_latency(s.sim.latency, 0.05) {
         Clock::RealTime { cpu_scale } => {
-            trust_flight::real_time_planner(&trust_flight::scenario::resolve_planner(&s), cpu_scale)
+            trust_flight::real_time_planner(&trust_flight::scenario::resolve_planner(s), cpu_scale)
         }
-        Clock::Fixed { .. } => trust_flight::scenario::resolve_planner(&s),
+        Clock::Fixed { .. } => trust_flight::scenario::resolve_planner(s),
     };
     let params = LoopParams::new(&world, &planner);
     let setup = trust_flight::set_up(&world, &planner).expect("setup");

@@ -418,7 +418,7 @@ fn plan_once(world: &World, require_main: bool) {
         s.planner.name = preset;
         let resolved = trust_flight::scenario::resolve_planner(&s);
         let mut manager =
-            planner::build(&resolved, &trust_flight::scenario::planner_context(&world)).unwrap();
+            planner::build(&resolved, &trust_flight::scenario::planner_context(world)).unwrap();
         let report = manager
             .step(
                 0.0,

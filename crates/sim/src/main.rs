@@ -591,7 +591,7 @@ fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
         .into());
     }
     let world = World::build(s)?;
-    let planner = trust_flight::scenario::resolve_planner(&s);
+    let planner = trust_flight::scenario::resolve_planner(s);
     let log_path = out.join("run.jsonl");
     let options = RunOptions {
         log_path: Some(log_path.clone()),
