@@ -359,7 +359,7 @@ fn a_fixed_latency_has_one_owner_and_reaches_the_manager() {
     // One owner: a different manager latency is a problem of the file, not silently kept.
     let conflicting = format!("{text}[planner.manager]\nlatency_s = 0.01\n");
     let s = Scenario::from_toml_str(&conflicting, Path::new("latency.toml")).unwrap();
-    let problems = s.validate();
+    let problems = trust_flight::scenario::check(&s);
     assert!(
         problems
             .iter()
@@ -368,7 +368,8 @@ fn a_fixed_latency_has_one_owner_and_reaches_the_manager() {
     );
     let agreeing = format!("{text}[planner.manager]\nlatency_s = 0.03\n");
     let s = Scenario::from_toml_str(&agreeing, Path::new("latency.toml")).unwrap();
-    assert!(s.validate().is_empty(), "{:?}", s.validate());
+    let problems = trust_flight::scenario::check(&s);
+    assert!(problems.is_empty(), "{problems:?}");
     assert_eq!(
         trust_flight::scenario::resolve_planner(&s)
             .manager

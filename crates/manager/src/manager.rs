@@ -891,7 +891,9 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             .last_now
             .replace(now)
             .map_or(2.0 * self.params.cycle_budget_ms * 1e-3, |last| now - last);
-        if !self.params.background || !self.params.history {
+        // Without a main branch (braking, evading) the next cycle plans on the newest
+        // forecasts only: a job would explore and re-solve against this cycle's.
+        if !self.params.background || !self.params.history || self.main.is_none() {
             return false;
         }
         let shared = self

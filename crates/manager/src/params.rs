@@ -96,7 +96,10 @@ pub struct ManagerParams {
     /// ([`ManagerParams::background`]); `None`: [`ManagerParams::warm_max_evaluations`]. The
     /// worker has re-solved the main branch from this cycle's start already (FwdMarch with the
     /// warm budget, against the previous cycle's forecasts), so the cycle's own re-solve starts
-    /// from that and only takes in the newest forecasts. Default 30 (beyond the paper).
+    /// from that and only takes in the newest forecasts; a converged start stops early. Default
+    /// `None`: 30 evaluations flew E4 as well, but in the rooms with people the less refined
+    /// main branch collided (`room_penetration_pacing_person`, seed 26) or took twice as long
+    /// (`room_penetration_small_fast_people`, seed 202: 24.8 s against 10.1 s).
     pub merge_max_evaluations: Option<usize>,
     /// Run FwdExplore (the frontend and the cold solves) every this many cycles, and in every cycle
     /// that starts with fewer than two kept branches or without a main branch. 1: every cycle (the
@@ -189,7 +192,7 @@ impl ManagerParams {
             cold_max_evaluations: None,
             cold_solves_per_cycle: Some(2),
             background: true,
-            merge_max_evaluations: Some(30),
+            merge_max_evaluations: None,
             explore_period_cycles: 3,
             repair_margin_m: 0.05,
             ranking: None,
