@@ -56,6 +56,7 @@ mod error;
 mod guidance;
 mod overrides;
 mod path;
+mod problem;
 mod scene;
 mod solution;
 mod state;
@@ -72,6 +73,7 @@ pub use error::{
 pub use guidance::{guidance_radius, straight_end};
 pub use overrides::Overridable;
 pub use path::GuidePath;
+pub use problem::Problem;
 pub use scene::Scene;
 pub use solution::{CostBreakdown, RankingWeights, Solution, SolveStats, SolveStatus};
 pub use state::{Limits, State};

@@ -111,7 +111,7 @@ pub fn load(path: &Path) -> Result<Scenario, WorldError> {
     let s = Scenario::parse_file(path)?;
     let mut problems_found = s.validate();
     problems_found.extend(problems(&s));
-    invalid_unless_empty(s, path, problems_found)
+    WorldError::unless_problems(s, path, problems_found)
 }
 
 /// Reads, parses and fully checks a scenario file ([`check`]): what `trust-sim validate`
@@ -122,22 +122,7 @@ pub fn load(path: &Path) -> Result<Scenario, WorldError> {
 pub fn load_checked(path: &Path) -> Result<Scenario, WorldError> {
     let s = Scenario::parse_file(path)?;
     let problems_found = check(&s);
-    invalid_unless_empty(s, path, problems_found)
-}
-
-fn invalid_unless_empty(
-    s: Scenario,
-    path: &Path,
-    problems: Vec<Problem>,
-) -> Result<Scenario, WorldError> {
-    if problems.is_empty() {
-        Ok(s)
-    } else {
-        Err(WorldError::Invalid {
-            path: path.to_path_buf(),
-            problems,
-        })
-    }
+    WorldError::unless_problems(s, path, problems_found)
 }
 
 /// One owner of the delay: the loop's and the one the manager plans for must agree.

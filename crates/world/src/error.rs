@@ -97,6 +97,23 @@ fn fmt_bytes(n: u64) -> String {
 }
 
 impl WorldError {
+    /// `value` if `problems` is empty, else [`WorldError::Invalid`] with them for the file at
+    /// `path`.
+    pub fn unless_problems<T>(
+        value: T,
+        path: &std::path::Path,
+        problems: Vec<Problem>,
+    ) -> Result<T, WorldError> {
+        if problems.is_empty() {
+            Ok(value)
+        } else {
+            Err(WorldError::Invalid {
+                path: path.to_path_buf(),
+                problems,
+            })
+        }
+    }
+
     /// Shorthand for [`WorldError::Input`].
     pub fn input(
         field: impl Into<String>,

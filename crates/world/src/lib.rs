@@ -563,14 +563,7 @@ pub fn load_checked<P: serde::de::DeserializeOwned + Default + Clone>(
 ) -> Result<Scenario<P>, WorldError> {
     let s = Scenario::parse_file(path)?;
     let problems = check(&s);
-    if problems.is_empty() {
-        Ok(s)
-    } else {
-        Err(WorldError::Invalid {
-            path: path.to_path_buf(),
-            problems,
-        })
-    }
+    WorldError::unless_problems(s, path, problems)
 }
 
 /// Bound (m) on how much the planner's trilinear ESDF of voxel size `voxel_m` may overestimate

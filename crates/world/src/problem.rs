@@ -1,46 +1,6 @@
 //! [`Problem`]: one finding of scenario validation, and the formatting helpers its messages use.
 
-use serde::Serialize;
-
-/// One problem found in a scenario: the field path, the offending value and what was expected.
-///
-/// Displays as `field.path: value — expected ...`, e.g.
-/// `mission.goal: [300, 10, 5] — expected a point inside world.bounds [0, 0, 0]..[250, 75, 20]`.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
-pub struct Problem {
-    /// Dotted path of the field in the scenario file (`obstacles[3].radius_m`,
-    /// `planner.frontend.budget_ms`, `world.generator`).
-    pub field: String,
-    /// The offending value, formatted (numbers as in the file; vectors as `[x, y, z]`).
-    pub value: String,
-    /// What would have been accepted, in words.
-    pub expected: String,
-}
-
-impl Problem {
-    /// A problem with `field`, `value` (formatted with `Display`) and `expected`.
-    pub fn new(
-        field: impl Into<String>,
-        value: impl std::fmt::Display,
-        expected: impl Into<String>,
-    ) -> Self {
-        Problem {
-            field: field.into(),
-            value: value.to_string(),
-            expected: expected.into(),
-        }
-    }
-}
-
-impl std::fmt::Display for Problem {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{}: {} — expected {}",
-            self.field, self.value, self.expected
-        )
-    }
-}
+pub use trust_core::Problem;
 
 /// Formats a number for a message, readably, with at most 6 significant digits: for a magnitude
 /// in `[1e-4, 1e6)` Rust's shortest round-trip form (`300`, `0.25`, `NaN`, `inf`), rounded to 6

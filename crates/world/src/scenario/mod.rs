@@ -287,14 +287,7 @@ impl<P: DeserializeOwned + Default + Clone> Scenario<P> {
     pub fn load(path: &Path) -> Result<Scenario<P>, WorldError> {
         let s = Scenario::parse_file(path)?;
         let problems = s.validate();
-        if problems.is_empty() {
-            Ok(s)
-        } else {
-            Err(WorldError::Invalid {
-                path: path.to_path_buf(),
-                problems,
-            })
-        }
+        WorldError::unless_problems(s, path, problems)
     }
 }
 
