@@ -84,7 +84,7 @@ impl FrontendSpec {
         }
     }
 
-    /// The frontend alone (experiment E1 runs it without a manager). [`build`] applies the
+    /// The frontend alone (experiment E1 runs it without a manager). [`build`](crate::build) applies the
     /// vehicle-dependent adjustments first; this does not.
     ///
     /// # Errors
@@ -128,7 +128,7 @@ impl BackendSpec {
         }
     }
 
-    /// The backend alone (experiment E2 runs it without a manager). [`build`] applies the
+    /// The backend alone (experiment E2 runs it without a manager). [`build`](crate::build) applies the
     /// vehicle-dependent adjustments first; this does not.
     ///
     /// # Errors
