@@ -581,8 +581,9 @@ fn run(s: &Scenario, out: &Path, flags: &RunFlags) -> Result<ExitCode> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let tty = std::io::stderr().is_terminal();
     eprintln!("building the world of `{}` (seed {})...", s.name, s.seed);
-    // The world checks its sections; the planner's are checked here, where both are known.
-    let problems = trust_flight::scenario::problems(s);
+    // Every problem at once, as `validate` reports them: the world's sections and the
+    // planner's, which only this crate knows together.
+    let problems = trust_flight::scenario::check(s);
     if !problems.is_empty() {
         return Err(WorldError::Invalid {
             path: s.origin(),

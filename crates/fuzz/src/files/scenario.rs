@@ -32,8 +32,8 @@ const SCENARIO: &str = "scenario.toml";
 
 // ---------------------------------------------------------------- the entry points
 
-/// What `trust-sim run` does with a scenario file before its first physics step: parse, build
-/// the world, resolve the planner (real time as the loop would), set up the traffic, sensor and
+/// What `trust-sim run` does with a scenario file before its first physics step: parse, check
+/// every section ([`trust_flight::scenario::check`]), build the world, resolve the planner (real time as the loop would), set up the traffic, sensor and
 /// planner ([`trust_flight::set_up`]), the vehicle model at rest on the start, and write the
 /// log header.
 ///
@@ -41,6 +41,14 @@ const SCENARIO: &str = "scenario.toml";
 /// The first error, as `run` would print it.
 pub fn run_set_up(path: &Path, log: &Path) -> Result<(), String> {
     let s = Scenario::parse_file(path).map_err(|e| e.to_string())?;
+    let problems = trust_flight::scenario::check(&s);
+    if !problems.is_empty() {
+        return Err(WorldError::Invalid {
+            path: s.origin(),
+            problems,
+        }
+        .to_string());
+    }
     let world = World::build(&s).map_err(|e| e.to_string())?;
     let planner = trust_flight::scenario::resolve_planner(&s);
     let params = LoopParams::new(&world, &planner);
