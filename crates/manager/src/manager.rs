@@ -1041,20 +1041,13 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             horizon_s: self.params.horizon_s,
             exploration: if cycle.stalled { 2.0 } else { 1.0 },
         };
-        let solver = Solver::new(
-            &*self.backend,
-            scene,
-            (cycle.start, *goal, self.limits),
-            &self.params,
-            cycle.deadline,
-            cycle.stalled,
-            self.route_guide(&cycle.start.p, goal),
-        );
-        let (frontend, rng) = (&*self.frontend, &mut self.rng);
         let pending = std::mem::take(&mut self.deferred_guides);
-        rayon::join(
+        // The random stream is lent to the frontend while the solver borrows the manager.
+        let mut rng = std::mem::replace(&mut self.rng, Rng::seed_from_u64(0));
+        let solver = self.solver(cycle, goal, scene);
+        let out = rayon::join(
             || match cycle.explore {
-                true => fwd_explore(frontend, rng, &query, &solver, spans),
+                true => fwd_explore(&*self.frontend, &mut rng, &query, &solver, spans),
                 false => solve_deferred(pending, &solver),
             },
             || {
@@ -1065,7 +1058,9 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                     })
                     .collect()
             },
-        )
+        );
+        self.rng = rng;
+        out
     }
 
     /// The safety pass over one solved trajectory: its statistics go to the cycle's timing; a
