@@ -2005,8 +2005,12 @@ impl<'s, 'a, B: TrajectoryBackend> Solver<'s, 'a, B> {
     /// warm-started from its trajectory (its free terminal moves on toward the goal as the goal
     /// guidance surface shrinks), with [`ManagerParams::warm_max_evaluations`].
     fn fwd_march(&self, traj: &PolyTraj) -> Candidate {
-        let budget = self.params.warm_max_evaluations;
-        self.repaired(self.solve_with(InitialGuess::WarmStart(traj), budget))
+        self.fwd_march_within(traj, self.params.warm_max_evaluations)
+    }
+
+    /// [`Solver::fwd_march`] with its evaluation budget given.
+    fn fwd_march_within(&self, traj: &PolyTraj, max_evaluations: Option<usize>) -> Candidate {
+        self.repaired(self.solve_with(InitialGuess::WarmStart(traj), max_evaluations))
     }
 
     /// BwdReplan (Algorithm 1, line 7): a sub-branch re-anchored at the replan start,

@@ -94,13 +94,23 @@ pub struct ManagerParams {
     pub background: bool,
     /// Evaluation budget of the main branch's re-solve in a cycle that merged the worker's job
     /// ([`ManagerParams::background`]); `None`: [`ManagerParams::warm_max_evaluations`]. The
-    /// worker has re-solved the main branch from this cycle's start already (FwdMarch with the
-    /// warm budget, against the previous cycle's forecasts), so the cycle's own re-solve starts
+    /// worker has re-solved the main branch from this cycle's start already (FwdMarch with
+    /// [`ManagerParams::worker_march_max_evaluations`], against the previous cycle's forecasts),
+    /// so the cycle's own re-solve starts
     /// from that and only takes in the newest forecasts; a converged start stops early. Default
     /// `None`: 30 evaluations flew E4 as well, but in the rooms with people the less refined
     /// main branch collided (`room_penetration_pacing_person`, seed 26) or took twice as long
     /// (`room_penetration_small_fast_people`, seed 202: 24.8 s against 10.1 s).
     pub merge_max_evaluations: Option<usize>,
+    /// Evaluation budget of the worker's re-solve of the main branch (FwdMarch off the cycle,
+    /// [`ManagerParams::background`]); `None`: [`ManagerParams::warm_max_evaluations`]. The
+    /// cycle then re-solves from the worker's result with the newest forecasts, and a converged
+    /// start stops early, so what the worker leaves unconverged lands on the cycle. Default 200
+    /// (beyond the paper): on E4 the main branch's re-solve seldom converges within the warm
+    /// budget, so with 100 here the cycle's own re-solve ran on for a median 98 evaluations;
+    /// with 200 off the cycle it stops after a median 21 (`trust-sim run scenarios/e4.toml
+    /// --seed 9401`), and flight times and the suite's outcomes stay as they were.
+    pub worker_march_max_evaluations: Option<usize>,
     /// Run FwdExplore (the frontend and the cold solves) every this many cycles, and in every cycle
     /// that starts with fewer than two kept branches or without a main branch. 1: every cycle (the
     /// paper's Algorithm 1). At least 1. Default 3 (beyond the paper): the kept branches carry
@@ -193,6 +203,7 @@ impl ManagerParams {
             cold_solves_per_cycle: Some(2),
             background: true,
             merge_max_evaluations: None,
+            worker_march_max_evaluations: Some(200),
             explore_period_cycles: 3,
             repair_margin_m: 0.05,
             ranking: None,
@@ -287,6 +298,11 @@ impl ManagerParams {
                 self.sub_branch_max_evaluations,
             ),
             ("manager.cold_max_evaluations", self.cold_max_evaluations),
+            ("manager.merge_max_evaluations", self.merge_max_evaluations),
+            (
+                "manager.worker_march_max_evaluations",
+                self.worker_march_max_evaluations,
+            ),
         ] {
             if v == Some(0) {
                 return Err(PlanError::invalid(

@@ -304,6 +304,42 @@ fn with_the_worker_the_main_branch_is_re_solved_within_the_merge_budget() {
     );
 }
 
+#[test]
+fn a_worker_that_converges_the_main_branch_leaves_the_cycle_little_to_re_solve() {
+    // The cycle's own re-solve of the main branch starts from the worker's: the more of it the
+    // worker did (`worker_march_max_evaluations`), the fewer evaluations remain on the cycle.
+    let map = std::sync::Arc::new(two_gap_corridor());
+    let in_cycle = |worker_budget: usize| {
+        let mut m = planner(ManagerParams {
+            warm_max_evaluations: Some(60),
+            worker_march_max_evaluations: Some(worker_budget),
+            repair_margin_m: 0.0,
+            ..ManagerParams::trust()
+        });
+        m.share_map(std::sync::Arc::clone(&map));
+        let reports = fly(&mut m, &map, GOAL, State::at_rest(0.0, START), 12, |_| {
+            Vec::new()
+        });
+        let marched: Vec<usize> = reports
+            .iter()
+            .filter(|r| r.timing.worker_ms > 0.0)
+            .flat_map(|r| r.branches.iter())
+            .filter(|b| b.origin == Origin::Marched)
+            .map(|b| b.evaluation_count)
+            .collect();
+        assert!(
+            marched.len() >= 5,
+            "merged cycles with a main branch: {marched:?}"
+        );
+        marched.iter().sum::<usize>() as f64 / marched.len() as f64
+    };
+    let (short, long) = (in_cycle(2), in_cycle(400));
+    assert!(
+        long < short,
+        "mean in-cycle evaluations: worker budget 400 {long}, worker budget 2 {short}"
+    );
+}
+
 fn summary(reports: &[StepReport]) -> Vec<String> {
     reports
         .iter()

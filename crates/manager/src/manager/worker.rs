@@ -124,7 +124,12 @@ pub(super) fn run<F: PathFrontend, B: TrajectoryBackend>(input: JobInput<F, B>) 
         },
         || {
             rayon::join(
-                || main.map(|traj| solver.fwd_march(&traj)),
+                || {
+                    let budget = params
+                        .worker_march_max_evaluations
+                        .or(params.warm_max_evaluations);
+                    main.map(|traj| solver.fwd_march_within(&traj, budget))
+                },
                 || {
                     subs.par_iter()
                         .map(|(id, traj)| (*id, solver.bwd_replan(traj)))
