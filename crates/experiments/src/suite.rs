@@ -102,6 +102,10 @@ pub struct SuiteRow {
     pub over_budget: usize,
     /// Replanning ticks skipped because the planner was busy (real-time mode; 0 otherwise).
     pub skipped_ticks: u64,
+    /// Simulated time over the flight's wall time (how many times faster than real time it
+    /// flew, planning and simulation included; depends on the machine and its load).
+    #[serde(default)]
+    pub real_time_factor: f64,
 }
 
 impl SuiteRow {
@@ -109,12 +113,12 @@ impl SuiteRow {
                                    ideal_time_s,path_length_m,min_clearance_static_m,\
                                    min_clearance_dynamic_m,max_accel,a_max,fallbacks,log,\
                                    forecast_warning_s,v_max,cycle_ms_max,over_budget,\
-                                   skipped_ticks";
+                                   skipped_ticks,real_time_factor";
 
     fn to_line(&self) -> String {
         let clean = |s: &str| s.replace([',', '\n', '\r', '"'], ";");
         format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             clean(&self.class),
             clean(&self.planner),
             self.seed,
@@ -136,6 +140,7 @@ impl SuiteRow {
             self.cycle_ms_max,
             self.over_budget,
             self.skipped_ticks,
+            self.real_time_factor,
         )
     }
 }
@@ -410,6 +415,7 @@ fn fly_one(class: &str, s: &Scenario, out: &Path) -> Result<SuiteRow, Experiment
         cycle_ms_max: sm.cycle_ms_max,
         over_budget: sm.over_budget_count,
         skipped_ticks: sm.skipped_tick_count,
+        real_time_factor: sm.real_time_factor,
     })
 }
 
@@ -510,6 +516,17 @@ fn report(config: &SuiteConfig, summary: &[ClassSummary], rows: &[SuiteRow]) -> 
         total(|c| c.over_budget),
         summary.iter().map(|c| c.skipped_ticks).sum::<u64>(),
     ));
+    if let Some(slowest) = rows
+        .iter()
+        .filter(|r| r.real_time_factor > 0.0)
+        .min_by(|a, b| a.real_time_factor.total_cmp(&b.real_time_factor))
+    {
+        s.push_str(&format!(
+            "Slowest flight {:.1}× real time ({}, seed {}; simulated over wall time on this \
+             machine, flights in parallel share its cores).\n\n",
+            slowest.real_time_factor, slowest.class, slowest.seed,
+        ));
+    }
     let mut class = "";
     for c in summary {
         if c.class != class {
@@ -636,6 +653,7 @@ mod tests {
             cycle_ms_max: 4.0,
             over_budget: 0,
             skipped_ticks: 0,
+            real_time_factor: 5.0,
         }
     }
 
