@@ -133,9 +133,11 @@ enum Cmd {
         )]
         planners: Vec<String>,
         /// One-component ablation applied to every planner it concerns: none, vprm, minco, uvd,
-        /// no-pdc, no-ggs, no-history, no-hysteresis, perfect, quadrotor, mu=X, fault=X,
-        /// explore=K, route (a global route on the static map; without it every planner aims at
-        /// the final goal, the paper's setting).
+        /// no-pdc, no-ggs, no-history, no-hysteresis, no-worker (every solve in the cycle),
+        /// perfect, quadrotor, mu=X, fault=X, explore=K, route (a global route on the static map;
+        /// without it every planner aims at the final goal, the paper's setting), real-time or
+        /// real-time=X (each cycle's measured wall time, times X, is charged: use `--jobs 1` on a
+        /// quiet machine).
         #[arg(long, default_value = "none")]
         variant: String,
         /// Output directory.
