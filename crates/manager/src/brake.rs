@@ -375,6 +375,12 @@ fn brake(
     // swung the command from +0.9 to −0.9 a_max within 0.1 s (the path's own jerk and the
     // ramp of λ̇ added up) and the quadrotor overshot a_max by 10 %.
     let jerk_max = a_max / RAMP_S;
+    let rates = LambdaRates {
+        target,
+        beta_min,
+        ramp,
+        jerk_max,
+    };
 
     let mut accel = a_path + v_start * initial_lambda_dot;
     if v_start.norm() < accel.norm() * RAMP_S {
@@ -393,40 +399,7 @@ fn brake(
         u += lambda * STEP_S + 0.5 * lambda_dot * STEP_S * STEP_S;
         lambda = (lambda + lambda_dot * STEP_S).max(0.0);
         let [_, dq, ddq] = path.eval(u);
-        let speed = dq.norm().max(1e-9);
-        // The largest deceleration rate with |q″λ² + q′λ̇| ≤ target: the path's own
-        // acceleration along q′ helps or hinders, the part across it only uses up the budget.
-        let tangent = dq / speed;
-        let a_along = ddq.dot(&tangent) * lambda * lambda;
-        let a_across = (ddq * (lambda * lambda) - tangent * a_along).norm();
-        let exact = (a_along + (target * target - a_across * a_across).max(0.0).sqrt()) / speed;
-        let beta = exact.max(beta_min);
-        // The rate of λ̇ is bounded by the ramp and, where the path is fast, by the jerk limit
-        // (q′λ̈ is the acceleration's change along the path).
-        let ramp_here = ramp.min(TARGET_FRACTION * jerk_max / speed);
-        // Slow enough to bring λ̇ back to 0 exactly when λ reaches 0 at that rate; on the way
-        // back λ̇ may change up to a quarter faster (within the jerk limit), so that it keeps to
-        // that curve (without the slack, where the path sped up, the curve outran λ̇ and the
-        // vehicle stopped dead from 0.2 a_max).
-        let wanted = -beta.min((2.0 * ramp_here * lambda).sqrt());
-        let mut next = lambda_dot
-            + (wanted - lambda_dot).clamp(-ramp_here * STEP_S, 1.25 * ramp_here * STEP_S);
-        // Keep |Δa| ≤ jerk_max·dt where λ̇ can: the λ̇ for which q″λ² + q′λ̇ stays that close
-        // to the last acceleration form an interval (a line through a ball). Never faster along
-        // the path than before or than the ramp asks: where the path's own acceleration falls,
-        // matching it means speeding up along the path — chased, that ran away to 3× the
-        // path's speed. Where no λ̇ matches (the path turns faster), the ramp alone.
-        let free = ddq * (lambda * lambda) - accel;
-        let (g2, cg) = (dq.norm_squared(), free.dot(&dq));
-        let radius = jerk_max * STEP_S;
-        let disc = cg * cg - g2 * (free.norm_squared() - radius * radius);
-        if g2 > 1e-12 && disc >= 0.0 {
-            let half = disc.sqrt();
-            next = next
-                .clamp((-cg - half) / g2, (-cg + half) / g2)
-                .min(lambda_dot.max(next));
-        }
-        lambda_dot = next;
+        lambda_dot = next_lambda_dot(&dq, &ddq, lambda, lambda_dot, &accel, &rates);
         accel = ddq * (lambda * lambda) + dq * lambda_dot;
         step += 1;
         if lambda <= 1e-6 {
@@ -455,6 +428,77 @@ fn brake(
         let (t_last, [q, _, _]) = knots[knots.len() - 1];
         knots.push((t_last + KNOT_S, [q, Vec3::zeros(), Vec3::zeros()]));
     }
+    knots_to_trajectory(&knots, t0, hold_s)
+}
+
+/// The rates that bound λ̇ in [`brake`]: the target deceleration (m/s²), the floor of λ's
+/// deceleration rate (1/s), the ramp of λ̇ (1/s²) and the jerk limit (m/s³).
+struct LambdaRates {
+    target: f64,
+    beta_min: f64,
+    ramp: f64,
+    jerk_max: f64,
+}
+
+/// One step of [`brake`]'s time scaling: the next λ̇ at path velocity `dq` and acceleration
+/// `ddq` (at `u`), with `λ`, the current `λ̇` and the last commanded acceleration `accel`.
+fn next_lambda_dot(
+    dq: &Vec3,
+    ddq: &Vec3,
+    lambda: f64,
+    lambda_dot: f64,
+    accel: &Vec3,
+    rates: &LambdaRates,
+) -> f64 {
+    let LambdaRates {
+        target,
+        beta_min,
+        ramp,
+        jerk_max,
+    } = *rates;
+    let speed = dq.norm().max(1e-9);
+    // The largest deceleration rate with |q″λ² + q′λ̇| ≤ target: the path's own
+    // acceleration along q′ helps or hinders, the part across it only uses up the budget.
+    let tangent = dq / speed;
+    let a_along = ddq.dot(&tangent) * lambda * lambda;
+    let a_across = (ddq * (lambda * lambda) - tangent * a_along).norm();
+    let exact = (a_along + (target * target - a_across * a_across).max(0.0).sqrt()) / speed;
+    let beta = exact.max(beta_min);
+    // The rate of λ̇ is bounded by the ramp and, where the path is fast, by the jerk limit
+    // (q′λ̈ is the acceleration's change along the path).
+    let ramp_here = ramp.min(TARGET_FRACTION * jerk_max / speed);
+    // Slow enough to bring λ̇ back to 0 exactly when λ reaches 0 at that rate; on the way
+    // back λ̇ may change up to a quarter faster (within the jerk limit), so that it keeps to
+    // that curve (without the slack, where the path sped up, the curve outran λ̇ and the
+    // vehicle stopped dead from 0.2 a_max).
+    let wanted = -beta.min((2.0 * ramp_here * lambda).sqrt());
+    let mut next =
+        lambda_dot + (wanted - lambda_dot).clamp(-ramp_here * STEP_S, 1.25 * ramp_here * STEP_S);
+    // Keep |Δa| ≤ jerk_max·dt where λ̇ can: the λ̇ for which q″λ² + q′λ̇ stays that close
+    // to the last acceleration form an interval (a line through a ball). Never faster along
+    // the path than before or than the ramp asks: where the path's own acceleration falls,
+    // matching it means speeding up along the path — chased, that ran away to 3× the
+    // path's speed. Where no λ̇ matches (the path turns faster), the ramp alone.
+    let free = ddq * (lambda * lambda) - accel;
+    let (g2, cg) = (dq.norm_squared(), free.dot(dq));
+    let radius = jerk_max * STEP_S;
+    let disc = cg * cg - g2 * (free.norm_squared() - radius * radius);
+    if g2 > 1e-12 && disc >= 0.0 {
+        let half = disc.sqrt();
+        next = next
+            .clamp((-cg - half) / g2, (-cg + half) / g2)
+            .min(lambda_dot.max(next));
+    }
+    next
+}
+
+/// [`brake`]'s knots (time since the start, `[p, v, a]`) as quintic pieces from `t0`, then the
+/// hold at the last knot's position for `hold_s`.
+fn knots_to_trajectory(
+    knots: &[(f64, [Vec3; 3])],
+    t0: f64,
+    hold_s: f64,
+) -> Result<PolyTraj, PlanError> {
     let mut durations = Vec::with_capacity(knots.len());
     let mut pieces = Vec::with_capacity(knots.len());
     for w in knots.windows(2) {

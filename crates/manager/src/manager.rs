@@ -479,65 +479,14 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     ) -> Result<StepReport, PlanError> {
         let mut spans = Spans::start();
         check_step_input(now, measured, goal)?;
-        let real_goal = *goal;
-        // The forecasts the cycle plans against: their growth stopped after
-        // `forecast_growth_s`, and their mirror images at the walls.
-        let growth_s = self.params.forecast_growth();
-        let mut seen: Vec<Forecast> = scene
-            .forecasts
-            .iter()
-            .map(|f| f.with_growth_for(growth_s))
-            .collect();
-        if self.params.wall_images {
-            seen = with_wall_images(
-                seen,
-                scene.map.bounds(),
-                now,
-                now + 2.0 * self.params.horizon_s,
-            );
-        }
+        let seen = self.planned_forecasts(now, scene);
         let planned = Scene {
             forecasts: &seen,
             ..*scene
         };
         let scene = &planned;
-        // A goal outside the bounds or inside a static obstacle is a verdict, checked every
-        // cycle: the vehicle holds a stop short of it (no route search is needed to know).
-        let invalid_goal = invalid_goal_cause(goal, scene);
-        let newly_invalid = match &invalid_goal {
-            Some(cause) => self.hold_short_of_invalid_goal(cause, measured, goal, scene),
-            None => {
-                if self.router.is_none() {
-                    // Without a router the only verdict is an invalid goal's.
-                    self.unreachable = None;
-                }
-                false
-            }
-        };
-        // With a standing verdict that the goal cannot be reached, the cycle plans toward the
-        // reachable point nearest it (a held stop); the route keeps being re-checked.
-        let target = self.target(goal);
-        let mut cycle = self.begin_cycle(now, measured, &target, spans.started);
-        if let Some(u) = self.unreachable.as_ref().filter(|_| newly_invalid) {
-            cycle.events.push(Event::GoalUnreachable {
-                cause: u.cause.clone(),
-                held_at: u.held_at,
-            });
-        }
-        if invalid_goal.is_none() {
-            self.update_route(&mut cycle, measured, &real_goal, scene, &mut spans);
-        }
-        // A vehicle at rest waits where it is for its first route toward a new goal (a few
-        // cycles): flown toward the goal meanwhile it would head into the trap the route is
-        // for. It still plans (to hold its place), so it still gets out of a moving obstacle's
-        // way.
-        let target = if self.awaiting_first_route(measured) {
-            cycle.events.push(Event::AwaitingRoute);
-            measured.p
-        } else {
-            target
-        };
-        cycle.goal = target;
+        let mut cycle = self.begin_toward(now, measured, goal, scene, &mut spans);
+        let target = cycle.goal;
         let goal = &target;
 
         // Algorithm 1, lines 5–8: FwdMarch of the main branch and BwdReplan of the sub-branches,
@@ -588,6 +537,79 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             goal_unreachable: self.unreachable.clone(),
             worker_started,
         })
+    }
+
+    /// Starts the cycle toward `goal`: the verdict on a goal outside the bounds or inside a
+    /// static obstacle, the route, and the point the cycle aims at ([`Cycle::goal`]: the goal,
+    /// the held stop short of an unreachable one, or the vehicle's own place while it waits for
+    /// its first route).
+    fn begin_toward(
+        &mut self,
+        now: f64,
+        measured: &State,
+        goal: &Vec3,
+        scene: &Scene<'_>,
+        spans: &mut Spans,
+    ) -> Cycle {
+        // A goal outside the bounds or inside a static obstacle is a verdict, checked every
+        // cycle: the vehicle holds a stop short of it (no route search is needed to know).
+        let invalid_goal = invalid_goal_cause(goal, scene);
+        let newly_invalid = match &invalid_goal {
+            Some(cause) => self.hold_short_of_invalid_goal(cause, measured, goal, scene),
+            None => {
+                if self.router.is_none() {
+                    // Without a router the only verdict is an invalid goal's.
+                    self.unreachable = None;
+                }
+                false
+            }
+        };
+        // With a standing verdict that the goal cannot be reached, the cycle plans toward the
+        // reachable point nearest it (a held stop); the route keeps being re-checked.
+        let target = self.target(goal);
+        let mut cycle = self.begin_cycle(now, measured, &target, spans.started);
+        if let Some(u) = self.unreachable.as_ref().filter(|_| newly_invalid) {
+            cycle.events.push(Event::GoalUnreachable {
+                cause: u.cause.clone(),
+                held_at: u.held_at,
+            });
+        }
+        if invalid_goal.is_none() {
+            self.update_route(&mut cycle, measured, goal, scene, spans);
+        }
+        // A vehicle at rest waits where it is for its first route toward a new goal (a few
+        // cycles): flown toward the goal meanwhile it would head into the trap the route is
+        // for. It still plans (to hold its place), so it still gets out of a moving obstacle's
+        // way.
+        let target = if self.awaiting_first_route(measured) {
+            cycle.events.push(Event::AwaitingRoute);
+            measured.p
+        } else {
+            target
+        };
+        cycle.goal = target;
+        cycle
+    }
+
+    /// The forecasts a cycle at `now` plans against: `scene`'s with their growth stopped after
+    /// `forecast_growth_s`, and their mirror images at the walls.
+    fn planned_forecasts(&self, now: f64, scene: &Scene<'_>) -> Vec<Forecast> {
+        let growth_s = self.params.forecast_growth();
+        let seen: Vec<Forecast> = scene
+            .forecasts
+            .iter()
+            .map(|f| f.with_growth_for(growth_s))
+            .collect();
+        if self.params.wall_images {
+            with_wall_images(
+                seen,
+                scene.map.bounds(),
+                now,
+                now + 2.0 * self.params.horizon_s,
+            )
+        } else {
+            seen
+        }
     }
 
     /// Whether the vehicle is at rest and its first route toward the goal is being searched.
@@ -1429,7 +1451,11 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         Some(decision.main)
     }
 
-    /// Builds the braking fallback, commits it and reports it.
+    /// Builds the braking fallback, commits it and reports it: the options
+    /// ([`Manager::fallback_options`]), the first admissible one clear of the held forecasts or
+    /// else the best-ranked ([`Manager::first_clear_fallback`]), and when none is clear, the one
+    /// with the widest margin against the obstacles' likely motion
+    /// ([`Manager::widest_likely_fallback`]).
     fn fallback(
         &mut self,
         start: &State,
@@ -1439,6 +1465,63 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         events: &mut Vec<Event>,
     ) -> Option<FallbackReport> {
         let hold_s = self.params.brake_hold();
+        let mut options = self.fallback_options(start, reanchored, rejected, hold_s);
+        // The options are judged against the forecasts grown for at most a quarter of the
+        // horizon (the scene's forecasts already stop growing after `forecast_growth`, 0.25 s
+        // by default; this cap matters when that is longer, e.g. the paper's growth for ever)
+        // and then held: the fallback is chosen again next cycle from new observations, and against
+        // an uncertainty growing without end every option collides at last, so the latest
+        // collision won — fleeing along a person's path instead of stepping out of it.
+        let grow_for = FALLBACK_GROWTH_FRACTION * self.params.horizon_s;
+        let held: Vec<Forecast> = scene
+            .forecasts
+            .iter()
+            .map(|f| f.growth_held_after(grow_for))
+            .collect();
+        let judged = Scene {
+            forecasts: &held,
+            ..*scene
+        };
+        let (mut best, verdicts) = self.first_clear_fallback(&options, start, &judged);
+        if best.as_ref().is_some_and(|(_, v)| v.violation.is_some())
+            && let Some(i) = self.widest_likely_fallback(&options, &verdicts, start, scene)
+        {
+            // Reported against the forecasts (its shortfall is theirs).
+            best = Some((i, verdicts[i]));
+        }
+        let (i, verdict) = best?;
+        let (along, traj) = options.swap_remove(i);
+        let collision_free = verdict.violation.is_none();
+        let stop_time = traj.t_end() - hold_s;
+        events.push(Event::Fallback {
+            along,
+            collision_free,
+            min_margin_m: verdict.min_margin_m(),
+        });
+        self.committed = Some(traj);
+        Some(FallbackReport {
+            along,
+            collision_free,
+            min_margin_m: verdict.min_margin_m(),
+            shortfall_m: if collision_free {
+                0.0
+            } else {
+                (-verdict.min_margin_m()).max(0.0)
+            },
+            stop_time,
+        })
+    }
+
+    /// The fallback's options, in the order they are tried: braking along the committed plan
+    /// (unless re-anchored) and along each rejected trajectory, braking straight, the rejected
+    /// trajectories flown as they are (evade), then the escapes and the dashes.
+    fn fallback_options(
+        &self,
+        start: &State,
+        reanchored: bool,
+        rejected: &[(FallbackKind, PolyTraj)],
+        hold_s: f64,
+    ) -> Vec<(FallbackKind, PolyTraj)> {
         let a_max = self.limits.a_max;
         let mut options: Vec<(FallbackKind, PolyTraj)> = Vec::new();
         if let Some(plan) = self.committed.as_ref().filter(|_| !reanchored)
@@ -1484,43 +1567,40 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         if let Ok(dashes) = dash_maneuvers(start, &directions, cruise_s, &self.limits, hold_s) {
             options.extend(dashes.into_iter().map(|t| (FallbackKind::Dash, t)));
         }
-        // The options are judged against the forecasts grown for at most a quarter of the
-        // horizon (the scene's forecasts already stop growing after `forecast_growth`, 0.25 s
-        // by default; this cap matters when that is longer, e.g. the paper's growth for ever)
-        // and then held: the fallback is chosen again next cycle from new observations, and against
-        // an uncertainty growing without end every option collides at last, so the latest
-        // collision won — fleeing along a person's path instead of stepping out of it.
-        let grow_for = FALLBACK_GROWTH_FRACTION * self.params.horizon_s;
-        let held: Vec<Forecast> = scene
-            .forecasts
-            .iter()
-            .map(|f| f.growth_held_after(grow_for))
-            .collect();
-        let judged = Scene {
-            forecasts: &held,
-            ..*scene
-        };
-        // The first collision-free option; else, clear of the static map and the bounds before
-        // all (they are known, the forecasts are guesses: a vehicle that dodged a person into a
-        // door frame hit it), the one that collides latest, then least deeply.
-        let jerk_limit = a_max / crate::brake::RAMP_S;
-        let assess = |traj: &PolyTraj, scene: &Scene<'_>| {
-            assess_trajectory(
-                traj,
-                scene,
-                start.t,
-                traj.t_end(),
-                &self.limits,
-                &self.params.safety,
-            )
-        };
-        // A rejected trajectory that breaks the speed or acceleration limits is no way out
-        // (without this, one rejected only for its limits passed as "collision-free" and the
-        // vehicle flew it: up to 1.08 a_max in the rooms with people).
-        let admissible = |kind: FallbackKind, traj: &PolyTraj, v: &SafetyVerdict| {
-            kind != FallbackKind::Evade || !(v.over_limits || max_jerk(traj) > jerk_limit)
-        };
-        let mut best: Option<(usize, SafetyVerdict)> = None;
+        options
+    }
+
+    /// The safety verdict on a fallback option from `start` to its end.
+    fn assess_fallback(&self, traj: &PolyTraj, start: &State, scene: &Scene<'_>) -> SafetyVerdict {
+        assess_trajectory(
+            traj,
+            scene,
+            start.t,
+            traj.t_end(),
+            &self.limits,
+            &self.params.safety,
+        )
+    }
+
+    /// Whether a fallback option may be flown at all. A rejected trajectory that breaks the
+    /// speed or acceleration limits is no way out (without this, one rejected only for its
+    /// limits passed as "collision-free" and the vehicle flew it: up to 1.08 a_max in the rooms
+    /// with people).
+    fn admissible_fallback(&self, kind: FallbackKind, traj: &PolyTraj, v: &SafetyVerdict) -> bool {
+        let jerk_limit = self.limits.a_max / crate::brake::RAMP_S;
+        kind != FallbackKind::Evade || !(v.over_limits || max_jerk(traj) > jerk_limit)
+    }
+
+    /// The first admissible option clear of `judged`'s forecasts; else, clear of the static map
+    /// and the bounds before all (they are known, the forecasts are guesses: a vehicle that
+    /// dodged a person into a door frame hit it), the one that collides latest, then least
+    /// deeply. Also every verdict computed, by option (up to the first clear one).
+    fn first_clear_fallback(
+        &self,
+        options: &[(FallbackKind, PolyTraj)],
+        start: &State,
+        judged: &Scene<'_>,
+    ) -> (Option<(usize, SafetyVerdict)>, Vec<SafetyVerdict>) {
         let rank = |v: &SafetyVerdict| {
             let static_clear = v.min_static_margin_m >= 0.0;
             (
@@ -1529,11 +1609,12 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                 v.min_margin_m(),
             )
         };
+        let mut best: Option<(usize, SafetyVerdict)> = None;
         let mut verdicts = Vec::with_capacity(options.len());
         for (i, (kind, traj)) in options.iter().enumerate() {
-            let v = assess(traj, &judged);
+            let v = self.assess_fallback(traj, start, judged);
             verdicts.push(v);
-            if !admissible(*kind, traj, &v) {
+            if !self.admissible_fallback(*kind, traj, &v) {
                 continue;
             }
             if v.violation.is_none() {
@@ -1546,78 +1627,63 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                 best = Some((i, v));
             }
         }
-        // Nothing clear of the forecasts: of the options that stay clear of the obstacles'
-        // likely motion — the forecasts without their growth, else without any margin beyond
-        // the obstacle's own size — and of the static map, the one with the widest margin
-        // there. "Collides latest" alone fled along a faster person's path, where the person
-        // catches up, instead of stepping out of it, which the forecasts' margins (some 0.4 m
-        // on each side of a person's lane) had ruled out (a holdout room with a person pacing
-        // across it: 16 of 60 flights collided, 11 with this alone, 3 with the EKF's lag
-        // compensation too).
-        if best.as_ref().is_some_and(|(_, v)| v.violation.is_some()) {
-            let likely: [Vec<Forecast>; 2] = [
-                scene
-                    .forecasts
-                    .iter()
-                    .map(|f| f.growth_held_after(0.0))
-                    .collect(),
-                scene
-                    .forecasts
-                    .iter()
-                    .map(|f| Forecast {
-                        r_safe: 0.0,
-                        mu: 0.0,
-                        ..*f
-                    })
-                    .collect(),
-            ];
-            for forecasts in &likely {
-                let level = Scene {
-                    forecasts,
-                    ..*scene
-                };
-                // The clear option with the widest margin (the first clear one braked to rest
-                // 3 cm outside a person's likely lane, and the person was not quite there).
-                let widest = options
-                    .iter()
-                    .enumerate()
-                    .filter(|(i, (kind, traj))| admissible(*kind, traj, &verdicts[*i]))
-                    .filter_map(|(i, (_, traj))| {
-                        let v = assess(traj, &level);
-                        v.violation.is_none().then(|| (i, v.min_margin_m()))
-                    })
-                    .fold(None, |acc: Option<(usize, f64)>, (i, m)| match acc {
-                        Some((_, best)) if best >= m => acc,
-                        _ => Some((i, m)),
-                    });
-                if let Some((i, _)) = widest {
-                    // Reported against the forecasts (its shortfall is theirs).
-                    best = Some((i, verdicts[i]));
-                    break;
-                }
+        (best, verdicts)
+    }
+
+    /// Nothing clear of the forecasts: of the options that stay clear of the obstacles' likely
+    /// motion — the forecasts without their growth, else without any margin beyond the
+    /// obstacle's own size — and of the static map, the one with the widest margin there.
+    /// "Collides latest" alone fled along a faster person's path, where the person catches up,
+    /// instead of stepping out of it, which the forecasts' margins (some 0.4 m on each side of a
+    /// person's lane) had ruled out (a holdout room with a person pacing across it: 16 of 60
+    /// flights collided, 11 with this alone, 3 with the EKF's lag compensation too).
+    fn widest_likely_fallback(
+        &self,
+        options: &[(FallbackKind, PolyTraj)],
+        verdicts: &[SafetyVerdict],
+        start: &State,
+        scene: &Scene<'_>,
+    ) -> Option<usize> {
+        let likely: [Vec<Forecast>; 2] = [
+            scene
+                .forecasts
+                .iter()
+                .map(|f| f.growth_held_after(0.0))
+                .collect(),
+            scene
+                .forecasts
+                .iter()
+                .map(|f| Forecast {
+                    r_safe: 0.0,
+                    mu: 0.0,
+                    ..*f
+                })
+                .collect(),
+        ];
+        for forecasts in &likely {
+            let level = Scene {
+                forecasts,
+                ..*scene
+            };
+            // The clear option with the widest margin (the first clear one braked to rest
+            // 3 cm outside a person's likely lane, and the person was not quite there).
+            let widest = options
+                .iter()
+                .enumerate()
+                .filter(|(i, (kind, traj))| self.admissible_fallback(*kind, traj, &verdicts[*i]))
+                .filter_map(|(i, (_, traj))| {
+                    let v = self.assess_fallback(traj, start, &level);
+                    v.violation.is_none().then(|| (i, v.min_margin_m()))
+                })
+                .fold(None, |acc: Option<(usize, f64)>, (i, m)| match acc {
+                    Some((_, best)) if best >= m => acc,
+                    _ => Some((i, m)),
+                });
+            if let Some((i, _)) = widest {
+                return Some(i);
             }
         }
-        let (i, verdict) = best?;
-        let (along, traj) = options.swap_remove(i);
-        let collision_free = verdict.violation.is_none();
-        let stop_time = traj.t_end() - hold_s;
-        events.push(Event::Fallback {
-            along,
-            collision_free,
-            min_margin_m: verdict.min_margin_m(),
-        });
-        self.committed = Some(traj);
-        Some(FallbackReport {
-            along,
-            collision_free,
-            min_margin_m: verdict.min_margin_m(),
-            shortfall_m: if collision_free {
-                0.0
-            } else {
-                (-verdict.min_margin_m()).max(0.0)
-            },
-            stop_time,
-        })
+        None
     }
 }
 
