@@ -7,7 +7,8 @@
 //! of a folder with K seeds and writes one table per class (`trust-sim suite`); [`e3`] reproduces
 //! Table Sim-B-1 (the branches of one planning cycle); [`e1`] and [`e2`] type the JSON printed by the
 //! E1 and E2 examples and write their reports; [`flight_plots`] draws the figures of one flight from
-//! its run log. Errors are [`ExperimentError`]s naming the file, field and value.
+//! its run log; [`forest`] flies MIT-ACL's dynamic-forest benchmark and scores it with the
+//! peers' metrics (`trust-sim forest`). Errors are [`ExperimentError`]s naming the file, field and value.
 //!
 //! Use it to run or summarize a comparison (the `trust-sim` binary and `cargo xtask ablate` are thin
 //! wrappers), or to read a study's outputs: [`study::read_runs_csv`] and the serde types of
@@ -29,6 +30,7 @@ pub mod e2;
 pub mod e3;
 mod error;
 pub mod flight_plots;
+pub mod forest;
 pub mod study;
 pub mod suite;
 

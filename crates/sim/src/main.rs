@@ -14,6 +14,9 @@
 //! trust-sim suite [SCENARIO.toml|DIR...] [--seeds K] [--seed S] [--planners a,b] [--out DIR]
 //!                 [--jobs J] [--time-limit T] [--no-plots] [--real-time [CPU_SCALE]]
 //! trust-sim e3 [--scenario FILE] [--seed S] [--out DIR]
+//! trust-sim forest [--tier easy|medium|hard|all] [--trials N] [--seed S] [--planner a,b]
+//!                  [--jobs J] [--out DIR] [--static known] [--time-limit T]
+//!                  [--vehicle perfect|quadrotor] [--real-time [CPU_SCALE]]
 //! ```
 //!
 //! The binary only parses the command line; the work is in `trust-world` (scenarios, worlds),
@@ -202,6 +205,52 @@ enum Cmd {
         /// Output directory.
         #[arg(long, default_value = "out/e3")]
         out: PathBuf,
+    },
+    /// MIT-ACL's dynamic-forest benchmark (docs/dynamic-forest.md): the tiers easy / medium /
+    /// hard (50 / 100 / 200 obstacles, 65 % cubes on trefoil knots) flown in closed loop and
+    /// scored with the peers' metrics; writes runs.csv, runs.json, summary.json, report.md and
+    /// every run log.
+    Forest {
+        /// Tiers: easy, medium, hard or all (or a comma-separated list).
+        #[arg(long, default_value = "all")]
+        tier: String,
+        /// Trials per tier and planner (the peers fly 10).
+        #[arg(long, default_value_t = 10)]
+        trials: usize,
+        /// Base seed: trial i flies seed S + i.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Planner presets, comma-separated, in report order.
+        #[arg(
+            long,
+            alias = "planners",
+            default_value = "trust",
+            value_delimiter = ','
+        )]
+        planner: Vec<String>,
+        /// Worker threads (default: one per core).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Output directory.
+        #[arg(long, default_value = "out/forest")]
+        out: PathBuf,
+        /// The scenario (its generator must be `dynamic-forest`; the tier sets its count).
+        #[arg(long, default_value = "scenarios/dynamic_forest.toml")]
+        scenario: PathBuf,
+        /// What the planner knows of the static obstacles: known (their true shapes). The
+        /// unknown mode (a sensed point cloud) is not implemented yet.
+        #[arg(long = "static", default_value = "known")]
+        static_mode: String,
+        /// Simulated time limit per flight (s), replacing the scenario's 100 s.
+        #[arg(long)]
+        time_limit: Option<f64>,
+        /// Vehicle model, replacing the scenario's (perfect tracking, as the peers' simulator).
+        #[arg(long)]
+        vehicle: Option<Model>,
+        /// Fly in real time (see `run --real-time`), replacing the scenario's `sim.latency`.
+        /// Measured times depend on the machine's load: use `--jobs 1` on a quiet machine.
+        #[arg(long, value_name = "CPU_SCALE", num_args = 0..=1, default_missing_value = "1")]
+        real_time: Option<f64>,
     },
     /// Combine the directories of a sharded study into one report, as a single run would write.
     AblateMerge {
@@ -462,6 +511,58 @@ fn run_cli() -> Result<ExitCode> {
             let summary = trust_experiments::e3::run_e3(&s, &out)?;
             out!("{}", trust_experiments::e3::report_md(&summary));
             out!("wrote {}", out.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Forest {
+            tier,
+            trials,
+            seed,
+            planner,
+            jobs,
+            out,
+            scenario,
+            static_mode,
+            time_limit,
+            vehicle,
+            real_time,
+        } => {
+            use trust_experiments::forest::{
+                ForestConfig, ForestOptions, SANDO_J_MAX, StaticMode, Tier, run_forest,
+            };
+            let static_mode: StaticMode = static_mode.parse()?;
+            let config = ForestConfig {
+                scenario,
+                tiers: Tier::parse_list(&tier)?,
+                trials,
+                seed,
+                planners: parse_presets(&planner)?,
+                static_mode,
+                time_limit_s: time_limit,
+                latency: real_time.map(real_time_latency).transpose()?,
+                vehicle: vehicle.map(|m| match m {
+                    Model::Quadrotor => VehicleModel::Quadrotor,
+                    Model::Perfect => VehicleModel::Perfect,
+                }),
+                j_max: SANDO_J_MAX,
+            };
+            config.validate()?;
+            eprintln!(
+                "{} tier(s) × {} trial(s) × {} planner(s) = {} flight(s) of the dynamic forest",
+                config.tiers.len(),
+                config.trials,
+                config.planners.len(),
+                config.tiers.len() * config.trials * config.planners.len()
+            );
+            let options = ForestOptions {
+                jobs,
+                progress: std::io::stderr().is_terminal(),
+            };
+            let rows = run_forest(&config, &out, &options)?;
+            let report = std::fs::read_to_string(out.join("report.md"))
+                .with_context(|| format!("reading {}", out.join("report.md").display()))?;
+            let head = report.split("## Reading it").next().unwrap_or(&report);
+            out!("{}", head.trim_end());
+            out!("\n{} flight(s); wrote {}", rows.len(), out.display());
             Ok(ExitCode::SUCCESS)
         }
         Cmd::AblateMerge {

@@ -9,7 +9,8 @@ use trust_predict::ObstacleShape;
 use crate::problem::{Problems, fmt_bounds, fmt_count, fmt_num, fmt_vec};
 use crate::scenario::scale::{MAX_PLACEMENT_WORK, check_sampled_points, sampled_point_bound};
 use crate::scenario::{
-    E4Params, GeneratorSpec, PointCloudSpec, Problem, RandomObstacles, Scenario,
+    DynamicForestParams, E4Params, GeneratorSpec, PointCloudSpec, Problem, RandomObstacles,
+    Scenario,
 };
 use crate::traffic::{Motion, MovingObstacle, MovingShape};
 
@@ -253,6 +254,56 @@ fn run_generator(
             };
             let statics: Vec<Shape> = layout.shapes.iter().chain(explicit).copied().collect();
             push_group(&group, bounds, &statics, ends, rng, work, layout, problems);
+        }
+        GeneratorSpec::DynamicForest(d) => dynamic_forest(d, bounds, rng, layout),
+    }
+}
+
+/// The dynamic forest (`trust_scenes::dynamic_forest`): its pillars and bars become static
+/// boxes, its cubes box obstacles on Fourier curves (the trefoils' exact coefficients). A cube
+/// may leave the world bounds (the knots reach z −1.9 to 6.9 m): its region is the world
+/// bounds widened to [`ForestRanges::reach`](trust_scenes::dynamic_forest::ForestRanges::reach),
+/// which only validation reads (a script does not reflect at walls). No placement is
+/// rejected: the centres start 5 m from the start along x, as in the benchmark.
+fn dynamic_forest(d: &DynamicForestParams, bounds: &Aabb, rng: &mut Rng, layout: &mut Layout) {
+    use trust_scenes::dynamic_forest::{self as forest, FOREST_RANGES, ForestObstacle};
+    let (lo, hi) = FOREST_RANGES.reach();
+    let region = Aabb {
+        min: bounds.min.inf(&lo),
+        max: bounds.max.sup(&hi),
+    };
+    let half = 0.5 * forest::CUBE_SIDE_M;
+    for (k, o) in forest::generate(d.obstacle_count, &FOREST_RANGES, rng)
+        .into_iter()
+        .enumerate()
+    {
+        match o {
+            ForestObstacle::Moving(knot) => {
+                let f = knot.fourier();
+                layout.obstacles.push(MovingObstacle {
+                    shape: MovingShape::Box {
+                        half_extents: [half; 3],
+                    },
+                    position: knot.position(0.0),
+                    velocity: knot.velocity(0.0),
+                    motion: Motion::Fourier(crate::script::FourierSpec {
+                        period_s: f.period_s,
+                        center: f.center,
+                        cos: f.cos.to_vec(),
+                        sin: f.sin.to_vec(),
+                        phase_s: f.phase_s,
+                    }),
+                    region,
+                });
+                layout
+                    .obstacle_origins
+                    .push(format!("world.generator obstacle {k} (moving cube)"));
+            }
+            ForestObstacle::Pillar { .. } | ForestObstacle::Bar { .. } => {
+                if let Some((min, max)) = o.static_box() {
+                    layout.shapes.push(Shape::AaBox(AaBox { min, max }));
+                }
+            }
         }
     }
 }

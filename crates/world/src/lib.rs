@@ -30,7 +30,8 @@
 //!
 //! The generators (`e1`, `e2-static`, `e2-dynamic`, `e3`, `e4`) reproduce the paper's stated
 //! settings; their distributions and why: `docs/decisions/0020-world-generators.md`; the point-cloud
-//! view: `0005-point-cloud-esdf.md`.
+//! view: `0005-point-cloud-esdf.md`. `dynamic-forest` is MIT-ACL's benchmark
+//! (`trust_scenes::dynamic_forest`, `docs/dynamic-forest.md`).
 //!
 //! # Validation
 //!

@@ -689,3 +689,150 @@ fn scripted_obstacles_follow_their_script_and_boxes_are_boxes() {
     );
     assert!((shape.radius() - 0.5).abs() < 1e-12, "√(0.4² + 0.3²)");
 }
+
+/// The dynamic forest's tier of `n` obstacles, trial seed `seed` (the file's setting).
+fn forest(n: usize, seed: u64) -> Scenario {
+    scenario(&format!(
+        "name = \"forest\"\nseed = {seed}\ntime_limit_s = 100.0\n\
+         [world]\ngenerator = {{ kind = \"dynamic-forest\", obstacle_count = {n} }}\n\
+         [mission]\nstart = [0, 0, 2]\ngoal = [105, 0, 2]\ngoal_tolerance_m = 0.5\n\
+         [vehicle]\nradius_m = 0.1\nlimits = {{ v_max = 5.0, a_max = 20.0 }}\nmodel = \"perfect\"\n"
+    ))
+}
+
+#[test]
+fn dynamic_forest_tiers_have_the_benchmarks_counts_and_are_deterministic() {
+    use trust_geometry::Shape;
+    // (obstacles, moving cubes, pillars, bars): 65 % move, 35 % of the rest are pillars.
+    for (n, moving, pillars, bars) in [(50, 32, 7, 11), (100, 65, 13, 22), (200, 130, 25, 45)] {
+        let w = World::build(&forest(n, 3)).unwrap();
+        assert_eq!(w.obstacles().len(), moving, "N = {n}");
+        assert_eq!(w.static_shapes().len(), n - moving, "N = {n}");
+        let size = |s: &Shape| match s {
+            Shape::AaBox(b) => (b.max - b.min, b.min.z),
+            other => panic!("a pillar or a bar is a box, not {other:?}"),
+        };
+        let is = |s: &Shape, want: [f64; 3]| (size(s).0 - Vec3::from(want)).norm() < 1e-12;
+        let standing = w
+            .static_shapes()
+            .iter()
+            .filter(|s| is(s, [0.4, 0.4, 4.0]) && size(s).1 == 0.0)
+            .count();
+        let lying = w
+            .static_shapes()
+            .iter()
+            .filter(|s| is(s, [0.4, 4.0, 0.4]))
+            .count();
+        assert_eq!((standing, lying), (pillars, bars), "N = {n}");
+        // Pillars first, then bars, as drawn.
+        assert!(
+            w.static_shapes()[..pillars]
+                .iter()
+                .all(|s| is(s, [0.4, 0.4, 4.0]))
+        );
+        for o in w.obstacles() {
+            assert_eq!(
+                o.shape,
+                MovingShape::Box {
+                    half_extents: [0.4; 3]
+                }
+            );
+        }
+        // Same seed, same forest; another seed, another forest.
+        let again = World::build(&forest(n, 3)).unwrap();
+        assert_eq!(again.static_shapes(), w.static_shapes());
+        assert_eq!(again.obstacles(), w.obstacles());
+        let other = World::build(&forest(n, 4)).unwrap();
+        assert_ne!(other.static_shapes(), w.static_shapes());
+    }
+}
+
+#[test]
+fn dynamic_forest_cubes_follow_the_trefoil_closed_form() {
+    use trust_scenes::dynamic_forest::{FOREST_RANGES, ForestObstacle, generate};
+    let seed = 5;
+    let w = World::build(&forest(50, seed)).unwrap();
+    // The generator is the world stream's first and only user.
+    let mut rng = Rng::seed_from_u64(Seeds::from_trial(seed).world);
+    let knots: Vec<_> = generate(50, &FOREST_RANGES, &mut rng)
+        .into_iter()
+        .filter_map(|o| match o {
+            ForestObstacle::Moving(k) => Some(k),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(knots.len(), w.obstacles().len());
+    let mut traffic = w.traffic().unwrap();
+    for (o, k) in w.obstacles().iter().zip(&knots) {
+        let Motion::Fourier(f) = &o.motion else {
+            panic!("a cube moves on a Fourier curve, not {:?}", o.motion);
+        };
+        assert!((f.period_s - std::f64::consts::TAU * k.slower).abs() < 1e-12);
+        assert!((f.phase_s - k.offset * k.slower).abs() < 1e-12);
+        let script = o.motion.script("m").unwrap().unwrap();
+        for t in [0.0, 1.7, 12.5, 33.3, 99.9] {
+            // x = x0 + sx/6 (sin u + 2 sin 2u), y = y0 + sy/5 (cos u − 2 cos 2u),
+            // z = z0 − sz/2 sin 3u, u = t/slower + offset.
+            let u = t / k.slower + k.offset;
+            let (c, s) = (k.center, k.scale);
+            let closed = Vec3::new(
+                c.x + s.x / 6.0 * (u.sin() + 2.0 * (2.0 * u).sin()),
+                c.y + s.y / 5.0 * (u.cos() - 2.0 * (2.0 * u).cos()),
+                c.z - s.z / 2.0 * (3.0 * u).sin(),
+            );
+            let (p, v) = script.evaluate(t);
+            assert!((p - closed).norm() < 1e-9, "t = {t}: {p} vs {closed}");
+            assert!((v - k.velocity(t)).norm() < 1e-9, "t = {t}");
+        }
+        // Peak speed within the benchmark's "at most about 1.8 m/s".
+        let peak = (0..2000)
+            .map(|i| k.velocity(i as f64 * k.period_s() / 2000.0).norm())
+            .fold(0.0, f64::max);
+        assert!(peak < 1.9, "{peak}");
+    }
+    // The true traffic follows the same curves.
+    for _ in 0..500 {
+        traffic.step(0.02).unwrap();
+    }
+    for (p, k) in traffic.positions().iter().zip(&knots) {
+        assert!((p - k.position(10.0)).norm() < 1e-6);
+    }
+}
+
+#[test]
+fn dynamic_forest_paths_stay_in_their_regions_and_clear_of_start_and_goal() {
+    let half = Vec3::repeat(0.4);
+    for n in [50, 100, 200] {
+        for seed in 0..4 {
+            let w = World::build(&forest(n, seed)).unwrap();
+            let b = *w.bounds();
+            assert_eq!(b.min, Vec3::new(-5.0, -15.0, 0.5));
+            assert_eq!(b.max, Vec3::new(110.0, 15.0, 6.0));
+            let (start, goal) = (w.start(), w.goal());
+            for o in w.obstacles() {
+                // The region is the world across (x, y) and wider in z: the knots go through
+                // the ground and above the ceiling.
+                let r = o.region;
+                assert!(r.min.x >= b.min.x && r.max.x <= b.max.x);
+                assert!(r.min.y >= b.min.y && r.max.y <= b.max.y);
+                let script = o.motion.script("m").unwrap().unwrap();
+                let Motion::Fourier(f) = &o.motion else {
+                    unreachable!()
+                };
+                for i in 0..600 {
+                    let (p, _) = script.evaluate(i as f64 * f.period_s / 600.0);
+                    let (lo, hi) = (p - half, p + half);
+                    assert!((0..3).all(|k| lo[k] >= r.min[k] && hi[k] <= r.max[k]));
+                    assert!(lo.x >= 2.6 - 1e-9 && hi.x <= 102.4 + 1e-9);
+                    assert!(o.shape.signed_distance(&p, &start) > 2.0);
+                    assert!(o.shape.signed_distance(&p, &goal) > 2.0);
+                }
+            }
+            for s in w.static_shapes() {
+                // x0 in [5, 100]: no pillar or bar comes within 4.8 m of the start or the goal.
+                assert!(s.signed_distance(&start) > 4.7, "{s:?}");
+                assert!(s.signed_distance(&goal) > 4.7, "{s:?}");
+            }
+        }
+    }
+}

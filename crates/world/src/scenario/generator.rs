@@ -27,6 +27,10 @@ pub enum GeneratorSpec {
     /// `{ kind = "e4" }`: experiment E4 (paper Sec. IV-D, Fig. baseline-test-3), 250 × 75 × 20 m
     /// of dense static obstacles seen as a point cloud and 100 moving obstacles.
     E4(E4Params),
+    /// `{ kind = "dynamic-forest", obstacle_count = 50 }`: MIT-ACL's dynamic-forest benchmark
+    /// (`trust_scenes::dynamic_forest`): 65 % cubes on trefoil knots, the rest pillars and bars,
+    /// between `(0, 0, 2)` and `(105, 0, 2)`; not an experiment of the paper.
+    DynamicForest(DynamicForestParams),
 }
 
 impl GeneratorSpec {
@@ -38,6 +42,7 @@ impl GeneratorSpec {
             GeneratorSpec::E2Dynamic(_) => "e2-dynamic",
             GeneratorSpec::E3(_) => "e3",
             GeneratorSpec::E4(_) => "e4",
+            GeneratorSpec::DynamicForest(_) => "dynamic-forest",
         }
     }
 
@@ -46,7 +51,10 @@ impl GeneratorSpec {
     /// (paper: 50 × 20 × 10 m), E3 `[-5, -10, 0]..[70, 10, 15]` (ours: Fig. Sim-A-1-1(a)'s goal
     /// `[65, 0, 7.5]` seen from a start at the origin needs 65 m along x; 20 m across as in E1,
     /// 15 m high so that the goal height 7.5 m is mid-height), E4 `[0, 0, 0]..[250, 75, 20]`
-    /// (paper: 250 × 75 × 20 m).
+    /// (paper: 250 × 75 × 20 m), dynamic forest `[-5, -15, 0.5]..[110, 15, 6]` (ours: 5 m
+    /// behind the start and beyond the goal along x; ±15 m across, 6 m beyond the farthest
+    /// reach of any obstacle so the forest can be flown around as in the peers' ±200 m map;
+    /// z = SANDO's altitude limits 0.5–6 m, `config/sando.yaml`).
     pub fn default_bounds(&self) -> Aabb {
         let (min, max) = match self {
             GeneratorSpec::E1(_) => ([0.0, 0.0, 0.0], [20.0, 20.0, 10.0]),
@@ -55,6 +63,7 @@ impl GeneratorSpec {
             }
             GeneratorSpec::E3(_) => ([-5.0, -10.0, 0.0], [70.0, 10.0, 15.0]),
             GeneratorSpec::E4(_) => ([0.0, 0.0, 0.0], [250.0, 75.0, 20.0]),
+            GeneratorSpec::DynamicForest(_) => ([-5.0, -15.0, 0.5], [110.0, 15.0, 6.0]),
         };
         Aabb {
             min: Vec3::from(min),
@@ -79,6 +88,7 @@ impl GeneratorSpec {
                 check_motion(&format!("{field}.motion"), &e.motion, p);
             }
             GeneratorSpec::E4(e) => e.check(field, p),
+            GeneratorSpec::DynamicForest(_) => {}
         }
     }
 }
@@ -97,6 +107,21 @@ pub(crate) fn check_motion(field: &str, m: &Motion, p: &mut Problems) {
              explicit [[obstacles]] entry, not to a generated group",
         ),
         Motion::ConstantVelocity {} => {}
+    }
+}
+
+/// Parameters of the dynamic-forest generator (`trust_scenes::dynamic_forest` documents the
+/// draws). The benchmark's tiers are easy / medium / hard = 50 / 100 / 200 obstacles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DynamicForestParams {
+    /// Number of obstacles `N`, moving and static. Default 50 (the easy tier).
+    pub obstacle_count: usize,
+}
+
+impl Default for DynamicForestParams {
+    fn default() -> Self {
+        DynamicForestParams { obstacle_count: 50 }
     }
 }
 

@@ -24,7 +24,7 @@
 //!
 //! [world]
 //! bounds = { min = [0, 0, 0], max = [40, 20, 10] }   # optional with a generator
-//! # generator = { kind = "e4", pillar_count = 150 } # e1 | e2-static | e2-dynamic | e3 | e4
+//! # generator = { kind = "e4", pillar_count = 150 } # e1 | e2-static | e2-dynamic | e3 | e4 | dynamic-forest
 //!
 //! [[static.shapes]]              # vertical cylinder, as in the run-log contract
 //! kind = "cylinder"
@@ -151,7 +151,7 @@ use serde::{Deserialize, Serialize};
 use trust_core::Aabb;
 
 pub use crate::problem::Problem;
-pub use generator::{E1Params, E2Params, E3Params, E4Params, GeneratorSpec};
+pub use generator::{DynamicForestParams, E1Params, E2Params, E3Params, E4Params, GeneratorSpec};
 pub use sections::{
     BoundsSpec, Latency, MAX_CPU_SCALE, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec,
     RandomEndpoints, RandomObstacles, SimSection, StaticSection, VehicleModel, VehicleSection,

@@ -217,6 +217,14 @@ impl<P> Scenario<P> {
                 }
                 self.scale_motion(p, &f("moving_motion"), &e.moving_motion);
             }
+            GeneratorSpec::DynamicForest(d) => {
+                p.count(
+                    &f("obstacle_count"),
+                    d.obstacle_count as u128,
+                    MAX_OBSTACLE_COUNT.min(MAX_STATIC_SHAPE_COUNT),
+                    "obstacles",
+                );
+            }
         }
     }
 
@@ -226,6 +234,10 @@ impl<P> Scenario<P> {
         let generated = match &self.world.generator {
             Some(GeneratorSpec::E4(e)) => {
                 e.pillar_count as u128 + e.wall_count as u128 + e.block_count as u128
+            }
+            Some(GeneratorSpec::DynamicForest(d)) => {
+                let n = d.obstacle_count;
+                (n - trust_scenes::dynamic_forest::moving_count(n)) as u128
             }
             _ => 0,
         };
@@ -379,6 +391,9 @@ impl<P> Scenario<P> {
             Some(GeneratorSpec::E1(e)) => e.obstacle_count as u128,
             Some(GeneratorSpec::E3(e)) => e.obstacle_count as u128,
             Some(GeneratorSpec::E4(e)) => e.moving_count as u128,
+            Some(GeneratorSpec::DynamicForest(d)) => {
+                trust_scenes::dynamic_forest::moving_count(d.obstacle_count) as u128
+            }
             _ => 0,
         };
         if total > MAX_OBSTACLE_COUNT as u128 {
