@@ -140,6 +140,30 @@ pub fn subscription<M: RosMessage + 'static>(
         .map_err(|e| Ros2Error::dds(format!("create subscription {name}"), e))
 }
 
+/// Takes every sample `sub` holds and hands it to `accept`; errors (a sample that does not
+/// decode, a message `accept` rejects) go to `warn` under `topic`.
+fn drain<M: RosMessage + 'static>(
+    sub: &Subscription<M>,
+    topic: &str,
+    warn: &mut dyn FnMut(&str, &Ros2Error),
+    mut accept: impl FnMut(M) -> Result<(), Ros2Error>,
+) {
+    loop {
+        match sub.take() {
+            Ok(Some((m, _))) => {
+                if let Err(e) = accept(m) {
+                    warn(topic, &e);
+                }
+            }
+            Ok(None) => break,
+            Err(e) => {
+                warn(topic, &Ros2Error::dds(format!("take from {topic}"), e));
+                break;
+            }
+        }
+    }
+}
+
 /// Where setpoints go.
 enum SetpointOut {
     Trajectory(Publisher<MultiDOFJointTrajectory>),
@@ -226,23 +250,14 @@ impl DdsNode {
         })
     }
 
-    /// Hands every message received so far to `core`; a rejected message goes to `warn`.
+    /// Hands every message received so far to `core`; a rejected message, or one that does
+    /// not decode, goes to `warn`.
     pub fn receive(&mut self, core: &mut NodeCore, warn: &mut dyn FnMut(&str, &Ros2Error)) {
-        while let Ok(Some((m, _))) = self.odom.take() {
-            if let Err(e) = core.on_odometry(&m) {
-                warn(topics::ODOM, &e);
-            }
-        }
-        while let Ok(Some((m, _))) = self.goal.take() {
-            if let Err(e) = core.on_goal(&m) {
-                warn(topics::GOAL, &e);
-            }
-        }
-        while let Ok(Some((m, _))) = self.obstacles.take() {
-            if let Err(e) = core.on_obstacles(&m) {
-                warn(topics::OBSTACLES, &e);
-            }
-        }
+        drain(&self.odom, topics::ODOM, warn, |m| core.on_odometry(&m));
+        drain(&self.goal, topics::GOAL, warn, |m| core.on_goal(&m));
+        drain(&self.obstacles, topics::OBSTACLES, warn, |m| {
+            core.on_obstacles(&m)
+        });
     }
 
     /// Runs one cycle of `core` at `now` and publishes its messages.
