@@ -23,7 +23,7 @@ use trust_ros2::{NodeCore, NodeParams, NodeSetup, Ros2Error};
 #[derive(Debug, Parser)]
 #[command(name = "trust-node", version)]
 struct Args {
-    /// Scenario file: its [planner] section, vehicle and map (bounds, static shapes).
+    /// Scenario file: its `[planner]` section, vehicle and map (bounds, static shapes).
     scenario: PathBuf,
     /// Node parameters (TOML: world_frame, body_frame, cycle_period_s, ...).
     #[arg(long)]
