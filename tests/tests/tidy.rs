@@ -73,7 +73,9 @@ fn members() -> Vec<Member> {
 /// `core`); `replay` (issue 20) reads run logs and draws with `plot`, and only the binary uses it;
 /// `export` (MCAP, issue 20) reads logs only (`runlog`), and only `sim` uses it;
 /// `flightstack` (PX4/Crazyflie outputs, issue 35) reads the planner's trajectory type (`core`)
-/// and knows no simulator type, its tests build MINCO trajectories (`minco`).
+/// and knows no simulator type, its tests build MINCO trajectories (`minco`); `ros2` (the ROS 2
+/// node, issue 35) sits at the top beside `sim`: the planner and map of a scenario file
+/// (`world`, `planner`) and the PX4 setpoints of `flightstack`.
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
     const PLANNING: &[&str] = &[
         "trust-overrides",
@@ -193,6 +195,15 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
         ),
         ("trust-replay", &["trust-runlog", "trust-plot"][..]),
         ("trust-flightstack", &["trust-core", "trust-minco"][..]),
+        (
+            "trust-ros2",
+            with(&[
+                "trust-vehicle",
+                "trust-world",
+                "trust-runlog",
+                "trust-flightstack",
+            ]),
+        ),
         (
             "trust-sim",
             with(&[

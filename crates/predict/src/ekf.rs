@@ -564,6 +564,30 @@ impl CvEkf {
         Ok(())
     }
 
+    /// The forecast at time `t`: the filter predicted to `t` on a copy, then [`CvEkf::forecast`];
+    /// at or before the filter time, the forecast made at the filter time. This is what a
+    /// tracker hands the planner each cycle (the simulator's `trust_world::Sensing::forecasts`,
+    /// the ROS 2 node's obstacle tracks).
+    ///
+    /// # Errors
+    /// As [`CvEkf::predict`] (a non-finite or absurd `t`) and [`CvEkf::forecast`].
+    pub fn forecast_at(
+        &self,
+        t: f64,
+        shape: ObstacleShape,
+        r_o: f64,
+        r_safe: f64,
+    ) -> Result<Forecast, PredictError> {
+        // A NaN `t` goes to `predict`, which names it.
+        if t.is_nan() || t > self.time() {
+            let mut g = self.clone();
+            g.predict(t - self.time())?;
+            g.forecast(shape, r_o, r_safe)
+        } else {
+            self.forecast(shape, r_o, r_safe)
+        }
+    }
+
     /// A forecast made at the filter time from the current estimate: `p0`, `v0` are the estimate
     /// shifted by the lag compensation ([`EkfParams::accel_smoothing_s`],
     /// [`CvEkf::acceleration`]), `mu` is [`CvEkf::uncertainty_rate`], and `r_safe` is increased

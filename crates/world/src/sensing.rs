@@ -335,7 +335,8 @@ impl Sensing {
     }
 
     /// The forecasts the planner gets at time `t`, one per tracked obstacle in the order of
-    /// [`Sensing::tracked_ids`], each made at `t0 = max(t, filter time)`.
+    /// [`Sensing::tracked_ids`], each made at `t0 = max(t, filter time)`
+    /// ([`trust_predict::CvEkf::forecast_at`]).
     ///
     /// # Errors
     /// [`WorldError::Input`] for a non-finite `t`; [`WorldError::Predict`] if a prediction overflows
@@ -347,14 +348,7 @@ impl Sensing {
         let mut out = Vec::with_capacity(self.filters.len());
         for (filter, shape) in self.filters.iter().zip(&self.shapes) {
             let Some(f) = filter else { continue };
-            let forecast = if t > f.time() {
-                let mut g = f.clone();
-                g.predict(t - f.time())?;
-                g.forecast(shape.forecast_shape(), shape.radius(), self.r_safe)?
-            } else {
-                f.forecast(shape.forecast_shape(), shape.radius(), self.r_safe)?
-            };
-            out.push(forecast);
+            out.push(f.forecast_at(t, shape.forecast_shape(), shape.radius(), self.r_safe)?);
         }
         Ok(out)
     }

@@ -1,0 +1,350 @@
+//! The thin DDS layer: one ros2-client node with the subscriptions and publishers of
+//! `docs/ros2.md`, and a loop ([`DdsNode::run`]) that drains the subscriptions into a
+//! [`NodeCore`], runs a cycle every `cycle_period_s` and a setpoint every
+//! `1/setpoint_rate_hz`, and publishes what the core returns. Everything else is in the core.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration as StdDuration, Instant, SystemTime, UNIX_EPOCH};
+
+use ros2_client::qos::{Durability, History, WhenFull};
+use ros2_client::{Context, MessageTypeName, Name, Node, NodeName, NodeOptions, QosProfile};
+use ros2_client::{Publisher, Subscription};
+use serde::{Deserialize, Serialize};
+use trust_flightstack::px4::TrajectorySetpoint;
+
+use crate::error::Ros2Error;
+use crate::msg::RosMessage;
+use crate::msg::builtin_interfaces::Time;
+use crate::msg::geometry_msgs::PoseStamped;
+use crate::msg::nav_msgs::{Odometry, Path};
+use crate::msg::trajectory_msgs::MultiDOFJointTrajectory;
+use crate::msg::trust_msgs::{MovingObstacleArray, PlannerEvent};
+use crate::msg::visualization_msgs::MarkerArray;
+use crate::node_core::NodeCore;
+
+/// Topic names, relative to the node's namespace (`/` by default, so `odom` is `/odom`, the
+/// DDS topic `rt/odom`).
+pub mod topics {
+    /// In: `nav_msgs/Odometry`.
+    pub const ODOM: &str = "odom";
+    /// In: `geometry_msgs/PoseStamped`.
+    pub const GOAL: &str = "goal";
+    /// In: `trust_msgs/MovingObstacleArray`.
+    pub const OBSTACLES: &str = "obstacles";
+    /// Out: `trajectory_msgs/MultiDOFJointTrajectory`, the plan.
+    pub const TRAJECTORY: &str = "trajectory";
+    /// Out: `nav_msgs/Path`.
+    pub const PATH: &str = "path";
+    /// Out: `trajectory_msgs/MultiDOFJointTrajectory` with one point (or PX4's setpoint).
+    pub const SETPOINT: &str = "setpoint";
+    /// Out, with `--px4`: `px4_msgs/TrajectorySetpoint`, absolute (PX4's uXRCE-DDS topic).
+    pub const PX4_SETPOINT: &str = "/fmu/in/trajectory_setpoint";
+    /// Out: `visualization_msgs/MarkerArray`.
+    pub const MARKERS: &str = "markers";
+    /// Out: `trust_msgs/PlannerEvent`.
+    pub const EVENTS: &str = "events";
+}
+
+/// `px4_msgs/msg/TrajectorySetpoint` as a ROS message: the flight stack's struct
+/// ([`TrajectorySetpoint`], PX4 `trust_flightstack::px4::PX4_RELEASE`), same wire layout.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct Px4TrajectorySetpoint(pub TrajectorySetpoint);
+crate::msg::ros_message!(Px4TrajectorySetpoint, "px4_msgs", "TrajectorySetpoint");
+
+/// Plans and paths: reliable, volatile, keep last 1 (a late subscriber waits for the next
+/// cycle; only the newest plan matters).
+pub fn plan_qos() -> QosProfile {
+    QosProfile::publisher_default()
+        .reliability_reliable(WhenFull::Fail)
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 1 })
+}
+
+/// Setpoints: best-effort, volatile, keep last 1 (a lost one is replaced 20 ms later; PX4's
+/// `/fmu/in` topics are best-effort).
+pub fn setpoint_qos() -> QosProfile {
+    QosProfile::subscription_default()
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 1 })
+}
+
+/// Inputs: best-effort, volatile, keep last 10 (matches reliable and best-effort writers, so
+/// both a sensor-data odometry and RViz's reliable goal are received).
+pub fn input_qos() -> QosProfile {
+    QosProfile::subscription_default()
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 10 })
+}
+
+/// How the node joins the DDS domain.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DdsOptions {
+    /// The node's namespace (`/`).
+    pub namespace: String,
+    /// The node's name (`trust_planner`).
+    pub node_name: String,
+    /// Publish PX4's `TrajectorySetpoint` on [`topics::PX4_SETPOINT`] instead of `setpoint`.
+    pub px4: bool,
+}
+
+impl Default for DdsOptions {
+    fn default() -> Self {
+        DdsOptions {
+            namespace: "/".into(),
+            node_name: "trust_planner".into(),
+            px4: false,
+        }
+    }
+}
+
+/// A topic of message type `M` named `name` (relative to the node's namespace).
+///
+/// # Errors
+/// [`Ros2Error::Dds`] for an invalid name or a failed creation.
+pub fn topic<M: RosMessage>(
+    node: &Node,
+    name: &str,
+    qos: &QosProfile,
+) -> Result<ros2_client::dds::rustdds::Topic, Ros2Error> {
+    let n = Name::parse(name).map_err(|e| Ros2Error::dds(format!("topic name {name}"), e))?;
+    node.create_topic(&n, MessageTypeName::new(M::PACKAGE, M::NAME), qos)
+        .map_err(|e| Ros2Error::dds(format!("create topic {name}"), e))
+}
+
+/// A publisher of `M` on `name`.
+///
+/// # Errors
+/// As [`topic`].
+pub fn publisher<M: RosMessage>(
+    node: &mut Node,
+    name: &str,
+    qos: QosProfile,
+) -> Result<Publisher<M>, Ros2Error> {
+    let t = topic::<M>(node, name, &qos)?;
+    node.create_publisher(&t, Some(qos))
+        .map_err(|e| Ros2Error::dds(format!("create publisher {name}"), e))
+}
+
+/// A subscription to `M` on `name`.
+///
+/// # Errors
+/// As [`topic`].
+pub fn subscription<M: RosMessage + 'static>(
+    node: &mut Node,
+    name: &str,
+    qos: QosProfile,
+) -> Result<Subscription<M>, Ros2Error> {
+    let t = topic::<M>(node, name, &qos)?;
+    node.create_subscription(&t, Some(qos))
+        .map_err(|e| Ros2Error::dds(format!("create subscription {name}"), e))
+}
+
+/// Takes every sample `sub` holds and hands it to `accept`; errors (a sample that does not
+/// decode, a message `accept` rejects) go to `warn` under `topic`.
+fn drain<M: RosMessage + 'static>(
+    sub: &Subscription<M>,
+    topic: &str,
+    warn: &mut dyn FnMut(&str, &Ros2Error),
+    mut accept: impl FnMut(M) -> Result<(), Ros2Error>,
+) {
+    loop {
+        match sub.take() {
+            Ok(Some((m, _))) => {
+                if let Err(e) = accept(m) {
+                    warn(topic, &e);
+                }
+            }
+            Ok(None) => break,
+            Err(e) => {
+                warn(topic, &Ros2Error::dds(format!("take from {topic}"), e));
+                break;
+            }
+        }
+    }
+}
+
+/// Where setpoints go.
+enum SetpointOut {
+    Trajectory(Publisher<MultiDOFJointTrajectory>),
+    Px4(Publisher<Px4TrajectorySetpoint>),
+}
+
+/// The node's DDS side (module docs).
+pub struct DdsNode {
+    node: Node,
+    odom: Subscription<Odometry>,
+    goal: Subscription<PoseStamped>,
+    obstacles: Subscription<MovingObstacleArray>,
+    trajectory: Publisher<MultiDOFJointTrajectory>,
+    path: Publisher<Path>,
+    setpoint: SetpointOut,
+    markers: Publisher<MarkerArray>,
+    events: Publisher<PlannerEvent>,
+}
+
+impl std::fmt::Debug for DdsNode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DdsNode")
+            .field("node", &self.node.fully_qualified_name())
+            .finish_non_exhaustive()
+    }
+}
+
+/// The system clock as a ROS time.
+pub fn system_time() -> Time {
+    let d = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .unwrap_or_default();
+    Time {
+        sec: i32::try_from(d.as_secs()).unwrap_or(i32::MAX),
+        nanosec: d.subsec_nanos(),
+    }
+}
+
+impl DdsNode {
+    /// Creates the node in `context` with its subscriptions and publishers, and starts its
+    /// ros2-client spinner (ROS graph discovery) on a thread of its own.
+    ///
+    /// # Errors
+    /// [`Ros2Error::Dds`] naming what could not be created.
+    pub fn new(context: &Context, options: &DdsOptions) -> Result<Self, Ros2Error> {
+        let name = NodeName::new(&options.namespace, &options.node_name)
+            .map_err(|e| Ros2Error::dds("node name", e))?;
+        let mut node = context
+            .new_node(name, NodeOptions::new().enable_rosout(false))
+            .map_err(|e| Ros2Error::dds("create node", e))?;
+        let odom = subscription(&mut node, topics::ODOM, input_qos())?;
+        let goal = subscription(&mut node, topics::GOAL, input_qos())?;
+        let obstacles = subscription(&mut node, topics::OBSTACLES, input_qos())?;
+        let trajectory = publisher(&mut node, topics::TRAJECTORY, plan_qos())?;
+        let path = publisher(&mut node, topics::PATH, plan_qos())?;
+        let setpoint = if options.px4 {
+            SetpointOut::Px4(publisher(&mut node, topics::PX4_SETPOINT, setpoint_qos())?)
+        } else {
+            SetpointOut::Trajectory(publisher(&mut node, topics::SETPOINT, setpoint_qos())?)
+        };
+        let markers = publisher(&mut node, topics::MARKERS, plan_qos())?;
+        let events = publisher(
+            &mut node,
+            topics::EVENTS,
+            plan_qos().history(History::KeepLast { depth: 10 }),
+        )?;
+        let spinner = node
+            .spinner()
+            .map_err(|e| Ros2Error::dds("create spinner", e))?;
+        std::thread::Builder::new()
+            .name("ros2-spinner".into())
+            .spawn(move || futures::executor::block_on(spinner.spin()))
+            .map_err(|e| Ros2Error::dds("start spinner thread", e))?;
+        Ok(DdsNode {
+            node,
+            odom,
+            goal,
+            obstacles,
+            trajectory,
+            path,
+            setpoint,
+            markers,
+            events,
+        })
+    }
+
+    /// Hands every message received so far to `core`; a rejected message, or one that does
+    /// not decode, goes to `warn`.
+    pub fn receive(&mut self, core: &mut NodeCore, warn: &mut dyn FnMut(&str, &Ros2Error)) {
+        drain(&self.odom, topics::ODOM, warn, |m| core.on_odometry(&m));
+        drain(&self.goal, topics::GOAL, warn, |m| core.on_goal(&m));
+        drain(&self.obstacles, topics::OBSTACLES, warn, |m| {
+            core.on_obstacles(&m)
+        });
+    }
+
+    /// Runs one cycle of `core` at `now` and publishes its messages.
+    ///
+    /// # Errors
+    /// The cycle's error (nothing published), or [`Ros2Error::Dds`] if a write fails.
+    pub fn cycle(&mut self, core: &mut NodeCore, now: Time) -> Result<(), Ros2Error> {
+        let Some(out) = core.cycle(now)? else {
+            return Ok(());
+        };
+        if let Some(t) = out.trajectory {
+            self.trajectory
+                .publish(t)
+                .map_err(|e| Ros2Error::dds("publish trajectory", e))?;
+        }
+        if let Some(p) = out.path {
+            self.path
+                .publish(p)
+                .map_err(|e| Ros2Error::dds("publish path", e))?;
+        }
+        self.markers
+            .publish(out.markers)
+            .map_err(|e| Ros2Error::dds("publish markers", e))?;
+        self.events
+            .publish(out.event)
+            .map_err(|e| Ros2Error::dds("publish events", e))?;
+        Ok(())
+    }
+
+    /// Publishes the setpoint of `core` at `now` (nothing without a plan).
+    ///
+    /// # Errors
+    /// The conversion's error, or [`Ros2Error::Dds`] if the write fails.
+    pub fn setpoint(&mut self, core: &mut NodeCore, now: Time) -> Result<(), Ros2Error> {
+        match &self.setpoint {
+            SetpointOut::Trajectory(p) => {
+                if let Some(s) = core.setpoint(now)? {
+                    p.publish(s)
+                        .map_err(|e| Ros2Error::dds("publish setpoint", e))?;
+                }
+            }
+            SetpointOut::Px4(p) => {
+                if let Some(s) = core.px4_setpoint(now)? {
+                    p.publish(Px4TrajectorySetpoint(s))
+                        .map_err(|e| Ros2Error::dds("publish setpoint", e))?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Runs the node until `stop` is set: receives continuously (polling every 1 ms), runs a
+    /// cycle every `cycle_period_s` and a setpoint every `1/setpoint_rate_hz` on the system
+    /// clock. Errors of a cycle or a setpoint go to `warn` and the loop goes on.
+    pub fn run(
+        &mut self,
+        core: &mut NodeCore,
+        stop: &AtomicBool,
+        warn: &mut dyn FnMut(&str, &Ros2Error),
+    ) {
+        let cycle_period = StdDuration::from_secs_f64(core.params().cycle_period_s);
+        let setpoint_period = StdDuration::from_secs_f64(1.0 / core.params().setpoint_rate_hz);
+        let mut next_cycle = Instant::now();
+        let mut next_setpoint = Instant::now();
+        while !stop.load(Ordering::Relaxed) {
+            self.receive(core, warn);
+            let now = Instant::now();
+            if now >= next_cycle {
+                if let Err(e) = self.cycle(core, system_time()) {
+                    warn("cycle", &e);
+                }
+                next_cycle += cycle_period;
+                if next_cycle < now {
+                    // An overrun: skip the missed ticks instead of running them back to back.
+                    next_cycle = now + cycle_period;
+                }
+            }
+            if now >= next_setpoint {
+                if let Err(e) = self.setpoint(core, system_time()) {
+                    warn(topics::SETPOINT, &e);
+                }
+                next_setpoint += setpoint_period;
+                if next_setpoint < now {
+                    next_setpoint = now + setpoint_period;
+                }
+            }
+            std::thread::sleep(StdDuration::from_millis(1));
+        }
+    }
+}

@@ -1,0 +1,613 @@
+//! [`NodeCore`]: the node without DDS. Messages go in ([`NodeCore::on_odometry`],
+//! [`NodeCore::on_goal`], [`NodeCore::on_obstacles`]); a cycle at a clock value the caller gives
+//! ([`NodeCore::cycle`]) runs the planner and returns the messages to publish; setpoints are
+//! sampled from the committed plan at any clock value ([`NodeCore::setpoint`],
+//! [`NodeCore::px4_setpoint`]). No clock is read inside and nothing is sent, so every step is
+//! reproducible and testable alone (the style's rule for step functions).
+//!
+//! A bad message (another frame, a NaN pose, a zero quaternion, out-of-order obstacles) is an
+//! [`Ros2Error`] naming the field; the message is ignored and counted
+//! ([`NodeCounters::rejected_count`]), the node's state is unchanged.
+
+use std::sync::Arc;
+
+use trust_core::{Forecast, Scene, State, StaticMap, Vec3};
+use trust_flightstack::frame::FrameTransform;
+use trust_flightstack::px4::{self, TrajectorySetpoint};
+use trust_flightstack::yaw::{YawPolicy, YawTracker};
+use trust_planner::AnyManager;
+
+use crate::convert::{
+    Clock, goal_position, markers, odometry_state, path_message, trajectory_message,
+    trajectory_point,
+};
+use crate::error::Ros2Error;
+use crate::msg::builtin_interfaces::Time;
+use crate::msg::geometry_msgs::PoseStamped;
+use crate::msg::nav_msgs::{Odometry, Path};
+use crate::msg::trajectory_msgs::MultiDOFJointTrajectory;
+use crate::msg::trust_msgs::{MovingObstacleArray, PlannerEvent};
+use crate::msg::visualization_msgs::MarkerArray;
+use crate::params::{NodeParams, NodeSetup};
+use crate::tracker::{Tracker, observation};
+
+/// What the node counted since it started.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct NodeCounters {
+    /// Odometry messages accepted.
+    pub odom_count: u64,
+    /// Goals accepted.
+    pub goal_count: u64,
+    /// Obstacle messages accepted.
+    pub obstacles_count: u64,
+    /// Messages rejected (and ignored) because a field was invalid.
+    pub rejected_count: u64,
+    /// Planning cycles run.
+    pub cycle_count: u64,
+    /// Cycles skipped: no odometry or no goal yet.
+    pub idle_count: u64,
+    /// Cycles skipped because the odometry was older than `odom_timeout_s`.
+    pub stale_count: u64,
+}
+
+/// The messages of one planning cycle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CycleOutput {
+    /// `trajectory`: the committed plan from now on, sampled every `trajectory_dt_s` (`None`
+    /// when the manager has no plan).
+    pub trajectory: Option<MultiDOFJointTrajectory>,
+    /// `path`: the same samples as poses.
+    pub path: Option<Path>,
+    /// `markers`: the kept branches and the forecasts.
+    pub markers: MarkerArray,
+    /// `events`: what the cycle did.
+    pub event: PlannerEvent,
+}
+
+/// The ROS-free node (module docs).
+#[derive(Debug)]
+pub struct NodeCore {
+    params: NodeParams,
+    clock: Clock,
+    manager: AnyManager,
+    map: Arc<StaticMap>,
+    tracker: Tracker,
+    odom: Option<State>,
+    goal: Option<Vec3>,
+    forecasts: Vec<Forecast>,
+    yaw: YawTracker,
+    counters: NodeCounters,
+}
+
+impl NodeCore {
+    /// A node planning with `setup` (from a scenario file, [`NodeSetup::from_scenario`]) and
+    /// `params`, whose node time 0 is the ROS time `origin` (the DDS layer passes its start
+    /// time, whole seconds).
+    ///
+    /// # Errors
+    /// [`Ros2Error::Invalid`] for invalid `params` or a non-finite vehicle radius.
+    pub fn new(setup: NodeSetup, params: NodeParams, origin: Time) -> Result<Self, Ros2Error> {
+        params.validate()?;
+        let r = setup.vehicle_radius_m + setup.r_safe_margin_m;
+        if !(r.is_finite() && r >= 0.0) {
+            return Err(Ros2Error::invalid(
+                "vehicle.radius_m + sensing.r_safe_margin_m",
+                r,
+                "a finite number >= 0",
+            ));
+        }
+        let tracker = Tracker::new(setup.ekf, r, params.obstacle_timeout_s);
+        Ok(NodeCore {
+            clock: Clock {
+                origin_s: origin.as_seconds(),
+            },
+            manager: setup.manager,
+            map: setup.map,
+            tracker,
+            odom: None,
+            goal: None,
+            forecasts: Vec::new(),
+            yaw: YawTracker::new(YawPolicy::default())?,
+            counters: NodeCounters::default(),
+            params,
+        })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &NodeParams {
+        &self.params
+    }
+
+    /// The clock mapping node time to ROS time.
+    pub fn clock(&self) -> &Clock {
+        &self.clock
+    }
+
+    /// The planner (its committed plan is [`trust_manager::Manager::plan`]).
+    pub fn manager(&self) -> &AnyManager {
+        &self.manager
+    }
+
+    /// The counters.
+    pub fn counters(&self) -> NodeCounters {
+        self.counters
+    }
+
+    /// The goal, once one was accepted.
+    pub fn goal(&self) -> Option<Vec3> {
+        self.goal
+    }
+
+    /// Counts a rejected message and passes its error on.
+    fn rejected<T>(&mut self, r: Result<T, Ros2Error>) -> Result<T, Ros2Error> {
+        if r.is_err() {
+            self.counters.rejected_count += 1;
+        }
+        r
+    }
+
+    /// Takes an odometry message as the vehicle's latest state ([`odometry_state`]).
+    ///
+    /// # Errors
+    /// As [`odometry_state`]; the message is ignored and counted.
+    pub fn on_odometry(&mut self, msg: &Odometry) -> Result<(), Ros2Error> {
+        let r = odometry_state(msg, &self.params.world_frame, &self.clock);
+        let state = self.rejected(r)?;
+        self.odom = Some(state);
+        self.counters.odom_count += 1;
+        Ok(())
+    }
+
+    /// Takes a goal ([`goal_position`]); it replaces the previous one.
+    ///
+    /// # Errors
+    /// As [`goal_position`]; the message is ignored and counted.
+    pub fn on_goal(&mut self, msg: &PoseStamped) -> Result<(), Ros2Error> {
+        let r = goal_position(msg, &self.params.world_frame);
+        self.goal = Some(self.rejected(r)?);
+        self.counters.goal_count += 1;
+        Ok(())
+    }
+
+    /// Feeds the obstacles observed at the message's stamp to their tracks
+    /// ([`crate::tracker`]).
+    ///
+    /// # Errors
+    /// [`Ros2Error::Invalid`] naming the field (frame, an obstacle's position, shape or size,
+    /// a stamp before a track's last observation); the whole message is ignored and counted.
+    pub fn on_obstacles(&mut self, msg: &MovingObstacleArray) -> Result<(), Ros2Error> {
+        let r = self.observe(msg);
+        self.rejected(r)?;
+        self.counters.obstacles_count += 1;
+        Ok(())
+    }
+
+    fn observe(&mut self, msg: &MovingObstacleArray) -> Result<(), Ros2Error> {
+        if msg.header.frame_id != self.params.world_frame {
+            return Err(Ros2Error::invalid(
+                "obstacles.header.frame_id",
+                format!("{:?}", msg.header.frame_id),
+                format!("the node's world frame {:?}", self.params.world_frame),
+            ));
+        }
+        let t = self.clock.node_time(&msg.header.stamp);
+        let observations = msg
+            .obstacles
+            .iter()
+            .enumerate()
+            .map(|(i, o)| observation(&format!("obstacles.obstacles[{i}]"), o))
+            .collect::<Result<Vec<_>, _>>()?;
+        self.tracker.observe(t, &observations)
+    }
+
+    /// One planning cycle at ROS time `now`: the latest odometry, extrapolated at its velocity
+    /// to `now`, is the measured state; the tracks' forecasts at `now` and the map are the
+    /// scene; `Manager::step` plans toward the goal. `Ok(None)` (nothing to publish) without a
+    /// goal or odometry yet.
+    ///
+    /// # Errors
+    /// [`Ros2Error::Invalid`] naming `odom.header.stamp` when the odometry is older than
+    /// `odom_timeout_s` (the cycle is skipped and counted); [`Ros2Error::Plan`] if the planner
+    /// rejects its input; conversion errors naming the field.
+    pub fn cycle(&mut self, now: Time) -> Result<Option<CycleOutput>, Ros2Error> {
+        let t = self.clock.node_time(&now);
+        let (Some(odom), Some(goal)) = (self.odom, self.goal) else {
+            self.counters.idle_count += 1;
+            return Ok(None);
+        };
+        let age = t - odom.t;
+        if age > self.params.odom_timeout_s {
+            self.counters.stale_count += 1;
+            return Err(Ros2Error::invalid(
+                "odom.header.stamp",
+                format!("{age} s old"),
+                format!(
+                    "odometry at most odom_timeout_s = {} s old",
+                    self.params.odom_timeout_s
+                ),
+            ));
+        }
+        let measured = State {
+            t,
+            p: odom.p + odom.v * age.max(0.0),
+            v: odom.v,
+            a: odom.a,
+        };
+        self.forecasts = self.tracker.forecasts(t)?;
+        let scene = Scene::new(&self.map, &self.forecasts, t)?;
+        let report = self.manager.step(t, &measured, &goal, &scene)?;
+        self.counters.cycle_count += 1;
+        let p = &self.params;
+        let (trajectory, path) = match self.manager.plan() {
+            Some(plan) => (
+                Some(trajectory_message(
+                    plan,
+                    t,
+                    p.trajectory_dt_s,
+                    &self.clock,
+                    &p.world_frame,
+                    &p.body_frame,
+                )?),
+                Some(path_message(
+                    plan,
+                    t,
+                    p.trajectory_dt_s,
+                    &self.clock,
+                    &p.world_frame,
+                )?),
+            ),
+            None => (None, None),
+        };
+        let main = self.manager.main();
+        let branches: Vec<_> = self
+            .manager
+            .branches()
+            .iter()
+            .map(|b| (b.traj(), Some(b.id) == main))
+            .collect();
+        let markers = MarkerArray {
+            markers: markers(
+                &branches,
+                &self.forecasts,
+                t,
+                p.trajectory_dt_s,
+                &self.clock,
+                &p.world_frame,
+            )?,
+        };
+        let event = PlannerEvent {
+            header: self.clock.header(t, &p.world_frame)?,
+            cycle_count: self.counters.cycle_count,
+            cycle_time_ms: report.timing.wall_ms,
+            has_plan: self.manager.plan().is_some(),
+            fallback: report.fallback.is_some(),
+            events: report
+                .events
+                .iter()
+                .map(|e| {
+                    serde_json::to_string(e).unwrap_or_else(|e| format!("{{\"error\":\"{e}\"}}"))
+                })
+                .collect(),
+        };
+        Ok(Some(CycleOutput {
+            trajectory,
+            path,
+            markers,
+            event,
+        }))
+    }
+
+    /// The node time of ROS time `now`, clamped into the committed plan's span (a vehicle
+    /// before the plan starts holds its start, after it ends its end); `None` without a plan.
+    fn plan_time(&self, now: &Time) -> Option<f64> {
+        let plan = self.manager.plan()?;
+        Some(
+            self.clock
+                .node_time(now)
+                .clamp(plan.t_start(), plan.t_end()),
+        )
+    }
+
+    /// The setpoint at ROS time `now`: a one-point `MultiDOFJointTrajectory` stamped `now`
+    /// (`time_from_start` 0) of the committed plan at `now` (its end after it ends); `None`
+    /// without a plan.
+    ///
+    /// # Errors
+    /// Conversion errors naming the field (a non-finite sample, a stamp out of range).
+    pub fn setpoint(&self, now: Time) -> Result<Option<MultiDOFJointTrajectory>, Ros2Error> {
+        let (Some(plan), Some(t)) = (self.manager.plan(), self.plan_time(&now)) else {
+            return Ok(None);
+        };
+        Ok(Some(MultiDOFJointTrajectory {
+            header: now.into_header(&self.params.world_frame),
+            joint_names: vec![self.params.body_frame.clone()],
+            points: vec![trajectory_point(plan, t, t)?],
+        }))
+    }
+
+    /// The PX4 setpoint at ROS time `now` ([`trust_flightstack::px4::setpoint_at`]: NED, yaw
+    /// held at 0 rad), stamped with `now` in µs; `None` without a plan.
+    ///
+    /// # Errors
+    /// [`Ros2Error::FlightStack`] naming the field that does not fit PX4's `f32`.
+    pub fn px4_setpoint(&mut self, now: Time) -> Result<Option<TrajectorySetpoint>, Ros2Error> {
+        let (Some(t), Some(plan)) = (self.plan_time(&now), self.manager.plan()) else {
+            return Ok(None);
+        };
+        let us = (now.as_seconds() * 1e6).max(0.0) as u64;
+        Ok(Some(px4::setpoint_at(
+            plan,
+            t,
+            us,
+            &FrameTransform::identity(),
+            &mut self.yaw,
+        )?))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use approx::assert_relative_eq;
+
+    use super::*;
+    use crate::msg::geometry_msgs::{Point, Quaternion, Vector3};
+    use crate::msg::trust_msgs::MovingObstacle;
+    use crate::msg::visualization_msgs::Marker;
+
+    const ORIGIN: Time = Time {
+        sec: 1_700_000_000,
+        nanosec: 0,
+    };
+
+    fn at(t: f64) -> Time {
+        Time::from_seconds(ORIGIN.as_seconds() + t).expect("in range")
+    }
+
+    fn core() -> NodeCore {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenarios/quickstart.toml");
+        let setup = NodeSetup::from_scenario(&path).expect("quickstart builds");
+        NodeCore::new(setup, NodeParams::default(), ORIGIN).expect("valid")
+    }
+
+    fn odom(t: f64, p: [f64; 3]) -> Odometry {
+        let mut m = Odometry::default();
+        m.header.stamp = at(t);
+        m.header.frame_id = "map".into();
+        m.child_frame_id = "base_link".into();
+        m.pose.pose.position = Point {
+            x: p[0],
+            y: p[1],
+            z: p[2],
+        };
+        m
+    }
+
+    fn goal(p: [f64; 3]) -> PoseStamped {
+        let mut m = PoseStamped::default();
+        m.header.stamp = ORIGIN;
+        m.header.frame_id = "map".into();
+        m.pose.position = Point {
+            x: p[0],
+            y: p[1],
+            z: p[2],
+        };
+        m
+    }
+
+    fn field_of(e: &Ros2Error) -> &str {
+        match e {
+            Ros2Error::Invalid { field, .. } => field,
+            other => panic!("expected Invalid, got {other}"),
+        }
+    }
+
+    #[test]
+    fn odometry_and_goal_give_a_trajectory_sampling_the_managers_plan() {
+        let mut core = core();
+        core.on_odometry(&odom(0.0, [2.0, 10.0, 3.0]))
+            .expect("valid");
+        core.on_goal(&goal([38.0, 10.0, 3.0])).expect("valid");
+        let out = core.cycle(at(0.0)).expect("cycle").expect("a cycle ran");
+        let traj = out.trajectory.expect("a plan");
+        let plan = core.manager().plan().expect("committed plan");
+        assert_eq!(traj.header.frame_id, "map");
+        assert_eq!(traj.joint_names, vec!["base_link".to_string()]);
+        assert!(traj.points.len() > 10, "{} samples", traj.points.len());
+        let start = core.clock().node_time(&traj.header.stamp);
+        for (k, point) in traj.points.iter().enumerate() {
+            let t = start + point.time_from_start.as_seconds();
+            let p = plan.position(t);
+            let v = plan.velocity(t);
+            let tr = point.transforms[0].translation;
+            assert_relative_eq!(tr.x, p.x, epsilon = 1e-6);
+            assert_relative_eq!(tr.y, p.y, epsilon = 1e-6);
+            assert_relative_eq!(tr.z, p.z, epsilon = 1e-6);
+            assert_relative_eq!(point.velocities[0].linear.x, v.x, epsilon = 1e-6);
+            if k > 0 && k + 1 < traj.points.len() {
+                assert_relative_eq!(
+                    point.time_from_start.as_seconds(),
+                    k as f64 * 0.05,
+                    epsilon = 1e-6
+                );
+            }
+        }
+        let last = traj.points.last().expect("points");
+        assert_relative_eq!(
+            start + last.time_from_start.as_seconds(),
+            plan.t_end(),
+            epsilon = 1e-6
+        );
+        let path = out.path.expect("a path");
+        assert_eq!(path.poses.len(), traj.points.len());
+        assert_eq!(out.event.cycle_count, 1);
+        assert!(out.event.has_plan);
+        assert!(
+            out.markers.markers.iter().any(|m| m.ns == "branches"),
+            "the branches are drawn"
+        );
+        // The setpoint is the plan at the clock value given.
+        let sp = core.setpoint(at(0.3)).expect("valid").expect("a plan");
+        let p = plan.position(0.3_f64.clamp(plan.t_start(), plan.t_end()));
+        assert_relative_eq!(
+            sp.points[0].transforms[0].translation.x,
+            p.x,
+            epsilon = 1e-6
+        );
+        assert_eq!(sp.header.stamp, at(0.3));
+        // PX4: NED, so north (our y) first, down = -z.
+        let px4 = core.px4_setpoint(at(0.3)).expect("valid").expect("a plan");
+        assert_relative_eq!(f64::from(px4.position[0]), p.y, epsilon = 1e-4);
+        assert_relative_eq!(f64::from(px4.position[1]), p.x, epsilon = 1e-4);
+        assert_relative_eq!(f64::from(px4.position[2]), -p.z, epsilon = 1e-4);
+    }
+
+    #[test]
+    fn without_a_goal_or_odometry_nothing_is_published() {
+        let mut core = core();
+        assert!(core.cycle(at(0.0)).expect("no error").is_none());
+        core.on_odometry(&odom(0.0, [2.0, 10.0, 3.0]))
+            .expect("valid");
+        assert!(core.cycle(at(0.1)).expect("no error").is_none());
+        assert!(core.setpoint(at(0.1)).expect("no error").is_none());
+        assert_eq!(core.counters().idle_count, 2);
+        assert_eq!(core.counters().cycle_count, 0);
+    }
+
+    #[test]
+    fn a_nan_pose_is_a_typed_error_counted_and_ignored() {
+        let mut core = core();
+        let e = core
+            .on_odometry(&odom(0.0, [f64::NAN, 10.0, 3.0]))
+            .expect_err("NaN");
+        assert_eq!(field_of(&e), "odom.pose.pose.position");
+        assert_eq!(core.counters().rejected_count, 1);
+        assert_eq!(core.counters().odom_count, 0);
+        core.on_goal(&goal([38.0, 10.0, 3.0])).expect("valid");
+        assert!(
+            core.cycle(at(0.0)).expect("no error").is_none(),
+            "no odometry yet"
+        );
+        let mut g = goal([1.0, 2.0, 3.0]);
+        g.pose.position.z = f64::INFINITY;
+        let e = core.on_goal(&g).expect_err("infinite");
+        assert_eq!(field_of(&e), "goal.pose.position");
+        assert_eq!(
+            core.goal(),
+            Some(Vec3::new(38.0, 10.0, 3.0)),
+            "the old goal stays"
+        );
+    }
+
+    #[test]
+    fn a_zero_quaternion_or_another_frame_is_rejected() {
+        let mut core = core();
+        let mut m = odom(0.0, [2.0, 10.0, 3.0]);
+        m.pose.pose.orientation = Quaternion {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            w: 0.0,
+        };
+        let e = core.on_odometry(&m).expect_err("zero quaternion");
+        assert_eq!(field_of(&e), "odom.pose.pose.orientation");
+        let mut m = odom(0.0, [2.0, 10.0, 3.0]);
+        m.header.frame_id = "odom".into();
+        let e = core.on_odometry(&m).expect_err("frame");
+        assert_eq!(field_of(&e), "odom.header.frame_id");
+        assert!(e.to_string().contains("\"map\""), "{e}");
+        assert_eq!(core.counters().rejected_count, 2);
+    }
+
+    #[test]
+    fn body_frame_velocity_is_rotated_into_the_world() {
+        let mut core = core();
+        let mut m = odom(0.0, [2.0, 10.0, 3.0]);
+        // Yaw 90°: the body's x axis points north (world y).
+        m.pose.pose.orientation = Quaternion::from_yaw(std::f64::consts::FRAC_PI_2);
+        m.twist.twist.linear = Vector3 {
+            x: 1.0,
+            y: 0.0,
+            z: 0.0,
+        };
+        core.on_odometry(&m).expect("valid");
+        let s = core.odom.expect("accepted");
+        assert_relative_eq!(s.v.x, 0.0, epsilon = 1e-12);
+        assert_relative_eq!(s.v.y, 1.0, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn stale_odometry_skips_the_cycle_with_a_typed_error() {
+        let mut core = core();
+        core.on_odometry(&odom(0.0, [2.0, 10.0, 3.0]))
+            .expect("valid");
+        core.on_goal(&goal([38.0, 10.0, 3.0])).expect("valid");
+        let e = core.cycle(at(2.0)).expect_err("2 s old");
+        assert_eq!(field_of(&e), "odom.header.stamp");
+        assert_eq!(core.counters().stale_count, 1);
+    }
+
+    fn obstacle(id: u32, shape: u8, p: [f64; 3]) -> MovingObstacle {
+        MovingObstacle {
+            id,
+            shape,
+            size: Vector3 {
+                x: 1.0,
+                y: 1.0,
+                z: 2.0,
+            },
+            position: Point {
+                x: p[0],
+                y: p[1],
+                z: p[2],
+            },
+            ..MovingObstacle::default()
+        }
+    }
+
+    #[test]
+    fn obstacles_become_forecasts_and_bad_ones_are_rejected_whole() {
+        let mut core = core();
+        let mut msg = MovingObstacleArray::default();
+        msg.header.frame_id = "map".into();
+        for k in 0..5 {
+            msg.header.stamp = at(-0.5 + 0.1 * f64::from(k));
+            msg.obstacles = vec![
+                obstacle(7, MovingObstacle::SHAPE_SPHERE, [20.0, 10.0, 3.0]),
+                obstacle(9, MovingObstacle::SHAPE_CYLINDER, [30.0, 4.0, 3.0]),
+            ];
+            core.on_obstacles(&msg).expect("valid");
+        }
+        assert_eq!(core.tracker.len(), 2);
+        // A bad shape: the whole message is ignored.
+        msg.header.stamp = at(0.0);
+        msg.obstacles[1].shape = 7;
+        let e = core.on_obstacles(&msg).expect_err("shape 7");
+        assert_eq!(field_of(&e), "obstacles.obstacles[1].shape");
+        // Out of order.
+        msg.header.stamp = at(-1.0);
+        msg.obstacles[1].shape = MovingObstacle::SHAPE_SPHERE;
+        let e = core.on_obstacles(&msg).expect_err("older");
+        assert_eq!(field_of(&e), "obstacles.header.stamp");
+        assert_eq!(core.counters().rejected_count, 2);
+        assert_eq!(core.counters().obstacles_count, 5);
+
+        core.on_odometry(&odom(0.0, [2.0, 10.0, 3.0]))
+            .expect("valid");
+        core.on_goal(&goal([38.0, 10.0, 3.0])).expect("valid");
+        let out = core.cycle(at(0.0)).expect("cycle").expect("ran");
+        let drawn: Vec<i32> = out
+            .markers
+            .markers
+            .iter()
+            .filter(|m| m.ns == "forecasts")
+            .map(|m| m.kind)
+            .collect();
+        assert_eq!(drawn, vec![Marker::SPHERE, Marker::CYLINDER]);
+        // Tracks not seen for obstacle_timeout_s are dropped.
+        core.on_odometry(&odom(2.0, [2.0, 10.0, 3.0]))
+            .expect("valid");
+        core.cycle(at(2.0)).expect("cycle").expect("ran");
+        assert!(core.tracker.is_empty());
+    }
+}
