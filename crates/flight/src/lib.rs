@@ -455,9 +455,9 @@ pub fn fly(
     let t = state.t;
     let (status, with, reason) = match &ending {
         Ending::Arrived => (Status::Arrived, None, None),
-        Ending::Collided(contact) => (Status::Collided, Some(contact.log_tag()), None),
+        Ending::Collided(contact) => (Status::Collided, Some(contact.to_string()), None),
         Ending::TimedOut => (Status::TimedOut, None, None),
-        Ending::Unreachable { reason } => (Status::Unreachable, None, Some(reason.clone())),
+        Ending::Unreachable { cause } => (Status::Unreachable, None, Some(cause.to_string())),
         Ending::Invalid { reason } => (Status::Invalid, None, Some(reason.clone())),
     };
     let forecast_warning_s = match ending {
