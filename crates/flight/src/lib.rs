@@ -208,7 +208,11 @@ pub fn header(world: &World, planner_label: &str, points_file: Option<String>) -
         start: v3(&world.start()),
         goal: v3(&world.goal()),
         goal_tolerance: s.mission.goal_tolerance_m,
-        static_shapes: world.static_shape_specs(),
+        static_shapes: world
+            .static_shape_specs()
+            .into_iter()
+            .map(Into::into)
+            .collect(),
         static_points_file: points_file,
         obstacles: world
             .obstacles()
