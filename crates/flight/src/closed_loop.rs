@@ -14,7 +14,7 @@
 //!   after that, and the ticks in between are skipped: the cycle's `overrun_ticks`.
 
 use trust_core::{PolyTraj, Scene, Vec3};
-use trust_manager::{CycleTiming, StepReport};
+use trust_manager::{CycleTiming, StepReport, UnreachableCause};
 use trust_planner::{AnyManager, ResolvedPlanner};
 use trust_predict::Forecast;
 use trust_vehicle::{Reference, Vehicle, VehicleState};
@@ -171,27 +171,12 @@ pub struct FlightState {
     /// lateness is charged to the cycle that merges it, [`Clock::RealTime`]).
     pub worker_since: Option<f64>,
     /// Since when the manager has held that the goal cannot be reached (s), and why.
-    pub unreachable_since: Option<(f64, String)>,
+    pub unreachable_since: Option<(f64, UnreachableCause)>,
 }
 
-/// What the vehicle touched.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Contact {
-    /// The static geometry.
-    Static,
-    /// The moving obstacle with this id.
-    Obstacle(usize),
-}
-
-impl Contact {
-    /// The run log's spelling (`"static"`, `"obstacle:<id>"`).
-    pub fn log_tag(&self) -> String {
-        match self {
-            Contact::Static => "static".to_owned(),
-            Contact::Obstacle(id) => format!("obstacle:{id}"),
-        }
-    }
-}
+/// What the vehicle touched; its `Display` is the run log's spelling (`static`,
+/// `obstacle:<id>`).
+pub use trust_runlog::Contact;
 
 /// How a flight ended.
 #[derive(Debug, Clone, PartialEq)]
@@ -204,8 +189,8 @@ pub enum Ending {
     TimedOut,
     /// The manager held that the goal cannot be reached for the settling time.
     Unreachable {
-        /// The manager's cause.
-        reason: String,
+        /// The manager's cause (its `Display` is the outcome's `reason`).
+        cause: UnreachableCause,
     },
     /// The planner rejected its input.
     Invalid {
@@ -370,12 +355,10 @@ pub fn step(
         Some(Ending::Collided(contact))
     } else if (vehicle.p - params.goal).norm() <= params.goal_tolerance_m {
         Some(Ending::Arrived)
-    } else if let Some((since, reason)) = &state.unreachable_since
+    } else if let Some((since, cause)) = state.unreachable_since
         && t - since >= params.unreachable_settle_s - 0.5 * dt
     {
-        Some(Ending::Unreachable {
-            reason: reason.clone(),
-        })
+        Some(Ending::Unreachable { cause })
     } else if state.step >= params.max_steps {
         Some(Ending::TimedOut)
     } else {
@@ -443,7 +426,7 @@ fn plan(
     match report.goal_unreachable() {
         Some(verdict) => {
             if state.unreachable_since.is_none() {
-                state.unreachable_since = Some((t, verdict.cause.clone()));
+                state.unreachable_since = Some((t, verdict.cause));
             }
         }
         None => state.unreachable_since = None,

@@ -208,7 +208,11 @@ pub fn header(world: &World, planner_label: &str, points_file: Option<String>) -
         start: v3(&world.start()),
         goal: v3(&world.goal()),
         goal_tolerance: s.mission.goal_tolerance_m,
-        static_shapes: world.static_shape_specs(),
+        static_shapes: world
+            .static_shape_specs()
+            .into_iter()
+            .map(Into::into)
+            .collect(),
         static_points_file: points_file,
         obstacles: world
             .obstacles()
@@ -455,9 +459,9 @@ pub fn fly(
     let t = state.t;
     let (status, with, reason) = match &ending {
         Ending::Arrived => (Status::Arrived, None, None),
-        Ending::Collided(contact) => (Status::Collided, Some(contact.log_tag()), None),
+        Ending::Collided(contact) => (Status::Collided, Some(contact.to_string()), None),
         Ending::TimedOut => (Status::TimedOut, None, None),
-        Ending::Unreachable { reason } => (Status::Unreachable, None, Some(reason.clone())),
+        Ending::Unreachable { cause } => (Status::Unreachable, None, Some(cause.to_string())),
         Ending::Invalid { reason } => (Status::Invalid, None, Some(reason.clone())),
     };
     let forecast_warning_s = match ending {

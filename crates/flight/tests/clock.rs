@@ -197,8 +197,8 @@ fn a_real_time_flight_logs_its_charged_time_and_skipped_ticks() {
 
 #[test]
 fn a_contact_is_typed_and_logged_as_the_contract_spells_it() {
-    assert_eq!(Contact::Static.log_tag(), "static");
-    assert_eq!(Contact::Obstacle(7).log_tag(), "obstacle:7");
+    assert_eq!(Contact::Static.to_string(), "static");
+    assert_eq!(Contact::Obstacle(7).to_string(), "obstacle:7");
     let c = Clearances {
         static_m: 0.5,
         dynamic_m: -0.01,

@@ -168,10 +168,11 @@ fn validation_reports_every_problem_not_just_the_first() {
     }
 }
 
-/// `[[static.shapes]]` holds the run log's `StaticShape`, written tagged by `kind` in the scenario
-/// (the log's external tagging is checked in `trust-runlog`).
+/// `[[static.shapes]]` holds the world's `StaticShape`, written tagged by `kind` in the scenario;
+/// it converts to the run log's type and back unchanged (the log's external tagging is checked
+/// in `trust-runlog`).
 #[test]
-fn static_shapes_are_the_run_log_type_tagged_by_kind_in_the_scenario() {
+fn static_shapes_are_tagged_by_kind_and_convert_to_the_run_log_type() {
     let text = "name = \"shapes\"\n[world]\nbounds = { min = [0, 0, 0], max = [20, 20, 10] }\n\
                 [mission]\nstart = [1, 10, 5]\ngoal = [19, 10, 5]\n\
                 [[static.shapes]]\nkind = \"sphere\"\ncenter = [5, 5, 5]\nradius = 1\n\
@@ -189,6 +190,14 @@ fn static_shapes_are_the_run_log_type_tagged_by_kind_in_the_scenario() {
     };
     assert_eq!(shapes[1], cylinder);
     assert!(matches!(shapes[2], StaticShape::Box { max, .. } if max == [11.0, 3.0, 4.0]));
+    for shape in shapes {
+        let logged = trust_runlog::StaticShape::from(*shape);
+        assert_eq!(StaticShape::from(logged), *shape);
+    }
+    assert!(matches!(
+        trust_runlog::StaticShape::from(cylinder),
+        trust_runlog::StaticShape::Cylinder { z_max, .. } if z_max == 6.0
+    ));
     let written = s.to_toml_string().unwrap();
     assert!(written.contains("kind = \"cylinder\""), "{written}");
     let unknown = text.replace("radius = 1\n", "radius = 1\nheight = 2\n");

@@ -75,3 +75,5 @@ pub use report::{
 };
 pub use routing::{RECHECK_S, ROUTE_WORK_PER_CYCLE, RouteReason, Router};
 pub use safety::{Hit, SafetyVerdict, Violation, assess_trajectory, check_trajectory};
+/// Why a goal cannot be reached ([`Event::GoalUnreachable`], [`GoalUnreachable`]).
+pub use trust_route::UnreachableCause;

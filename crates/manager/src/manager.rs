@@ -570,7 +570,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         let mut cycle = self.begin_cycle(now, measured, &target, spans.started);
         if let Some(u) = self.unreachable.as_ref().filter(|_| newly_invalid) {
             cycle.events.push(Event::GoalUnreachable {
-                cause: u.cause.clone(),
+                cause: u.cause,
                 held_at: u.held_at,
             });
         }
@@ -630,7 +630,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         goal: &Vec3,
         scene: &Scene<'_>,
     ) -> bool {
-        let cause = cause.to_string();
+        let cause = *cause;
         let same = self.routed_goal.is_some_and(|g| (g - goal).norm() <= 1e-9)
             && self.unreachable.as_ref().is_some_and(|u| u.cause == cause);
         if same {
@@ -736,9 +736,9 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                     .as_ref()
                     .and_then(|r| r.points().last().copied());
                 let since_t = self.unreachable.as_ref().map_or(measured.t, |u| u.since_t);
-                let cause = verdict.cause.to_string();
+                let cause = verdict.cause;
                 cycle.events.push(Event::GoalUnreachable {
-                    cause: cause.clone(),
+                    cause,
                     held_at: held_at.map(|p| [p.x, p.y, p.z]),
                 });
                 self.unreachable = Some(crate::GoalUnreachable {

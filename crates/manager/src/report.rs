@@ -194,8 +194,9 @@ pub enum Event {
     /// The route planner proved the goal cannot be reached ([`GoalUnreachable`]); the manager
     /// holds a stop at the reachable point nearest the goal and re-checks.
     GoalUnreachable {
-        /// Why, in words (sealed off, narrower than the vehicle plus its margin, ...).
-        cause: String,
+        /// Why (sealed off, narrower than the vehicle plus its margin, ...); its `Display` is
+        /// the sentence.
+        cause: trust_route::UnreachableCause,
         /// The reachable point nearest the goal the manager now aims at, if any.
         #[serde(default)]
         held_at: Option<[f64; 3]>,
@@ -471,8 +472,8 @@ pub struct StepReport {
 /// route or the goal changes.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GoalUnreachable {
-    /// Why, in words.
-    pub cause: String,
+    /// Why; its `Display` is the sentence (a run log's `unreachable` outcome `reason`).
+    pub cause: trust_route::UnreachableCause,
     /// The reachable point nearest the goal, where the manager holds a stop (`None`: where the
     /// vehicle is).
     pub held_at: Option<[f64; 3]>,

@@ -1005,7 +1005,7 @@ fn a_goal_inside_a_wall_or_outside_the_bounds_is_unreachable_and_a_stop_is_held_
             state.t = t;
             let r = m.step(t, &state, &goal, &scene).unwrap();
             let u = r.goal_unreachable.clone().expect("a verdict every cycle");
-            assert!(u.cause.contains(cause), "{}", u.cause);
+            assert!(u.cause.to_string().contains(cause), "{}", u.cause);
             let since = *first_since.get_or_insert(u.since_t);
             assert_eq!(u.since_t, since, "the verdict keeps its first time");
             let verdicts = r
@@ -1455,7 +1455,7 @@ fn a_sealed_goal_is_reported_unreachable_and_a_stop_is_held_outside() {
         .expect("a verdict");
     assert!(verdict < 10, "the verdict took {verdict} cycles");
     let u = reports[verdict].goal_unreachable().unwrap();
-    assert!(u.cause.contains("sealed"), "{}", u.cause);
+    assert!(u.cause.to_string().contains("sealed"), "{}", u.cause);
     let held = u.held_at.expect("a reachable point nearest the goal");
     let held = Vec3::new(held[0], held[1], held[2]);
     assert!(map.signed_distance(&held) >= 0.3, "{held}");

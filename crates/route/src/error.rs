@@ -51,8 +51,10 @@ impl fmt::Display for ReadablePoint {
     }
 }
 
-/// Why a goal cannot be reached ([`crate::Unreachable`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Why a goal cannot be reached ([`crate::Unreachable`]). Its `Display` is the sentence run logs
+/// carry as an `unreachable` outcome's `reason`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum UnreachableCause {
     /// The goal lies outside the map bounds.

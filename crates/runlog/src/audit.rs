@@ -583,11 +583,12 @@ impl<'a> Auditor<'a> {
         }
         if r.collision_t.is_none() && (static_c < 0.0 || dynamic_c < 0.0) {
             r.collision_t = Some(s.t);
-            r.with = Some(if static_c <= dynamic_c {
-                "static".to_string()
+            let contact = if static_c <= dynamic_c {
+                crate::Contact::Static
             } else {
-                format!("obstacle:{nearest}")
-            });
+                crate::Contact::Obstacle(nearest)
+            };
+            r.with = Some(contact.to_string());
         }
         self.previous = Some(Previous {
             index,

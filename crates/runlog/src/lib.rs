@@ -416,6 +416,25 @@ impl Status {
     }
 }
 
+/// What the vehicle touched: a `collided` outcome's `with`. Its `Display` is the contract's
+/// spelling, `static` or `obstacle:<id>` (the header's obstacle index).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Contact {
+    /// The static geometry.
+    Static,
+    /// The moving obstacle with this id.
+    Obstacle(usize),
+}
+
+impl std::fmt::Display for Contact {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Contact::Static => f.write_str("static"),
+            Contact::Obstacle(id) => write!(f, "obstacle:{id}"),
+        }
+    }
+}
+
 /// The last line.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Outcome {
@@ -435,7 +454,7 @@ pub struct Outcome {
     pub max_speed: f64,
     /// Largest `|a|` over the state records.
     pub max_accel: f64,
-    /// For `collided`: `"static"` or `"obstacle:<id>"`.
+    /// For `collided`: `"static"` or `"obstacle:<id>"` ([`Contact`]'s spelling).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub with: Option<String>,
     /// Added: why the run is `invalid`, or other notes.

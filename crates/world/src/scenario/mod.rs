@@ -154,12 +154,9 @@ pub use crate::problem::Problem;
 pub use generator::{DynamicForestParams, E1Params, E2Params, E3Params, E4Params, GeneratorSpec};
 pub use sections::{
     BoundsSpec, Latency, MAX_CPU_SCALE, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec,
-    RandomEndpoints, RandomObstacles, SimSection, StaticSection, VehicleModel, VehicleSection,
-    WorldSection, endpoint_draw_count,
+    RandomEndpoints, RandomObstacles, SimSection, StaticSection, StaticShape, VehicleModel,
+    VehicleSection, WorldSection, endpoint_draw_count,
 };
-
-/// A static obstacle of `[[static.shapes]]`: the run log's type (see [`StaticSection::shapes`]).
-pub use trust_runlog::StaticShape;
 
 use crate::error::WorldError;
 use crate::seeds::Seeds;

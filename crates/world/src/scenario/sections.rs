@@ -9,7 +9,6 @@ use trust_geometry::{AaBox, Cylinder, Shape, Sphere};
 use crate::problem::Problem;
 use crate::scenario::generator::GeneratorSpec;
 use crate::traffic::{Motion, MovingObstacle, MovingShape};
-use trust_runlog::StaticShape;
 use trust_vehicle::{QuadrotorParams, Se3Gains};
 
 /// An axis-aligned box `{ min = [x, y, z], max = [x, y, z] }`.
@@ -59,56 +58,79 @@ pub struct WorldSection {
     pub generator: Option<GeneratorSpec>,
 }
 
-/// The scenario's form of a static obstacle: the run log's [`StaticShape`] (one type for both),
-/// written tagged by `kind` — `{ kind = "sphere", center = [x, y, z], radius = r }`,
+/// A static obstacle of `[[static.shapes]]`, tagged by `kind` —
+/// `{ kind = "sphere", center = [x, y, z], radius = r }`,
 /// `{ kind = "cylinder", center = [x, y], radius = r, z_min = a, z_max = b }` (vertical, as in the
-/// run-log contract), `{ kind = "box", min = [x, y, z], max = [x, y, z] }` (axis-aligned) — where
-/// the run log tags it externally. A serde adapter for [`StaticShape`] (`serde(remote)`): it
-/// (de)serializes the run-log type itself, so there is nothing to convert.
-#[derive(Serialize, Deserialize)]
-#[serde(
-    remote = "StaticShape",
-    tag = "kind",
-    rename_all = "snake_case",
-    deny_unknown_fields
-)]
-enum KindTagged {
+/// run-log contract), `{ kind = "box", min = [x, y, z], max = [x, y, z] }` (axis-aligned). The
+/// world's own type: the run log's [`trust_runlog::StaticShape`] has the same variants, tagged
+/// externally, and converts both ways (`From`), for writing a log's header and reading one.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum StaticShape {
+    /// A ball.
     Sphere {
+        /// Centre.
         center: [f64; 3],
+        /// Radius.
         radius: f64,
     },
+    /// A vertical cylinder: axis through `center` (x, y) from `z_min` to `z_max`.
     Cylinder {
+        /// Axis position (x, y).
         center: [f64; 2],
+        /// Radius.
         radius: f64,
+        /// Bottom.
         z_min: f64,
+        /// Top.
         z_max: f64,
     },
+    /// An axis-aligned box.
     Box {
+        /// Lower corner.
         min: [f64; 3],
+        /// Upper corner.
         max: [f64; 3],
     },
 }
 
-/// `[[static.shapes]]` through [`KindTagged`].
-mod kind_tagged {
-    use serde::{Deserialize, Deserializer, Serialize, Serializer};
-    use trust_runlog::StaticShape;
-
-    #[derive(Serialize, Deserialize)]
-    #[serde(transparent)]
-    struct One(#[serde(with = "super::KindTagged")] StaticShape);
-
-    pub(super) fn serialize<S: Serializer>(v: &[StaticShape], s: S) -> Result<S::Ok, S::Error> {
-        s.collect_seq(v.iter().map(|x| One(*x)))
+impl From<StaticShape> for trust_runlog::StaticShape {
+    fn from(s: StaticShape) -> Self {
+        match s {
+            StaticShape::Sphere { center, radius } => Self::Sphere { center, radius },
+            StaticShape::Cylinder {
+                center,
+                radius,
+                z_min,
+                z_max,
+            } => Self::Cylinder {
+                center,
+                radius,
+                z_min,
+                z_max,
+            },
+            StaticShape::Box { min, max } => Self::Box { min, max },
+        }
     }
+}
 
-    pub(super) fn deserialize<'de, D: Deserializer<'de>>(
-        d: D,
-    ) -> Result<Vec<StaticShape>, D::Error> {
-        Ok(Vec::<One>::deserialize(d)?
-            .into_iter()
-            .map(|One(x)| x)
-            .collect())
+impl From<trust_runlog::StaticShape> for StaticShape {
+    fn from(s: trust_runlog::StaticShape) -> Self {
+        match s {
+            trust_runlog::StaticShape::Sphere { center, radius } => Self::Sphere { center, radius },
+            trust_runlog::StaticShape::Cylinder {
+                center,
+                radius,
+                z_min,
+                z_max,
+            } => Self::Cylinder {
+                center,
+                radius,
+                z_min,
+                z_max,
+            },
+            trust_runlog::StaticShape::Box { min, max } => Self::Box { min, max },
+        }
     }
 }
 
@@ -162,7 +184,7 @@ pub(crate) fn static_shape(s: &Shape) -> StaticShape {
 #[serde(deny_unknown_fields)]
 pub struct StaticSection {
     /// Analytic shapes (`[[static.shapes]]`), added to a generator's.
-    #[serde(default, with = "kind_tagged")]
+    #[serde(default)]
     pub shapes: Vec<StaticShape>,
     /// What the planner sees as a point cloud (`[static.point_cloud]`); absent: the planner sees
     /// the shapes analytically.
