@@ -73,7 +73,8 @@ fn members() -> Vec<Member> {
 /// `core`); `replay` (issue 20) reads run logs and draws with `plot`, and only the binary uses it;
 /// `export` (MCAP, issue 20) reads logs only (`runlog`), and only `sim` uses it;
 /// `flightstack` (PX4/Crazyflie outputs, issue 35) reads the planner's trajectory type (`core`)
-/// and knows no simulator type, its tests build MINCO trajectories (`minco`); `ros2` (the ROS 2
+/// and knows no simulator type, its tests build MINCO trajectories (`minco`); `sensing`
+/// (simulated sensors and the online map, issue 34) sits on `geometry` alone; `ros2` (the ROS 2
 /// node, issue 35) sits at the top beside `sim`: the planner and map of a scenario file
 /// (`world`, `planner`) and the PX4 setpoints of `flightstack`.
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
@@ -99,6 +100,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
         ("trust-overrides", &[][..]),
         ("trust-geometry", &[][..]),
         ("trust-predict", &["trust-geometry"][..]),
+        ("trust-sensing", &["trust-geometry"][..]),
         (
             "trust-core",
             &["trust-geometry", "trust-predict", "trust-overrides"][..],

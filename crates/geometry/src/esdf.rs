@@ -260,6 +260,54 @@ impl Esdf {
         })
     }
 
+    /// A field from signed distances computed elsewhere (`distances[voxel_index(dims, i, j, k)]`,
+    /// in metres, with the convention of [`Esdf`]: negative at occupied voxels, positive at free
+    /// ones). An online map that keeps its own distance field incrementally (`trust-sensing`)
+    /// hands it to a [`crate::StaticMap`] this way, without a second transform.
+    ///
+    /// Positive values may be lower bounds of the true distance (a field truncated at some
+    /// distance stays conservative and keeps the slope bound the line-of-sight test relies on);
+    /// `+inf` is allowed. Errors on a non-finite `origin`, a non-positive `resolution`, an empty
+    /// or too large grid, a slice of the wrong length, or a NaN or `-inf` value (naming its
+    /// index).
+    pub fn from_signed_distances(
+        origin: Vec3,
+        resolution: f64,
+        dims: [usize; 3],
+        distances: Vec<f64>,
+    ) -> Result<Self, GeometryError> {
+        crate::error::check_vec("esdf.origin", &origin)?;
+        check_positive("esdf.resolution", resolution)?;
+        let count = checked_voxel_count(dims)?;
+        if distances.len() != count {
+            return Err(GeometryError::LengthMismatch {
+                field: "distances".into(),
+                len: distances.len(),
+                expected: count,
+            });
+        }
+        if let Some(i) = distances
+            .iter()
+            .position(|d| d.is_nan() || *d == f64::NEG_INFINITY)
+        {
+            return Err(GeometryError::non_finite(
+                format!("distances[{i}]"),
+                distances[i],
+            ));
+        }
+        let occupied_count = distances.iter().filter(|&&d| d < 0.0).count();
+        let (coarse, coarse_dims) = coarse_minima(&distances, dims);
+        Ok(Self {
+            origin,
+            resolution,
+            dims,
+            distances,
+            occupied_count,
+            coarse,
+            coarse_dims,
+        })
+    }
+
     /// A lower bound of [`Esdf::signed_distance`] at `p`, from the coarse grid of block minima:
     /// one memory access instead of eight, for rejecting points that are surely clear (the
     /// interpolant is a convex combination of its cell's corners, which all lie in `p`'s block
@@ -901,5 +949,31 @@ mod tests {
         assert!(checked_voxel_count([usize::MAX, 2, 2]).is_err());
         // A product beyond u128 (the file fuzzer found it through a world placeholder).
         assert!(checked_voxel_count([usize::MAX; 3]).is_err());
+    }
+
+    #[test]
+    fn from_signed_distances_round_trips_and_validates() {
+        let mut occupied = vec![false; 5 * 4 * 3];
+        occupied[voxel_index([5, 4, 3], 2, 1, 1)] = true;
+        let a = Esdf::from_occupancy(Vec3::new(0.5, 0.5, 0.5), 0.5, [5, 4, 3], &occupied).unwrap();
+        let b = Esdf::from_signed_distances(a.origin(), 0.5, [5, 4, 3], a.distances().to_vec())
+            .unwrap();
+        assert_eq!(a, b);
+        assert_eq!(b.occupied_count(), 1);
+        let mut bad = a.distances().to_vec();
+        bad[7] = f64::NAN;
+        let e = Esdf::from_signed_distances(a.origin(), 0.5, [5, 4, 3], bad).unwrap_err();
+        assert_eq!(e.to_string(), "distances[7] must be finite, got NaN");
+        let e = Esdf::from_signed_distances(a.origin(), 0.5, [5, 4, 3], vec![1.0; 3]).unwrap_err();
+        assert!(
+            matches!(e, GeometryError::LengthMismatch { len: 3, .. }),
+            "{e}"
+        );
+        // +inf everywhere is an empty field.
+        let empty =
+            Esdf::from_signed_distances(Vec3::zeros(), 1.0, [2, 2, 2], vec![f64::INFINITY; 8])
+                .unwrap();
+        assert_eq!(empty.occupied_count(), 0);
+        assert_eq!(empty.signed_distance(&Vec3::zeros()), f64::INFINITY);
     }
 }

@@ -1,12 +1,13 @@
 //! The static map: bounds, analytic shapes in a BVH, and an optional voxel ESDF.
 
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy, BvhNode};
+use parry3d_f64::query::Ray;
 
 use crate::Vec3;
 use crate::aabb::Aabb;
 use crate::error::{GeometryError, check_positive};
 use crate::esdf::Esdf;
-use crate::parry_conv::{segment_blocked, to_p_aabb};
+use crate::parry_conv::{ray_shape_hit, segment_blocked, to_p, to_p_aabb};
 use crate::shapes::Shape;
 
 /// Step length reported by [`StaticMap::resolution`] for maps without a voxel grid, in metres:
@@ -437,6 +438,42 @@ impl StaticMap {
         !blocked
     }
 
+    /// Ray cast against every obstacle: the distance in metres from `origin` along `dir` (any
+    /// non-zero length; it is normalized) to the first obstacle point within `max_range`,
+    /// `Some(0.0)` if `origin` is inside or on an obstacle, `None` if the ray stays clear.
+    ///
+    /// * Shapes: parry's ray casts ([`Shape::cast_ray`]) on the leaves of the map's BVH, visited
+    ///   nearest box first, so the cost grows with the shapes the ray passes, not their number.
+    /// * ESDF: sphere tracing on the interpolated field — from each sample the ray advances by
+    ///   `d / L` (`L = 2√3` bounds the interpolant's slope, as in [`StaticMap::segment_clear`]),
+    ///   so it never steps over the zero level; a sample within `resolution / 1000` of the zero
+    ///   level is the hit. After [`MAX_TRACE_STEPS`] samples the trace answers a hit where it
+    ///   stands (conservative).
+    ///
+    /// Invalid input answers conservatively ([`crate::scale`]): a non-finite or out-of-scale
+    /// `origin`, a zero or non-finite `dir` or a NaN `max_range` gives `Some(0.0)`; a negative
+    /// `max_range` counts as 0 (then only an origin inside an obstacle hits).
+    pub fn cast_ray(&self, origin: &Vec3, dir: &Vec3, max_range: f64) -> Option<f64> {
+        let Ok((unit, max_t)) = ray_input(origin, dir, max_range) else {
+            return Some(0.0);
+        };
+        let mut best = self
+            .esdf
+            .as_ref()
+            .and_then(|e| esdf_ray_hit(e, origin, &unit, max_t));
+        if !self.shapes.is_empty() {
+            let limit = best.unwrap_or(max_t);
+            let ray = Ray::new(to_p(origin), to_p(&unit));
+            if let Some((_, t)) = self.bvh.cast_ray(&ray, limit, |i, so_far| {
+                ray_shape_hit(&self.shapes[i as usize], origin, &unit, so_far)
+            }) && best.is_none_or(|b| t < b)
+            {
+                best = Some(t);
+            }
+        }
+        best
+    }
+
     /// Indices of the shapes whose bounding boxes intersect `region` (broad phase), ascending.
     /// `out` is cleared first. Sub-linear in the number of shapes (BVH).
     pub fn shapes_near(&self, region: &Aabb, out: &mut Vec<usize>) {
@@ -448,6 +485,44 @@ impl StaticMap {
         out.extend(self.bvh.intersect_aabb(&query).map(|i| i as usize));
         out.sort_unstable();
     }
+}
+
+/// Longest ray a cast follows, in metres: twice the largest distance within the scale policy.
+const MAX_RAY_M: f64 = 4.0 * crate::scale::MAX_COORD_M;
+
+/// The unit direction and the range of a ray cast, or `Err` for input answered "blocked at once"
+/// (see [`StaticMap::cast_ray`]).
+pub(crate) fn ray_input(origin: &Vec3, dir: &Vec3, max_range: f64) -> Result<(Vec3, f64), ()> {
+    let len = dir.norm();
+    if !crate::scale::position_in_scale(origin)
+        || !len.is_finite()
+        || len == 0.0
+        || max_range.is_nan()
+    {
+        return Err(());
+    }
+    Ok((dir / len, max_range.clamp(0.0, MAX_RAY_M)))
+}
+
+/// Sphere tracing of the ray `origin + t * unit`, `t` in `[0, max_t]`, on the ESDF (see
+/// [`StaticMap::cast_ray`]).
+fn esdf_ray_hit(esdf: &Esdf, origin: &Vec3, unit: &Vec3, max_t: f64) -> Option<f64> {
+    let tol = esdf.resolution() * 1e-3;
+    let mut t = 0.0;
+    for _ in 0..MAX_TRACE_STEPS {
+        let d = esdf.signed_distance(&(origin + unit * t));
+        if d.is_nan() || d <= tol {
+            return Some(t);
+        }
+        if d == f64::INFINITY {
+            return None;
+        }
+        t += d / ESDF_LIPSCHITZ;
+        if t > max_t {
+            return None;
+        }
+    }
+    Some(t.min(max_t))
 }
 
 /// Conservative line-of-sight test of `[a, b]` against the ESDF (see
@@ -653,6 +728,124 @@ mod tests {
                 let slope = if with_cloud { ESDF_LIPSCHITZ } else { 1.0 };
                 if min_sampled - slope * spacing / 2.0 > clearance + 1e-3 {
                     prop_assert!(clear, "said blocked, but all samples are at >= {min_sampled}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn ray_casts_have_known_answers() {
+        let ball = Sphere::new(v(10.0, 10.0, 5.0), 2.0).unwrap();
+        let cyl = Cylinder::new(v(4.0, 4.0, 5.0), 1.0, 2.0).unwrap();
+        let bx = AaBox::new(v(15.0, 2.0, 1.0), v(17.0, 4.0, 3.0)).unwrap();
+        let map =
+            StaticMap::from_shapes(bounds(), vec![ball.into(), cyl.into(), bx.into()]).unwrap();
+        let close = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() < 1e-9);
+        // Ball: from (1, 10, 5) along +x the surface is at x = 8; the direction's length is free.
+        assert!(close(
+            map.cast_ray(&v(1.0, 10.0, 5.0), &v(3.0, 0.0, 0.0), 20.0),
+            7.0
+        ));
+        assert_eq!(
+            map.cast_ray(&v(1.0, 10.0, 5.0), &v(1.0, 0.0, 0.0), 6.9),
+            None
+        );
+        // Cylinder (axis z): side at x = 3 from the left, top cap at z = 7 from above.
+        assert!(close(
+            map.cast_ray(&v(0.0, 4.0, 5.0), &v(1.0, 0.0, 0.0), 20.0),
+            3.0
+        ));
+        assert!(close(
+            map.cast_ray(&v(4.0, 4.0, 9.5), &v(0.0, 0.0, -1.0), 20.0),
+            2.5
+        ));
+        // Past the cap: z = 7.5 passes over it.
+        assert_eq!(
+            map.cast_ray(&v(0.0, 4.0, 7.5), &v(1.0, 0.0, 0.0), 8.0),
+            None
+        );
+        // Box: diagonal ray into its corner region.
+        assert!(close(
+            map.cast_ray(&v(16.0, 3.0, 9.0), &v(0.0, 0.0, -1.0), 20.0),
+            6.0
+        ));
+        let d = v(1.0, 1.0, 0.0);
+        let hit = map.cast_ray(&v(12.0, -1.0, 2.0), &d, 20.0).unwrap();
+        assert!((hit - 3.0 * 2f64.sqrt()).abs() < 1e-9, "{hit}");
+        // Inside an obstacle: 0. Nearest of several along the ray wins.
+        assert_eq!(
+            map.cast_ray(&v(10.0, 10.0, 5.0), &v(1.0, 0.0, 0.0), 5.0),
+            Some(0.0)
+        );
+        assert!(close(
+            map.cast_ray(&v(0.0, 4.0, 5.0), &v(1.0, 0.0, 0.0), 100.0),
+            3.0
+        ));
+        // Invalid input is "blocked at once"; a zero range hits only from inside.
+        assert_eq!(map.cast_ray(&v(f64::NAN, 0.0, 0.0), &d, 1.0), Some(0.0));
+        assert_eq!(
+            map.cast_ray(&v(1.0, 1.0, 1.0), &Vec3::zeros(), 1.0),
+            Some(0.0)
+        );
+        assert_eq!(map.cast_ray(&v(1.0, 1.0, 1.0), &d, f64::NAN), Some(0.0));
+        assert_eq!(map.cast_ray(&v(1.0, 1.0, 1.0), &d, 0.0), None);
+        assert_eq!(map.cast_ray(&v(1.0, 1.0, 1.0), &d, -3.0), None);
+        // An empty map never hits.
+        let empty = StaticMap::new(bounds()).unwrap();
+        assert_eq!(empty.cast_ray(&v(1.0, 1.0, 1.0), &d, 1e3), None);
+        // The shape method agrees with the map.
+        assert!(close(
+            Shape::from(ball).cast_ray(&v(1.0, 10.0, 5.0), &v(1.0, 0.0, 0.0), 20.0),
+            7.0
+        ));
+    }
+
+    #[test]
+    fn ray_cast_on_the_esdf_stops_at_the_zero_level() {
+        // A wall of points at x in [10, 10.5): voxels of 0.25 m from x = 10.
+        let mut pts = Vec::new();
+        for j in 0..80 {
+            for k in 0..40 {
+                pts.push(v(10.1, 0.125 + 0.25 * j as f64, 0.125 + 0.25 * k as f64));
+            }
+        }
+        let map = StaticMap::new(bounds())
+            .unwrap()
+            .with_point_cloud(&pts, 0.25)
+            .unwrap();
+        let hit = map
+            .cast_ray(&v(2.0, 10.1, 5.1), &v(1.0, 0.0, 0.0), 20.0)
+            .unwrap();
+        // The zero level lies on the voxel face at x = 10 (within the tracer's tolerance).
+        assert!((hit - 8.0).abs() < 1e-3, "{hit}");
+        assert!(map.signed_distance(&v(2.0 + hit, 10.1, 5.1)).abs() < 1e-3);
+        assert_eq!(
+            map.cast_ray(&v(2.0, 10.1, 5.1), &v(-1.0, 0.0, 0.0), 20.0),
+            None
+        );
+        assert_eq!(
+            map.cast_ray(&v(2.0, 10.1, 5.1), &v(1.0, 0.0, 0.0), 7.9),
+            None
+        );
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+
+        /// The BVH cast equals the nearest hit over all shapes, and the point it reports lies on
+        /// the surface.
+        #[test]
+        fn cast_ray_matches_brute_force(seed in 0u64..4, o in point_strategy(), az in 0.0f64..6.0, el in -1.5f64..1.5) {
+            let shapes = random_shapes(120, seed);
+            let map = StaticMap::from_shapes(bounds(), shapes.clone()).unwrap();
+            let d = v(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+            let got = map.cast_ray(&o, &d, 30.0);
+            let brute = shapes.iter().filter_map(|s| s.cast_ray(&o, &d, 30.0)).fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t))));
+            prop_assert_eq!(got.is_some(), brute.is_some());
+            if let (Some(g), Some(b)) = (got, brute) {
+                prop_assert!((g - b).abs() < 1e-9, "{g} vs {b}");
+                if g > 0.0 {
+                    prop_assert!(map.signed_distance(&(o + d * g)).abs() < 1e-6);
                 }
             }
         }

@@ -2,8 +2,8 @@
 
 use parry3d_f64::bounding_volume::Aabb as PAabb;
 use parry3d_f64::math::{Pose, Vector as PVec};
-use parry3d_f64::query;
-use parry3d_f64::shape::{Cuboid, Cylinder as PCylinder, Segment};
+use parry3d_f64::query::{self, Ray, RayCast};
+use parry3d_f64::shape::{Ball, Cuboid, Cylinder as PCylinder, Segment};
 
 use crate::Vec3;
 use crate::aabb::Aabb;
@@ -68,6 +68,29 @@ pub(crate) fn segment_shape_distance(shape: &Shape, a: &Vec3, b: &Vec3) -> f64 {
     // Segment against ball/cylinder/cuboid is always supported by the default dispatcher; if it
     // ever were not, report contact so callers stay conservative.
     result.map(|d| d.distance).unwrap_or(0.0)
+}
+
+/// Distance along the ray `origin + t * dir` (`dir` a unit vector, `t` in `[0, max_t]`) to the
+/// first point of the solid `shape`, by parry's ray casts in the shape's frame (the cylinder with
+/// y and z swapped, as in [`segment_shape_distance`]); `Some(0)` if `origin` is inside.
+pub(crate) fn ray_shape_hit(shape: &Shape, origin: &Vec3, dir: &Vec3, max_t: f64) -> Option<f64> {
+    match shape {
+        Shape::Sphere(s) => {
+            let ray = Ray::new(to_p(&(origin - s.center)), to_p(dir));
+            Ball::new(s.radius.abs()).cast_local_ray(&ray, max_t, true)
+        }
+        Shape::Cylinder(c) => {
+            let o = origin - c.center;
+            let ray = Ray::new(PVec::new(o.x, o.z, o.y), PVec::new(dir.x, dir.z, dir.y));
+            PCylinder::new(c.half_height.abs(), c.radius.abs()).cast_local_ray(&ray, max_t, true)
+        }
+        Shape::AaBox(bx) => {
+            let center = 0.5 * (bx.min + bx.max);
+            let half = 0.5 * (bx.max - bx.min);
+            let ray = Ray::new(to_p(&(origin - center)), to_p(dir));
+            Cuboid::new(to_p(&half.abs())).cast_local_ray(&ray, max_t, true)
+        }
+    }
 }
 
 /// Whether the segment `[a, b]` comes closer than `clearance` to `shape` or touches it — the

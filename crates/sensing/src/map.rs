@@ -1,0 +1,648 @@
+//! The online local map: log-odds voxels in a rolling window and their incremental distance
+//! field.
+
+use serde::{Deserialize, Serialize};
+use trust_geometry::{Aabb, Esdf, StaticMap, Vec3};
+
+use crate::distance::{DistanceField, KeyBox};
+use crate::error::{SensingError, check_count, check_range};
+use crate::occupancy::{LogOddsParams, VoxelState};
+use crate::ring::Ring;
+use crate::scan::{ReturnKind, Scan};
+use crate::traversal::{VoxelKey, VoxelTraversal, voxel_key};
+
+/// Most voxels a window may hold (16 M, about 340 MB of map state).
+pub const MAX_WINDOW_VOXELS: usize = 1 << 24;
+
+/// Parameters of a [`LocalMap`]. Sources of the defaults in `docs/sensing.md`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LocalMapParams {
+    /// Voxel edge, metres, in `[1e-3, 10]`. Default 0.1 m: Fast-Planner's SDF map resolution (as
+    /// `trust_geometry::DEFAULT_RESOLUTION`).
+    pub resolution_m: f64,
+    /// Voxels of the rolling window along x, y, z, each in `2..=2048`, at most
+    /// [`MAX_WINDOW_VOXELS`] in all. Default 112 × 112 × 48 (11.2 × 11.2 × 4.8 m at 0.1 m): about
+    /// Fast-Planner's local update range of ±5.5 m horizontally, and the camera's 87° × 58° field
+    /// of view out to 5 m.
+    pub dims: [usize; 3],
+    /// The distance field is exact up to this distance and truncated beyond it, metres, in
+    /// `[resolution_m, 64 resolution_m]`. Default 1 m: three times the largest static safety
+    /// clearance of the scale-free defaults (0.333 m at E4's limits, ARCHITECTURE.md).
+    pub max_distance_m: f64,
+    /// The log-odds sensor model (OctoMap's defaults).
+    pub log_odds: LogOddsParams,
+    /// Whether a ray without a return clears the voxels up to the sensor's maximum range (true:
+    /// a simulated sensor's "nothing within range" is free-space evidence; set false for a real
+    /// camera whose missing pixels may hide anything).
+    pub free_on_no_return: bool,
+    /// Trace each ray from its end back towards the sensor and stop at the first voxel another
+    /// ray of the same frame already cleared (Fast-Planner's ray-casting shortcut, Zhou et al.,
+    /// "Robust and Efficient Quadrotor Trajectory Generation for Fast Autonomous Flight", RA-L
+    /// 2019). Faster, approximate: a voxel near the sensor crossed only by rays that stopped
+    /// earlier stays unobserved this frame. Default false (every voxel every ray passes).
+    pub stop_at_visited: bool,
+}
+
+impl Default for LocalMapParams {
+    fn default() -> Self {
+        Self {
+            resolution_m: 0.1,
+            dims: [112, 112, 48],
+            max_distance_m: 1.0,
+            log_odds: LogOddsParams::default(),
+            free_on_no_return: true,
+            stop_at_visited: false,
+        }
+    }
+}
+
+impl LocalMapParams {
+    /// Checks every field (named `map.<field>` in the error).
+    pub fn validate(&self) -> Result<(), SensingError> {
+        let res = check_range(
+            "map.resolution_m",
+            self.resolution_m,
+            1e-3,
+            10.0,
+            false,
+            "in [1e-3, 10] m",
+        )?;
+        for (i, axis) in ['x', 'y', 'z'].into_iter().enumerate() {
+            check_count(
+                &format!("map.dims.{axis}"),
+                self.dims[i],
+                2,
+                2048,
+                "in 2..=2048",
+            )?;
+        }
+        let count = self.dims.iter().product::<usize>();
+        check_count(
+            "map.dims (product)",
+            count,
+            8,
+            MAX_WINDOW_VOXELS,
+            "at most 16 777 216 voxels",
+        )?;
+        check_range(
+            "map.max_distance_m",
+            self.max_distance_m,
+            res,
+            64.0 * res,
+            false,
+            "in [resolution_m, 64 resolution_m]",
+        )?;
+        self.log_odds.validate()
+    }
+}
+
+/// One voxel's state.
+#[derive(Debug, Clone, Copy, Default)]
+struct Voxel {
+    log_odds: f32,
+    /// `frame` if a ray of the current frame passed it, `frame + 1` if one ended in it.
+    mark: u32,
+    known: bool,
+}
+
+/// What one [`LocalMap::integrate_scan`] did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ScanUpdate {
+    /// Rays that brought evidence (hits, and no-returns if they clear).
+    pub ray_count: usize,
+    /// Voxels updated (each at most once per scan; a hit wins over a miss, as in OctoMap).
+    pub voxel_count: usize,
+    /// Voxels whose occupancy flipped (what the distance field has to catch up with).
+    pub flip_count: usize,
+}
+
+/// A local occupancy map around the vehicle: log-odds voxels in a rolling window (ring-buffer
+/// indexing: moving the window clears only the voxels that leave it), states
+/// unknown / free / occupied, and a signed distance field truncated at
+/// [`LocalMapParams::max_distance_m`] that follows the occupancy incrementally.
+///
+/// Unknown space (the policy, `docs/sensing.md`):
+/// * the distance field, and the [`Esdf`] / [`StaticMap`] it exports for the planner, count
+///   only occupied voxels as obstacles: unknown space is free there (the route and the
+///   optimizer may plan into it, at their usual costs);
+/// * what the vehicle commits to fly (the committed part and its braking tail) must lie in
+///   known free space: [`LocalMap::is_known_free`], [`LocalMap::segment_known_free`] (FASTER,
+///   Tordesillas et al., IEEE T-RO 2022). Everything outside the window is unknown.
+///
+/// The usual cycle: [`LocalMap::recentre`] on the vehicle, [`LocalMap::insert_scan`] per frame
+/// (or [`LocalMap::integrate_scan`] then [`LocalMap::update_distance`]), then queries or
+/// [`LocalMap::to_static_map`].
+#[derive(Debug, Clone)]
+pub struct LocalMap {
+    params: LocalMapParams,
+    ring: Ring,
+    voxels: Vec<Voxel>,
+    occupied: Vec<bool>,
+    occupied_count: usize,
+    field: DistanceField,
+    frame: u32,
+    touched: Vec<(usize, VoxelKey)>,
+    pending: Option<KeyBox>,
+}
+
+/// Checks that `p` is finite and within the scale policy.
+fn check_point(field: &str, p: &Vec3) -> Result<(), SensingError> {
+    for (i, axis) in ['x', 'y', 'z'].into_iter().enumerate() {
+        check_range(
+            &format!("{field}.{axis}"),
+            p[i],
+            -trust_geometry::scale::MAX_COORD_M,
+            trust_geometry::scale::MAX_COORD_M,
+            false,
+            "|x| <= 1e6 m (the scale policy)",
+        )?;
+    }
+    Ok(())
+}
+
+impl LocalMap {
+    /// An all-unknown map whose window is centred on `center`.
+    pub fn new(params: LocalMapParams, center: &Vec3) -> Result<Self, SensingError> {
+        params.validate()?;
+        check_point("center", center)?;
+        let res = params.resolution_m;
+        let r = (params.max_distance_m / res - 1e-9).ceil().max(1.0) as i64;
+        let ring = Ring {
+            dims: params.dims,
+            low: Self::low_for(&params, center),
+            res,
+        };
+        let n = ring.len();
+        Ok(Self {
+            params,
+            ring,
+            voxels: vec![Voxel::default(); n],
+            occupied: vec![false; n],
+            occupied_count: 0,
+            field: DistanceField::new(n, r, res),
+            frame: 2,
+            touched: Vec::new(),
+            pending: None,
+        })
+    }
+
+    fn low_for(params: &LocalMapParams, center: &Vec3) -> VoxelKey {
+        let c = voxel_key(center, params.resolution_m);
+        [
+            c[0] - (params.dims[0] / 2) as i64,
+            c[1] - (params.dims[1] / 2) as i64,
+            c[2] - (params.dims[2] / 2) as i64,
+        ]
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &LocalMapParams {
+        &self.params
+    }
+
+    /// The region the window covers now.
+    pub fn window(&self) -> Aabb {
+        self.ring.world_box()
+    }
+
+    /// Occupied voxels in the window.
+    pub fn occupied_count(&self) -> usize {
+        self.occupied_count
+    }
+
+    /// Voxels of the distance field recomputed since the map was made (a work count).
+    pub fn recomputed_count(&self) -> u64 {
+        self.field.recomputed_count
+    }
+
+    /// Moves the window so that it is centred on `center` (to the voxel). Voxels that stay inside
+    /// keep their state; those that leave are forgotten (unknown when they come back); only the
+    /// slots that change hands are touched, and the distance field is recomputed near the two
+    /// faces that moved. Pending occupancy changes are folded into the field first.
+    pub fn recentre(&mut self, center: &Vec3) -> Result<(), SensingError> {
+        check_point("center", center)?;
+        self.update_distance();
+        let new_low = Self::low_for(&self.params, center);
+        let r = self.field.r;
+        for i in 0..3 {
+            let delta = new_low[i] - self.ring.low[i];
+            if delta == 0 {
+                continue;
+            }
+            let n = self.ring.dims[i] as i64;
+            if delta.abs() >= n {
+                self.clear_all(new_low);
+                return Ok(());
+            }
+            let (lo, hi) = (self.ring.low[i], self.ring.high()[i]);
+            let leaving = if delta > 0 {
+                (lo, lo + delta - 1)
+            } else {
+                (hi + delta + 1, hi)
+            };
+            let mut lost_occupied = false;
+            for k in leaving.0..=leaving.1 {
+                lost_occupied |= self.clear_slab(i, k);
+            }
+            self.ring.low[i] = new_low[i];
+            let (lo, hi) = (self.ring.low, self.ring.high());
+            if self.occupied_count > 0 {
+                // The entering voxels get their distances; the voxels within `r` of the face the
+                // lost occupied voxels were behind lose them.
+                let mut entering = KeyBox { lo, hi };
+                if delta > 0 {
+                    entering.lo[i] = hi[i] - delta + 1;
+                } else {
+                    entering.hi[i] = lo[i] - delta - 1;
+                }
+                self.field.recompute(&self.ring, &self.occupied, &entering);
+            }
+            if lost_occupied {
+                let mut near = KeyBox { lo, hi };
+                if delta > 0 {
+                    near.hi[i] = lo[i] + r - 1;
+                } else {
+                    near.lo[i] = hi[i] - r + 1;
+                }
+                self.field.recompute(&self.ring, &self.occupied, &near);
+            }
+        }
+        Ok(())
+    }
+
+    /// Forgets every voxel whose coordinate along `axis` is `k` (a slab of the window); returns
+    /// whether one of them was occupied.
+    fn clear_slab(&mut self, axis: usize, k: i64) -> bool {
+        let d = self.ring.dims;
+        let s = self.ring.axis_slot(axis, k);
+        let (a1, a2) = match axis {
+            0 => (1, 2),
+            1 => (0, 2),
+            _ => (0, 1),
+        };
+        let strides = [1, d[0], d[0] * d[1]];
+        let far = self.field.r as f64 * self.ring.res;
+        let mut lost = false;
+        for j in 0..d[a2] {
+            for i in 0..d[a1] {
+                let slot = s * strides[axis] + i * strides[a1] + j * strides[a2];
+                self.voxels[slot] = Voxel::default();
+                if self.occupied[slot] {
+                    self.occupied[slot] = false;
+                    self.occupied_count -= 1;
+                    lost = true;
+                }
+                self.field.dist[slot] = far;
+            }
+        }
+        lost
+    }
+
+    fn clear_all(&mut self, new_low: VoxelKey) {
+        self.voxels.fill(Voxel::default());
+        self.occupied.fill(false);
+        self.occupied_count = 0;
+        self.field.reset(self.ring.res);
+        self.ring.low = new_low;
+        self.pending = None;
+    }
+
+    /// Integrates a scan and updates the distance field: [`LocalMap::integrate_scan`] then
+    /// [`LocalMap::update_distance`].
+    pub fn insert_scan(&mut self, scan: &Scan) -> Result<ScanUpdate, SensingError> {
+        let u = self.integrate_scan(scan)?;
+        self.update_distance();
+        Ok(u)
+    }
+
+    /// Folds one scan into the occupancy (not yet into the distance field). Each voxel is updated
+    /// at most once per scan: a hit if some ray ends in it, else a miss if some ray passes it
+    /// (OctoMap's `insertPointCloud` discretization), with free space cleared along each ray by
+    /// the 3-D DDA ([`VoxelTraversal`]). Rays and their parts outside the window are ignored.
+    ///
+    /// Errors (and changes nothing) on a non-finite or out-of-scale origin, a ray whose direction
+    /// is not a finite unit vector (within `1e-6`) or whose range is not finite in `[0, 1e4]` m,
+    /// naming the ray.
+    pub fn integrate_scan(&mut self, scan: &Scan) -> Result<ScanUpdate, SensingError> {
+        check_point("scan.origin", &scan.origin)?;
+        for (i, ray) in scan.rays.iter().enumerate() {
+            let n = ray.direction.norm();
+            if !n.is_finite() || (n - 1.0).abs() > 1e-6 {
+                return Err(SensingError::Scan {
+                    field: format!("scan.rays[{i}].direction"),
+                    problem: format!("norm {n}; expected a finite unit vector"),
+                });
+            }
+            check_range(
+                &format!("scan.rays[{i}].range"),
+                ray.range,
+                0.0,
+                1e4,
+                false,
+                "in [0, 1e4] m",
+            )?;
+        }
+        if self.frame > u32::MAX - 4 {
+            for v in &mut self.voxels {
+                v.mark = 0;
+            }
+            self.frame = 2;
+        }
+        self.frame += 2;
+        let (miss, hit) = (self.frame, self.frame + 1);
+        self.touched.clear();
+        let o = scan.origin;
+        let res = self.ring.res;
+        // Hits first, so that a voxel some ray ends in is a hit whatever the order of the rays.
+        for ray in &scan.rays {
+            if ray.kind != ReturnKind::Hit {
+                continue;
+            }
+            let k = voxel_key(&(o + ray.direction * ray.range), res);
+            if self.ring.contains(&k) {
+                let slot = self.ring.slot(&k);
+                if self.voxels[slot].mark != hit {
+                    self.voxels[slot].mark = hit;
+                    self.touched.push((slot, k));
+                }
+            }
+        }
+        let window = self.ring.world_box();
+        let mut ray_count = 0;
+        for ray in &scan.rays {
+            let clears = match ray.kind {
+                ReturnKind::Hit => true,
+                ReturnKind::NoReturn => self.params.free_on_no_return,
+                ReturnKind::Invalid => false,
+            };
+            if !clears {
+                continue;
+            }
+            ray_count += 1;
+            let end = o + ray.direction * ray.range;
+            let Some((a, b)) = window.clip_segment(&o, &end) else {
+                continue;
+            };
+            if self.params.stop_at_visited {
+                for k in VoxelTraversal::unchecked(&b, &a, res) {
+                    if !self.ring.contains(&k) {
+                        continue;
+                    }
+                    let slot = self.ring.slot(&k);
+                    let v = &mut self.voxels[slot];
+                    if v.mark == miss {
+                        break;
+                    }
+                    if v.mark != hit {
+                        v.mark = miss;
+                        self.touched.push((slot, k));
+                    }
+                }
+            } else {
+                for k in VoxelTraversal::unchecked(&a, &b, res) {
+                    if !self.ring.contains(&k) {
+                        continue;
+                    }
+                    let slot = self.ring.slot(&k);
+                    let v = &mut self.voxels[slot];
+                    if v.mark != hit && v.mark != miss {
+                        v.mark = miss;
+                        self.touched.push((slot, k));
+                    }
+                }
+            }
+        }
+        let lo = self.params.log_odds;
+        let mut flip_count = 0;
+        for &(slot, k) in &self.touched {
+            let v = &mut self.voxels[slot];
+            let prior = if v.known { f64::from(v.log_odds) } else { 0.0 };
+            let value = lo.update(prior, v.mark == hit);
+            v.log_odds = value as f32;
+            v.known = true;
+            let now = lo.is_occupied(f64::from(v.log_odds));
+            if now != self.occupied[slot] {
+                self.occupied[slot] = now;
+                if now {
+                    self.occupied_count += 1;
+                } else {
+                    self.occupied_count -= 1;
+                }
+                flip_count += 1;
+                match &mut self.pending {
+                    Some(b) => b.include(&k),
+                    None => self.pending = Some(KeyBox::point(k)),
+                }
+            }
+        }
+        Ok(ScanUpdate {
+            ray_count,
+            voxel_count: self.touched.len(),
+            flip_count,
+        })
+    }
+
+    /// Brings the distance field up to date with the occupancy: recomputes it exactly in the box
+    /// of the voxels that flipped since the last call, grown by the truncation distance. Returns
+    /// the number of voxels recomputed (0 if nothing flipped).
+    pub fn update_distance(&mut self) -> u64 {
+        let Some(b) = self.pending.take() else {
+            return 0;
+        };
+        let before = self.field.recomputed_count;
+        let r = self.field.r;
+        let target = KeyBox {
+            lo: [b.lo[0] - r, b.lo[1] - r, b.lo[2] - r],
+            hi: [b.hi[0] + r, b.hi[1] + r, b.hi[2] + r],
+        };
+        self.field.recompute(&self.ring, &self.occupied, &target);
+        self.field.recomputed_count - before
+    }
+
+    /// The state of the voxel containing `p`: [`VoxelState::Unknown`] outside the window or for a
+    /// non-finite `p`.
+    pub fn state(&self, p: &Vec3) -> VoxelState {
+        if !trust_geometry::scale::position_in_scale(p) {
+            return VoxelState::Unknown;
+        }
+        let k = voxel_key(p, self.ring.res);
+        self.state_of_key(&k)
+    }
+
+    fn state_of_key(&self, k: &VoxelKey) -> VoxelState {
+        if !self.ring.contains(k) {
+            return VoxelState::Unknown;
+        }
+        let slot = self.ring.slot(k);
+        if self.occupied[slot] {
+            VoxelState::Occupied
+        } else if self.voxels[slot].known {
+            VoxelState::Free
+        } else {
+            VoxelState::Unknown
+        }
+    }
+
+    /// The log-odds of the voxel containing `p`, `None` if it is unknown.
+    pub fn log_odds(&self, p: &Vec3) -> Option<f64> {
+        if self.state(p) == VoxelState::Unknown {
+            return None;
+        }
+        let v = self.voxels[self.ring.slot(&voxel_key(p, self.ring.res))];
+        Some(f64::from(v.log_odds))
+    }
+
+    /// True if the voxel containing `p` is observed and free.
+    pub fn is_known_free(&self, p: &Vec3) -> bool {
+        self.state(p) == VoxelState::Free
+    }
+
+    /// True if every point within `clearance` of the segment `[a, b]` lies in known free voxels:
+    /// every voxel the segment passes (3-D DDA) and every voxel within `ceil(clearance /
+    /// resolution)` voxels of one of them per axis is [`VoxelState::Free`] (conservative: a cube
+    /// around each voxel). False for non-finite input, a NaN clearance, a segment leaving the
+    /// window, or a clearance above 16 voxels (the check would cost too much; ask the distance
+    /// field instead). A negative clearance counts as 0.
+    pub fn segment_known_free(&self, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
+        if clearance.is_nan() {
+            return false;
+        }
+        let w = self.ring.world_box();
+        if !w.contains(a) || !w.contains(b) {
+            return false;
+        }
+        let res = self.ring.res;
+        let c = (clearance.max(0.0) / res).ceil();
+        if c > 16.0 {
+            return false;
+        }
+        let c = c as i64;
+        for k in VoxelTraversal::unchecked(a, b, res) {
+            for dz in -c..=c {
+                for dy in -c..=c {
+                    for dx in -c..=c {
+                        let q = [k[0] + dx, k[1] + dy, k[2] + dz];
+                        if self.state_of_key(&q) != VoxelState::Free {
+                            return false;
+                        }
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// Signed distance at `p` from the distance field (trilinear between voxel centres), as of
+    /// the last [`LocalMap::update_distance`]; `None` outside the box of the window's voxel
+    /// centres or for a non-finite `p`. Values are exact up to
+    /// [`LocalMapParams::max_distance_m`] (against the voxel centres) and truncated there.
+    pub fn distance(&self, p: &Vec3) -> Option<f64> {
+        self.distance_and_gradient(p).map(|(d, _)| d)
+    }
+
+    /// [`LocalMap::distance`] and the exact gradient of the interpolant.
+    pub fn distance_and_gradient(&self, p: &Vec3) -> Option<(f64, Vec3)> {
+        if !trust_geometry::scale::position_in_scale(p) {
+            return None;
+        }
+        let res = self.ring.res;
+        let mut base = [0i64; 3];
+        let mut t = [0.0; 3];
+        for i in 0..3 {
+            let g = p[i] / res - 0.5;
+            let b = g.floor();
+            base[i] = b as i64;
+            t[i] = g - b;
+            // The cell's far corner must be inside the window too.
+            if base[i] < self.ring.low[i] || base[i] + 1 > self.ring.high()[i] {
+                // On the last centre exactly: use the cell below.
+                if base[i] == self.ring.high()[i] && t[i] == 0.0 {
+                    base[i] -= 1;
+                    t[i] = 1.0;
+                } else {
+                    return None;
+                }
+            }
+        }
+        let val = |dx: i64, dy: i64, dz: i64| {
+            let k = [base[0] + dx, base[1] + dy, base[2] + dz];
+            self.field.dist[self.ring.slot(&k)]
+        };
+        let c = [
+            val(0, 0, 0),
+            val(1, 0, 0),
+            val(0, 1, 0),
+            val(1, 1, 0),
+            val(0, 0, 1),
+            val(1, 0, 1),
+            val(0, 1, 1),
+            val(1, 1, 1),
+        ];
+        let [tx, ty, tz] = t;
+        let c00 = c[0] + tx * (c[1] - c[0]);
+        let c10 = c[2] + tx * (c[3] - c[2]);
+        let c01 = c[4] + tx * (c[5] - c[4]);
+        let c11 = c[6] + tx * (c[7] - c[6]);
+        let c0 = c00 + ty * (c10 - c00);
+        let c1 = c01 + ty * (c11 - c01);
+        let value = c0 + tz * (c1 - c0);
+        let dx = (1.0 - ty) * (1.0 - tz) * (c[1] - c[0])
+            + ty * (1.0 - tz) * (c[3] - c[2])
+            + (1.0 - ty) * tz * (c[5] - c[4])
+            + ty * tz * (c[7] - c[6]);
+        let dy = (1.0 - tz) * (c10 - c00) + tz * (c11 - c01);
+        let dz = c1 - c0;
+        Some((value, Vec3::new(dx, dy, dz) / res))
+    }
+
+    /// The distance field of the whole window as an [`Esdf`] (voxel centres as the window's,
+    /// values as [`LocalMap::distance`]'s), for a [`StaticMap`]. Costs one copy of the window.
+    pub fn to_esdf(&self) -> Result<Esdf, SensingError> {
+        let d = self.ring.dims;
+        let (lo, hi) = (self.ring.low, self.ring.high());
+        let mut values = Vec::with_capacity(self.ring.len());
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                let row = d[0] * (self.ring.axis_slot(1, y) + d[1] * self.ring.axis_slot(2, z));
+                for x in lo[0]..=hi[0] {
+                    values.push(self.field.dist[row + self.ring.axis_slot(0, x)]);
+                }
+            }
+        }
+        Ok(Esdf::from_signed_distances(
+            self.ring.center(&lo),
+            self.ring.res,
+            d,
+            values,
+        )?)
+    }
+
+    /// A [`StaticMap`] over `bounds` whose obstacles are this map's occupied voxels (its ESDF is
+    /// [`LocalMap::to_esdf`]): what the existing planner stack consumes unchanged. Unknown space
+    /// is free in it (see the policy above).
+    pub fn to_static_map(&self, bounds: Aabb) -> Result<StaticMap, SensingError> {
+        Ok(StaticMap::new(bounds)?.with_esdf(self.to_esdf()?))
+    }
+
+    /// Signed distance field of the window from scratch (every voxel, no truncation shortcut in
+    /// the region): what [`LocalMap::update_distance`] must agree with. For tests and checks;
+    /// costs a full transform.
+    pub fn recompute_distance_from_scratch(&self) -> Vec<f64> {
+        let mut field = DistanceField::new(self.ring.len(), self.field.r, self.ring.res);
+        field.recompute(
+            &self.ring,
+            &self.occupied,
+            &KeyBox {
+                lo: self.ring.low,
+                hi: self.ring.high(),
+            },
+        );
+        field.dist
+    }
+
+    /// The distance field per slot (the storage order of the ring buffer).
+    pub fn distance_slots(&self) -> &[f64] {
+        &self.field.dist
+    }
+}
