@@ -193,6 +193,10 @@ fn parse_suite_csv(text: &str) -> Result<Vec<SuiteRow>> {
             },
             over_budget: usize::try_from(count("over_budget")?)?,
             skipped_ticks: count("skipped_ticks")?,
+            real_time_factor: match optional("real_time_factor") {
+                None | Some("") => 0.0,
+                Some(v) => number("real_time_factor", v)?,
+            },
         });
     }
     Ok(rows)
