@@ -7,7 +7,7 @@ use crate::Vec3;
 use crate::aabb::Aabb;
 use crate::error::{GeometryError, check_positive};
 use crate::esdf::Esdf;
-use crate::parry_conv::{ray_shape_hit, segment_blocked, to_p, to_p_aabb};
+use crate::parry_conv::{ray_input, ray_shape_hit, segment_blocked, to_p, to_p_aabb};
 use crate::shapes::Shape;
 
 /// Step length reported by [`StaticMap::resolution`] for maps without a voxel grid, in metres:
@@ -485,23 +485,6 @@ impl StaticMap {
         out.extend(self.bvh.intersect_aabb(&query).map(|i| i as usize));
         out.sort_unstable();
     }
-}
-
-/// Longest ray a cast follows, in metres: twice the largest distance within the scale policy.
-const MAX_RAY_M: f64 = 4.0 * crate::scale::MAX_COORD_M;
-
-/// The unit direction and the range of a ray cast, or `Err` for input answered "blocked at once"
-/// (see [`StaticMap::cast_ray`]).
-pub(crate) fn ray_input(origin: &Vec3, dir: &Vec3, max_range: f64) -> Result<(Vec3, f64), ()> {
-    let len = dir.norm();
-    if !crate::scale::position_in_scale(origin)
-        || !len.is_finite()
-        || len == 0.0
-        || max_range.is_nan()
-    {
-        return Err(());
-    }
-    Ok((dir / len, max_range.clamp(0.0, MAX_RAY_M)))
 }
 
 /// Sphere tracing of the ray `origin + t * unit`, `t` in `[0, max_t]`, on the ESDF (see

@@ -212,6 +212,40 @@ fn box_verdict(bx: &crate::shapes::AaBox, a: &Vec3, b: &Vec3, clearance: f64) ->
     None
 }
 
+/// Longest ray a cast follows, in metres: twice the largest distance within the scale policy.
+const MAX_RAY_M: f64 = 4.0 * crate::scale::MAX_COORD_M;
+
+/// The unit direction and the range of a ray cast, or `Err` for input answered "blocked at once"
+/// (see [`crate::StaticMap::cast_ray`]).
+pub(crate) fn ray_input(origin: &Vec3, dir: &Vec3, max_range: f64) -> Result<(Vec3, f64), ()> {
+    let len = dir.norm();
+    if !crate::scale::position_in_scale(origin)
+        || !len.is_finite()
+        || len == 0.0
+        || max_range.is_nan()
+    {
+        return Err(());
+    }
+    Ok((dir / len, max_range.clamp(0.0, MAX_RAY_M)))
+}
+
+impl Shape {
+    /// Ray cast against the solid shape: the distance in metres from `origin` along `dir` (any
+    /// non-zero length; it is normalized) to the first point of the shape within `max_range`,
+    /// `Some(0.0)` if `origin` is inside or on it, `None` if the ray stays clear. parry's ray
+    /// casts do the work (closed forms for the ball and the box, GJK for the cylinder).
+    ///
+    /// Invalid input answers conservatively, as the other queries do ([`crate::scale`]): a
+    /// non-finite or out-of-scale `origin`, a zero or non-finite `dir` or a NaN `max_range` gives
+    /// `Some(0.0)` ("blocked at once"); a negative `max_range` counts as 0.
+    pub fn cast_ray(&self, origin: &Vec3, dir: &Vec3, max_range: f64) -> Option<f64> {
+        match ray_input(origin, dir, max_range) {
+            Ok((unit, max_t)) => ray_shape_hit(self, origin, &unit, max_t),
+            Err(()) => Some(0.0),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

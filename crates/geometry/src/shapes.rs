@@ -522,21 +522,6 @@ impl Shape {
     pub fn is_free(&self, p: &Vec3, clearance: f64) -> bool {
         self.signed_distance(p) >= clearance
     }
-
-    /// Ray cast against the solid shape: the distance in metres from `origin` along `dir` (any
-    /// non-zero length; it is normalized) to the first point of the shape within `max_range`,
-    /// `Some(0.0)` if `origin` is inside or on it, `None` if the ray stays clear. parry's ray
-    /// casts do the work (closed forms for the ball and the box, GJK for the cylinder).
-    ///
-    /// Invalid input answers conservatively, as the other queries do ([`crate::scale`]): a
-    /// non-finite or out-of-scale `origin`, a zero or non-finite `dir` or a NaN `max_range` gives
-    /// `Some(0.0)` ("blocked at once"); a negative `max_range` counts as 0.
-    pub fn cast_ray(&self, origin: &Vec3, dir: &Vec3, max_range: f64) -> Option<f64> {
-        match crate::map::ray_input(origin, dir, max_range) {
-            Ok((unit, max_t)) => crate::parry_conv::ray_shape_hit(self, origin, &unit, max_t),
-            Err(()) => Some(0.0),
-        }
-    }
 }
 
 #[cfg(test)]
