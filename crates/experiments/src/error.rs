@@ -55,3 +55,40 @@ impl ExperimentError {
         ExperimentError::Input(Problem::new(field, value, expected))
     }
 }
+
+/// Checks a study's planner list (named `option` in the errors): one or more presets, each at
+/// most once.
+pub(crate) fn check_planner_list(
+    option: &str,
+    planners: &[trust_planner::PlannerPreset],
+) -> Result<(), ExperimentError> {
+    if planners.is_empty() {
+        return Err(ExperimentError::input(
+            option,
+            "(empty)",
+            "one or more of trust, baseline1, baseline2, baseline3",
+        ));
+    }
+    for (i, p) in planners.iter().enumerate() {
+        if planners[..i].contains(p) {
+            return Err(ExperimentError::input(
+                option,
+                p.name(),
+                "each planner at most once",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks a `--time-limit` replacing the scenario's: a positive, finite number of seconds.
+pub(crate) fn check_time_limit(time_limit_s: Option<f64>) -> Result<(), ExperimentError> {
+    match time_limit_s {
+        Some(t) if !(t.is_finite() && t > 0.0) => Err(ExperimentError::input(
+            "--time-limit",
+            t,
+            "a positive number of seconds",
+        )),
+        _ => Ok(()),
+    }
+}

@@ -107,31 +107,8 @@ impl StudyConfig {
                 "at least 1",
             ));
         }
-        if self.planners.is_empty() {
-            return Err(ExperimentError::input(
-                "--planners",
-                "(empty)",
-                "one or more of trust, baseline1, baseline2, baseline3",
-            ));
-        }
-        for (i, p) in self.planners.iter().enumerate() {
-            if self.planners[..i].contains(p) {
-                return Err(ExperimentError::input(
-                    "--planners",
-                    p.name(),
-                    "each planner at most once",
-                ));
-            }
-        }
-        if let Some(t) = self.time_limit_s
-            && !(t.is_finite() && t > 0.0)
-        {
-            return Err(ExperimentError::input(
-                "--time-limit",
-                t,
-                "a positive number of seconds",
-            ));
-        }
+        crate::error::check_planner_list("--planners", &self.planners)?;
+        crate::error::check_time_limit(self.time_limit_s)?;
         Ok(())
     }
 
