@@ -28,6 +28,8 @@ pub(crate) struct Meter {
     pub(crate) limit: usize,
     /// Units already paid toward the query that paused the previous slice (kept by the search).
     pub(crate) prepaid: usize,
+    /// Parts of a unit bought and not yet spent ([`Meter::charge_parts`], kept by the search).
+    pub(crate) credit: u32,
 }
 
 impl Meter {
@@ -46,7 +48,13 @@ impl Meter {
     /// than what is left of the slice is paid over several slices ([`Meter::prepaid`]) and runs
     /// once paid, so no slice exceeds its budget and the total does not depend on the slicing.
     pub(crate) fn charge_sight(&mut self, len_m: f64) -> Result<(), Paused> {
-        let units = 1 + (len_m / SIGHT_UNIT_M).clamp(0.0, 1.0e9) as usize;
+        self.charge_units(1 + (len_m / SIGHT_UNIT_M).clamp(0.0, 1.0e9) as usize)
+    }
+
+    /// Takes `units` for one step that runs only once all are paid: paid over several slices
+    /// if need be ([`Meter::prepaid`]), so no slice exceeds its budget and the total does not
+    /// depend on the slicing. The retried step must reach this call again with nothing changed.
+    pub(crate) fn charge_units(&mut self, units: usize) -> Result<(), Paused> {
         while self.prepaid < units {
             if self.work >= self.limit {
                 return Err(Paused);
@@ -58,7 +66,23 @@ impl Meter {
         self.prepaid = 0;
         Ok(())
     }
+
+    /// Takes `parts` [`PARTS_PER_UNIT`]ths of a unit for a cheap step (a flood expansion, a ball
+    /// of bounds stamped into the grid): whole units are bought before the step runs and the
+    /// change is kept in [`Meter::credit`] (saved by the search), so the total stays an integer
+    /// count of units that does not depend on the slicing.
+    pub(crate) fn charge_parts(&mut self, parts: u32) -> Result<(), Paused> {
+        while self.credit < parts {
+            self.charge()?;
+            self.credit += PARTS_PER_UNIT;
+        }
+        self.credit -= parts;
+        Ok(())
+    }
 }
+
+/// Parts of a unit of work that [`Meter::charge_parts`] counts in.
+pub(crate) const PARTS_PER_UNIT: u32 = 64;
 
 /// Metres of a line-of-sight query charged as one more unit ([`Meter::charge_sight`]).
 pub(crate) const SIGHT_UNIT_M: f64 = 2.0;
@@ -201,12 +225,23 @@ pub(crate) const EVALUATED: u8 = 1;
 pub(crate) const CLOSED: u8 = 2;
 /// Per-cell flag: the A* from the start holds a tentative cost for it.
 pub(crate) const SEEN: u8 = 4;
-/// Per-cell flag: reached by the flood from the goal at the inflated clearance.
-pub(crate) const FLOOD_C: u8 = 8;
-/// Per-cell flag: reached by the relaxed flood at the vehicle radius (the verdict's cause).
+/// Per-cell flag: reached by the relaxed flood at the inflated clearance from the goal.
+pub(crate) const FLOOD_G: u8 = 8;
+/// Per-cell flag: reached by the exact flood at the vehicle radius (the verdict's cause).
 pub(crate) const FLOOD_R: u8 = 16;
-/// Per-cell flag: reached by the relaxed flood at the inflated clearance (the verdict's proof).
-pub(crate) const FLOOD_CR: u8 = 32;
+/// Per-cell flag: reached by the relaxed flood at the inflated clearance from the start.
+pub(crate) const FLOOD_S: u8 = 32;
+/// Per-cell flag: [`Layer`]'s stored value is a lower bound on the centre's signed distance
+/// stamped by a free ball ([`Layer::query_stamped`]), not (yet) its evaluated value.
+pub(crate) const BOUND: u8 = 64;
+/// Per-cell flag: an upper bound on the centre's signed distance is stored (a blocked ball).
+pub(crate) const UBOUND: u8 = 128;
+
+/// Largest radius of a ball of bounds, in cells (a ball stamps at most `(2k + 1)³` cells).
+pub(crate) const MAX_BALL_CELLS: i64 = 10;
+/// Cells of a ball's bounding cube stamped per unit of work ([`Layer::query_stamped`]); measured
+/// with `cargo run --release -p trust-route --example route_timing` (see decision 0019).
+pub(crate) const STAMPED_CELLS_PER_UNIT: u32 = 1024;
 
 /// The 26 neighbour offsets of a cell and their lengths in cells (1, √2 or √3).
 pub(crate) fn neighbour_steps() -> [([i64; 3], f64); 26] {
@@ -227,17 +262,53 @@ pub(crate) fn neighbour_steps() -> [([i64; 3], f64); 26] {
 }
 
 /// A grid with its lazily evaluated cells: each centre's signed distance is computed the first
-/// time a search touches it (one unit of work) and kept, rounded down to `f32`. Every array is
-/// zero-initialised, so the OS pages in only the part the searches touch.
+/// time a search touches it (one unit of work) and kept, rounded down to `f32`. The floods also
+/// keep bounds proved by other cells' distances ("balls", [`Layer::query_stamped`]). Every
+/// array is zero-initialised, so the OS pages in only the part the searches touch.
 #[derive(Debug, Clone)]
 pub(crate) struct Layer {
     pub(crate) grid: Grid,
-    /// Lower bound on the centre's signed distance (valid under [`EVALUATED`]).
+    /// Lower bound on the centre's signed distance: its value under [`EVALUATED`], a bound
+    /// stamped by a ball under [`BOUND`].
     sd: Vec<f32>,
-    /// [`EVALUATED`], [`CLOSED`], [`SEEN`], [`FLOOD_C`], [`FLOOD_R`].
+    /// Upper bound on the centre's signed distance (valid under [`UBOUND`]).
+    ub: Vec<f32>,
+    /// [`EVALUATED`], [`CLOSED`], [`SEEN`], [`FLOOD_G`], [`FLOOD_R`], [`FLOOD_S`], [`BOUND`],
+    /// [`UBOUND`].
     pub(crate) flags: Vec<u8>,
-    /// Slope bound of the map's signed distance ([`ESDF_LIPSCHITZ`] or 1).
+    /// Slope bound of the map's signed distance ([`ESDF_LIPSCHITZ`] or 1), valid for the
+    /// whole map (its shapes and its ESDF alike).
     pub(crate) lipschitz: f64,
+    /// The cells (and their distances) whose balls are still to be stamped ([`Layer::flush`]):
+    /// at most the two ends of one edge.
+    pending: Vec<(usize, f64)>,
+}
+
+/// The levels the floods test cells at, which bound the balls worth stamping: lower bounds are
+/// stamped while they are at least `low` (the lowest level tested), upper bounds while they are
+/// below `high` (the highest).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Balls {
+    pub(crate) low: f64,
+    pub(crate) high: f64,
+}
+
+/// `x` rounded down to `f32` (a lower bound stays one).
+fn f32_down(x: f64) -> f32 {
+    let mut f = x as f32;
+    if f64::from(f) > x {
+        f = f.next_down();
+    }
+    f
+}
+
+/// `x` rounded up to `f32` (an upper bound stays one).
+fn f32_up(x: f64) -> f32 {
+    let mut f = x as f32;
+    if f64::from(f) < x {
+        f = f.next_up();
+    }
+    f
 }
 
 impl Layer {
@@ -246,7 +317,9 @@ impl Layer {
         Self {
             grid,
             sd: vec![0.0; n],
+            ub: vec![0.0; n],
             flags: vec![0; n],
+            pending: Vec::with_capacity(2),
             lipschitz: if map.esdf().is_some() {
                 ESDF_LIPSCHITZ
             } else {
@@ -261,14 +334,183 @@ impl Layer {
         if self.flags[i] & EVALUATED == 0 {
             m.charge()?;
             let d = map.signed_distance(&self.grid.center_of(i));
-            let mut f = d as f32;
-            if f64::from(f) > d {
-                f = f.next_down();
-            }
-            self.sd[i] = f;
+            self.sd[i] = f32_down(d);
             self.flags[i] |= EVALUATED;
         }
         Ok(f64::from(self.sd[i]))
+    }
+
+    /// The best lower bound known on cell `i`'s signed distance without a query.
+    fn lower_bound(&self, i: usize) -> Option<f64> {
+        (self.flags[i] & (EVALUATED | BOUND) != 0).then(|| f64::from(self.sd[i]))
+    }
+
+    /// [`Layer::edge_clear`] for the floods: the bounds the balls proved settle most edges;
+    /// else both ends are evaluated, and then one exact [`StaticMap::segment_clear`] if needed.
+    pub(crate) fn edge_clear_bounded(
+        &mut self,
+        map: &StaticMap,
+        i: usize,
+        j: usize,
+        level: f64,
+        balls: &Balls,
+        m: &mut Meter,
+    ) -> Result<bool, Paused> {
+        self.flush(balls, m)?;
+        let (p, q) = (self.grid.center_of(i), self.grid.center_of(j));
+        let len = (q - p).norm();
+        if let (Some(a), Some(b)) = (self.lower_bound(i), self.lower_bound(j))
+            && 0.5 * (a + b - self.lipschitz * len) >= level
+        {
+            return Ok(true);
+        }
+        // Both ends' queries are paid for at once, before either runs: a pause between them
+        // would let the next slice's flush stamp the first one's ball and settle the edge by
+        // bounds, where an unsliced search queries the second end.
+        let unknown = [i, j].map(|c| self.flags[c] & EVALUATED == 0);
+        m.charge_units(unknown.iter().filter(|&&u| u).count())?;
+        for (c, u) in [i, j].into_iter().zip(unknown) {
+            if u {
+                self.evaluate_deferred(map, c);
+            }
+        }
+        let (a, b) = (f64::from(self.sd[i]), f64::from(self.sd[j]));
+        if 0.5 * (a + b - self.lipschitz * len) >= level {
+            return Ok(true);
+        }
+        m.charge()?;
+        Ok(map.segment_clear(&p, &q, level))
+    }
+
+    /// For a relaxed flood: may the face shared by neighbour cells `i` and `j` hold a point at
+    /// least `level` from the obstacles? Its centre is then at least `level − h/√2` from them
+    /// (every point of the face lies within `h/√2` of its centre); the centre lies `h/2` from
+    /// both cell centres, so their bounds settle most faces, else one query of the centre.
+    pub(crate) fn face_open(
+        &mut self,
+        map: &StaticMap,
+        i: usize,
+        j: usize,
+        level: f64,
+        balls: &Balls,
+        m: &mut Meter,
+    ) -> Result<bool, Paused> {
+        self.flush(balls, m)?;
+        let h = self.grid.h;
+        let need = level - h / 2.0_f64.sqrt();
+        let known = self.lower_bound(i).into_iter().chain(self.lower_bound(j));
+        if known.fold(f64::NEG_INFINITY, f64::max) - self.lipschitz * 0.5 * h >= need {
+            return Ok(true);
+        }
+        m.charge()?;
+        let mid = 0.5 * (self.grid.center_of(i) + self.grid.center_of(j));
+        Ok(map.signed_distance(&mid) >= need)
+    }
+
+    /// True if cell `i`'s centre is at least `level` from the obstacles, using the bounds the
+    /// balls proved when they settle it and else one query ([`Layer::query_stamped`]).
+    pub(crate) fn at_least(
+        &mut self,
+        map: &StaticMap,
+        i: usize,
+        level: f64,
+        balls: &Balls,
+        m: &mut Meter,
+    ) -> Result<bool, Paused> {
+        self.flush(balls, m)?;
+        let f = self.flags[i];
+        if f & (EVALUATED | BOUND) != 0 && f64::from(self.sd[i]) >= level {
+            return Ok(true);
+        }
+        if f & EVALUATED != 0 {
+            return Ok(false);
+        }
+        if f & UBOUND != 0 && f64::from(self.ub[i]) < level {
+            return Ok(false);
+        }
+        Ok(self.query_stamped(map, i, m)? >= level)
+    }
+
+    /// Evaluates cell `i`'s signed distance `D` (one unit) and stamps the bounds it proves on
+    /// the cells around: with the map's slope bound `K`, every centre `q` within `ρ` of the
+    /// centre `p` has `D − K·ρ ≤ sd(q) ≤ D + K·ρ`. Lower bounds are stamped out to where they
+    /// fall to [`Balls::low`] (a free ball: those cells are free at every level the floods
+    /// test), upper bounds out to where they reach [`Balls::high`] (a blocked ball), each at
+    /// most [`MAX_BALL_CELLS`] cells; the stamping is charged by the cells it visits.
+    pub(crate) fn query_stamped(
+        &mut self,
+        map: &StaticMap,
+        i: usize,
+        m: &mut Meter,
+    ) -> Result<f64, Paused> {
+        if self.flags[i] & EVALUATED != 0 {
+            return Ok(f64::from(self.sd[i]));
+        }
+        m.charge()?;
+        Ok(self.evaluate_deferred(map, i))
+    }
+
+    /// Evaluates cell `i` (already paid for) and defers its ball. The ball's size is known only
+    /// now: it is paid for and stamped at the start of the next operation that reads bounds
+    /// ([`Layer::flush`]), before anything else that operation does, so a pause never falls
+    /// between a query and a decision that reads the bounds, and the grid's bounds and the
+    /// work total do not depend on the slicing.
+    fn evaluate_deferred(&mut self, map: &StaticMap, i: usize) -> f64 {
+        let d = map.signed_distance(&self.grid.center_of(i));
+        self.sd[i] = f32_down(d);
+        self.flags[i] = (self.flags[i] & !BOUND) | EVALUATED;
+        self.pending.push((i, d));
+        d
+    }
+
+    /// Stamps the balls of the last queries ([`Layer::query_stamped`]) still to be paid for.
+    /// Every operation that reads bounds calls it first, and nothing else before it.
+    pub(crate) fn flush(&mut self, balls: &Balls, m: &mut Meter) -> Result<(), Paused> {
+        while let Some(&(i, d)) = self.pending.first() {
+            let (h, k) = (self.grid.h, self.lipschitz);
+            let (low, up) = (d - balls.low, balls.high - d);
+            let reach = low.max(up) / (k * h);
+            if reach.is_nan() || reach < 1.0 {
+                self.pending.remove(0);
+                continue;
+            }
+            let r = (reach.floor() as i64).min(MAX_BALL_CELLS);
+            let cube = (2 * r + 1).pow(3) as u32;
+            m.charge_parts(cube.div_ceil(STAMPED_CELLS_PER_UNIT / PARTS_PER_UNIT))?;
+            self.pending.remove(0);
+            self.stamp(i, d, r, balls);
+        }
+        Ok(())
+    }
+
+    /// Stamps the bounds that cell `i`'s distance `d` proves on the cells within `r` cells.
+    fn stamp(&mut self, i: usize, d: f64, r: i64, balls: &Balls) {
+        let (h, k) = (self.grid.h, self.lipschitz);
+        let c = self.grid.coords(i);
+        for dz in -r..=r {
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    let Some(j) = self.grid.index([c[0] + dx, c[1] + dy, c[2] + dz]) else {
+                        continue;
+                    };
+                    let f = self.flags[j];
+                    if f & EVALUATED != 0 {
+                        continue;
+                    }
+                    let rho = h * ((dx * dx + dy * dy + dz * dz) as f64).sqrt();
+                    let lb = d - k * rho;
+                    if lb >= balls.low && (f & BOUND == 0 || f64::from(self.sd[j]) < lb) {
+                        self.sd[j] = f32_down(lb);
+                        self.flags[j] |= BOUND;
+                    }
+                    let ub = d + k * rho;
+                    if ub < balls.high && (f & UBOUND == 0 || f64::from(self.ub[j]) > ub) {
+                        self.ub[j] = f32_up(ub);
+                        self.flags[j] |= UBOUND;
+                    }
+                }
+            }
+        }
     }
 
     /// True if the straight edge between the centres of cells `i` and `j` (both at least `level`
@@ -338,10 +580,96 @@ mod tests {
             work: 0,
             limit: 2,
             prepaid: 0,
+            credit: 0,
         };
         assert!(m.charge().is_ok() && m.charge().is_ok());
         assert_eq!(m.charge(), Err(Paused));
         assert_eq!(m.work, 2);
+    }
+
+    fn random_map(seed: u64, count: usize) -> StaticMap {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let b = Aabb::new(Vec3::zeros(), Vec3::new(6.0, 5.0, 4.0)).unwrap();
+        let shapes = (0..count)
+            .map(|_| {
+                let lo = Vec3::new(
+                    rng.random_range(0.0..5.5),
+                    rng.random_range(0.0..4.5),
+                    rng.random_range(0.0..3.5),
+                );
+                let size = Vec3::new(
+                    rng.random_range(0.05..2.0),
+                    rng.random_range(0.05..2.0),
+                    rng.random_range(0.05..2.0),
+                );
+                trust_geometry::AaBox::new(lo, lo + size).unwrap().into()
+            })
+            .collect();
+        StaticMap::from_shapes(b, shapes).unwrap()
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
+        /// Free and blocked balls are sound: every cell a ball settles is settled as a query at
+        /// its own centre would settle it (brute force over every cell of the grid), at every
+        /// level the floods test, whatever order the cells are visited in.
+        #[test]
+        fn balls_settle_cells_as_their_own_queries_would(
+            seed in 0_u64..1_000_000,
+            count in 0_usize..8,
+            h in 0.05_f64..0.3,
+            low in -0.2_f64..0.5,
+            span in 0.0_f64..0.6,
+            stride in 1_usize..40,
+        ) {
+            let map = random_map(seed, count);
+            let grid = Grid::new(map.bounds(), h, 200_000, 10.0).unwrap();
+            let mut layer = Layer::new(grid, &map);
+            let balls = Balls { low, high: low + span };
+            let mut m = Meter { work: 0, limit: usize::MAX, prepaid: 0, credit: 0 };
+            let n = grid.len();
+            let levels = [low, low + 0.5 * span, low + span];
+            for (step, i) in (0..n).map(|k| (k * stride * 7919) % n).enumerate() {
+                let level = levels[step % 3];
+                let truth = map.signed_distance(&grid.center_of(i));
+                let said = layer.at_least(&map, i, level, &balls, &mut m).unwrap();
+                // Within the f32 rounding of the stored bounds.
+                if said {
+                    proptest::prop_assert!(truth >= level - 1e-5, "cell {i}: {truth} < {level}");
+                } else {
+                    proptest::prop_assert!(truth < level + 1e-5, "cell {i}: {truth} >= {level}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_free_ball_settles_an_empty_room_with_few_queries() {
+        let b = Aabb::new(Vec3::zeros(), Vec3::new(8.0, 8.0, 8.0)).unwrap();
+        let pillar =
+            trust_geometry::AaBox::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.2, 0.2, 8.0)).unwrap();
+        let map = StaticMap::from_shapes(b, vec![pillar.into()]).unwrap();
+        let grid = Grid::new(&b, 0.2, 1_000_000, 0.2).unwrap();
+        let mut layer = Layer::new(grid, &map);
+        let balls = Balls {
+            low: 0.2,
+            high: 0.4,
+        };
+        let mut m = Meter {
+            work: 0,
+            limit: usize::MAX,
+            prepaid: 0,
+            credit: 0,
+        };
+        let mut queries = 0;
+        for i in 0..grid.len() {
+            let before = layer.flags[i] & (EVALUATED | BOUND);
+            let free = layer.at_least(&map, i, 0.4, &balls, &mut m).unwrap();
+            queries += usize::from(before == 0);
+            assert_eq!(free, map.signed_distance(&grid.center_of(i)) >= 0.4);
+        }
+        assert!(queries * 20 < grid.len(), "{queries} of {}", grid.len());
     }
 
     #[test]
@@ -355,6 +683,7 @@ mod tests {
             work: 0,
             limit: usize::MAX,
             prepaid: 0,
+            credit: 0,
         };
         for i in (0..layer.grid.len()).step_by(97) {
             let d = layer.sd(&map, i, &mut m).unwrap();

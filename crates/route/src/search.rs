@@ -14,7 +14,7 @@ use trust_geometry::StaticMap;
 use crate::Vec3;
 use crate::error::{Endpoint, RouteError, UnreachableCause};
 use crate::grid::{
-    CLOSED, FLOOD_C, FLOOD_CR, FLOOD_R, Grid, Layer, Meter, Open, Paused, SEEN, SIGHT_UNIT_M,
+    Balls, CLOSED, FLOOD_G, FLOOD_R, FLOOD_S, Grid, Layer, Meter, Open, Paused, SEEN, SIGHT_UNIT_M,
     neighbour_steps, octile,
 };
 use crate::params::RouteParams;
@@ -114,24 +114,53 @@ pub struct RouteSearch {
     expanded_before: usize,
     /// The nearest cell to the goal of a finished A* search: distance, grid, path.
     nearest_before: Option<(f64, Grid, Vec<usize>)>,
-    flood: Option<Flood>,
-    flood_state: FloodState,
-    /// Whose turn: the goal-side flood's (true) or the A*'s.
-    flood_turn: bool,
+    /// The relaxed floods at the clearance from the goal's side and from the start's: the
+    /// first one exhausted proves the goal unreachable.
+    goal_flood: Option<Flood>,
+    start_flood: Option<Flood>,
+    sides: Sides,
+    /// The goal flood's first cell when no cell at the clearance joins the goal: the snap at
+    /// the radius.
+    goal_seed: SnapState,
+    /// Whose turn it is, and the work at which it passes on.
+    turn: Turn,
+    turn_end: usize,
+    /// The A* on the fine grid ran dry (the floods go on alone).
+    astar_exhausted: bool,
+    /// The exact flood at the radius once a side is proved sealed (the verdict's cause).
+    cause_flood: Option<Flood>,
+    /// Parts of a unit bought and not yet spent ([`Meter::charge_parts`]).
+    credit: u32,
     finishing: Option<Finishing>,
     coarse_route: Option<GlobalRoute>,
     refining: bool,
-    rcheck: Option<RCheck>,
     reached_target: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum FloodState {
+enum Sides {
     NotStarted,
-    Running,
-    /// Met the start side: no verdict to come from it.
-    Stopped,
-    Exhausted,
+    /// Both floods run: `goal` is the goal flood's first cell.
+    Running {
+        goal: usize,
+    },
+    /// The floods met (or the A* reached the goal): no proof to come from them.
+    Joined,
+    /// The flood from `side` ran dry without meeting the other side: no path keeps the
+    /// clearance. `from` is its first cell (`None`: no cell near the goal at all), `to` the
+    /// other side's.
+    Proved {
+        side: Endpoint,
+        from: Option<usize>,
+        to: Option<usize>,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Turn {
+    Astar,
+    Goal,
+    Start,
 }
 
 #[derive(Debug, Clone)]
@@ -415,15 +444,22 @@ impl Flood {
             .sqrt()
     }
 
-    /// One expansion. `met(i)`: cell `i` is known to be reachable from the other side.
+    /// One expansion (charged [`FLOOD_EXPANSION_PARTS`]; the cells' distances come from the
+    /// balls' bounds where they settle them, [`Layer::at_least`]). `met(i)`: cell `i` is known
+    /// to be reachable from the other side.
     fn step(
         &mut self,
         layer: &mut Layer,
         map: &StaticMap,
         m: &mut Meter,
+        balls: &Balls,
         met: impl Fn(&Layer, usize) -> bool,
     ) -> Result<FloodStep, Paused> {
-        let steps = neighbour_steps();
+        let steps: &[([i64; 3], f64)] = if self.exact {
+            &neighbour_steps()
+        } else {
+            &FACE_STEPS
+        };
         loop {
             if let Some((i, k)) = self.cur {
                 let Some(&(d, _)) = steps.get(k) else {
@@ -431,19 +467,14 @@ impl Flood {
                     return Ok(FloodStep::Expanded);
                 };
                 let c = layer.grid.coords(i);
-                let face = d.iter().filter(|&&v| v != 0).count() == 1;
-                if (self.exact || face)
-                    && let Some(j) = layer.grid.index([c[0] + d[0], c[1] + d[1], c[2] + d[2]])
+                if let Some(j) = layer.grid.index([c[0] + d[0], c[1] + d[1], c[2] + d[2]])
                     && layer.flags[j] & self.flag == 0
-                    && layer.sd(map, j, m)? >= self.level - self.slack(&layer.grid, j)
+                    && layer.at_least(map, j, self.level - self.slack(&layer.grid, j), balls, m)?
                     && (if self.exact {
-                        layer.edge_clear(map, i, j, self.level, m)?
+                        layer.edge_clear_bounded(map, i, j, self.level, balls, m)?
                     } else {
-                        // A path crossing between the two cubes crosses their shared face,
-                        // a square of half-diagonal h/√2 around the midpoint of the centres.
-                        m.charge()?;
-                        let mid = 0.5 * (layer.grid.center_of(i) + layer.grid.center_of(j));
-                        map.signed_distance(&mid) >= self.level - layer.grid.h / 2.0_f64.sqrt()
+                        // A path crossing between the two cubes crosses their shared face.
+                        layer.face_open(map, i, j, self.level, balls, m)?
                     })
                 {
                     layer.flags[j] |= self.flag;
@@ -466,10 +497,51 @@ impl Flood {
             if met(layer, i) {
                 return Ok(FloodStep::Met);
             }
-            m.charge()?;
+            m.charge_parts(if self.exact {
+                FLOOD_EXPANSION_PARTS * 2
+            } else {
+                FLOOD_EXPANSION_PARTS
+            })?;
             self.open.pop();
             self.cur = Some((i, 0));
         }
+    }
+}
+
+/// The six face neighbours of a cell (the relaxed floods' steps).
+const FACE_STEPS: [([i64; 3], f64); 6] = [
+    ([-1, 0, 0], 1.0),
+    ([1, 0, 0], 1.0),
+    ([0, -1, 0], 1.0),
+    ([0, 1, 0], 1.0),
+    ([0, 0, -1], 1.0),
+    ([0, 0, 1], 1.0),
+];
+
+/// Parts of a unit ([`crate::grid::PARTS_PER_UNIT`]) charged per expansion of a relaxed flood
+/// (six neighbours whose bounds are mostly known); an exact flood's (26 neighbours and their
+/// edges) is charged twice that. Measured with `cargo run --release -p trust-route --example
+/// route_timing` (decision 0019).
+const FLOOD_EXPANSION_PARTS: u32 = 4;
+
+/// Units of work a search keeps the turn for before the next one's ([`RouteSearch`]: the A*,
+/// the goal-side and the start-side relaxed floods take turns).
+const TURN_UNITS: usize = 32;
+
+/// A relaxed flood at clearance `c` from cell `from` toward cell `to`, flagging `flag`.
+fn relaxed_flood(
+    layer: &mut Layer,
+    map: &StaticMap,
+    from: usize,
+    to: usize,
+    flag: u8,
+    c: f64,
+) -> Flood {
+    let grid = layer.grid;
+    let margins: [f64; 3] = std::array::from_fn(|a| grid.origin[a] - map.bounds().min[a]);
+    Flood {
+        margins,
+        ..Flood::new(layer, from, to, flag, c, false)
     }
 }
 
@@ -522,22 +594,6 @@ impl Finishing {
         }
         Ok(())
     }
-}
-
-/// The verdict's checks once a side is exhausted on the grid: is that side joined to the other
-/// in the over-approximation of the free space at the inflated clearance (then the grid only
-/// could not resolve a passage: no verdict), and if not, at the radius alone (`TooNarrow` if so,
-/// `SealedOff` if not)?
-#[derive(Debug, Clone)]
-struct RCheck {
-    /// The exhausted side.
-    side: Endpoint,
-    snap: Option<SnapCursor>,
-    from: Option<Option<usize>>,
-    /// The relaxed flood at the clearance, then (once it is exhausted) at the radius.
-    flood: Option<Flood>,
-    /// The relaxed flood at the clearance was exhausted: the goal is proved unreachable at it.
-    proved: bool,
 }
 
 /// Drops consecutive duplicates and interior points collinear with their neighbours.
@@ -600,13 +656,18 @@ impl RouteSearch {
             astar: None,
             expanded_before: 0,
             nearest_before: None,
-            flood: None,
-            flood_state: FloodState::NotStarted,
-            flood_turn: false,
+            goal_flood: None,
+            start_flood: None,
+            sides: Sides::NotStarted,
+            goal_seed: SnapState::NotStarted,
+            turn: Turn::Astar,
+            turn_end: 0,
+            astar_exhausted: false,
+            cause_flood: None,
+            credit: 0,
             finishing: None,
             coarse_route: None,
             refining: false,
-            rcheck: None,
             reached_target: false,
         }
     }
@@ -622,10 +683,12 @@ impl RouteSearch {
             work: self.work,
             limit: self.work.saturating_add(budget),
             prepaid: self.prepaid,
+            credit: self.credit,
         };
         let r = self.drive(map, &mut m);
         self.work = m.work;
         self.prepaid = m.prepaid;
+        self.credit = m.credit;
         match r {
             Ok(mut answer) => {
                 if let RouteProgress::Unreachable(u) = &mut answer {
@@ -866,16 +929,27 @@ impl RouteSearch {
                 self.coarse = None;
             }
         }
-        if self.flood_state == FloodState::NotStarted {
-            self.flood_state = match target_cell {
-                Some(t) => {
-                    let layer = &mut self.layers[fine];
-                    self.flood = Some(Flood::new(layer, t, start_cell, FLOOD_C, c, true));
-                    FloodState::Running
-                }
-                None => FloodState::Exhausted,
+        if self.sides == Sides::NotStarted {
+            let goal = match target_cell {
+                Some(t) => Some(t),
+                None => self.goal_seed(map, m)?,
             };
+            let layer = &mut self.layers[fine];
+            self.sides = match goal {
+                Some(g) => {
+                    self.goal_flood = Some(relaxed_flood(layer, map, g, start_cell, FLOOD_G, c));
+                    self.start_flood = Some(relaxed_flood(layer, map, start_cell, g, FLOOD_S, c));
+                    Sides::Running { goal: g }
+                }
+                None => Sides::Proved {
+                    side: Endpoint::Goal,
+                    from: None,
+                    to: Some(start_cell),
+                },
+            };
+            self.turn_end = m.work + TURN_UNITS;
         }
+        let balls = self.balls();
         loop {
             if let Some(f) = &mut self.finishing {
                 f.run(map, c, m)?;
@@ -885,33 +959,77 @@ impl RouteSearch {
                 }
                 continue;
             }
-            if self.rcheck.is_some() {
-                let Some(verdict) = self.rcheck(map, m, start_cell, target_cell)? else {
-                    let layer = &self.layers[fine];
-                    return Ok(RouteProgress::Failed(RouteError::Unresolved {
-                        clearance_m: c,
-                        cell_m: layer.grid.h,
-                    }));
+            if let Sides::Proved { from, to, .. } = self.sides {
+                let verdict = match cause {
+                    Some(cause) => cause,
+                    None => self.cause_of(map, m, from, to, &balls)?,
                 };
-                if let Some(answer) = self.verdict(cause.unwrap_or(verdict)) {
+                self.sides = Sides::Joined;
+                if let Some(answer) = self.verdict(verdict) {
                     return Ok(answer);
                 }
                 continue;
             }
-            if self.flood_state == FloodState::Exhausted {
+            let running = matches!(self.sides, Sides::Running { .. });
+            if self.astar_exhausted && !running {
+                // The start's side ran dry on the grid, the relaxed floods met: a passage the
+                // grid cannot resolve may keep the clearance.
                 if let Some(cause) = cause {
                     if let Some(answer) = self.verdict(cause) {
                         return Ok(answer);
                     }
                     continue;
                 }
-                self.rcheck = Some(RCheck {
-                    side: Endpoint::Goal,
-                    snap: None,
-                    from: None,
-                    flood: None,
-                    proved: false,
-                });
+                return Ok(RouteProgress::Failed(RouteError::Unresolved {
+                    clearance_m: c,
+                    cell_m: self.layers[fine].grid.h,
+                }));
+            }
+            if !running {
+                self.turn = Turn::Astar;
+            } else if self.turn == Turn::Astar && self.astar_exhausted {
+                self.pass_turn(m.work);
+            }
+            if let (Sides::Running { goal }, Turn::Goal | Turn::Start) = (self.sides, self.turn) {
+                let coarse = self.coarse.filter(|_| !self.refining);
+                let (fine_layer, rest) = self.layers.split_at_mut(fine + 1);
+                let fine_layer = &mut fine_layer[fine];
+                let coarse_layer = coarse.map(|ix| &rest[ix - fine - 1]);
+                let (side, step) = if self.turn == Turn::Goal {
+                    let flood = self.goal_flood.as_mut().expect("goal flood");
+                    let step = flood.step(fine_layer, map, m, &balls, |layer, i| {
+                        if layer.flags[i] & (CLOSED | FLOOD_S) != 0 {
+                            return true;
+                        }
+                        coarse_layer.is_some_and(|cl| {
+                            let q = cl.grid.nearest_cell(&layer.grid.center_of(i));
+                            cl.grid.index(q).is_some_and(|j| cl.flags[j] & CLOSED != 0)
+                        })
+                    })?;
+                    ((Endpoint::Goal, goal, start_cell), step)
+                } else {
+                    let flood = self.start_flood.as_mut().expect("start flood");
+                    let step = flood.step(fine_layer, map, m, &balls, |layer, i| {
+                        layer.flags[i] & FLOOD_G != 0
+                    })?;
+                    ((Endpoint::Start, start_cell, goal), step)
+                };
+                match step {
+                    FloodStep::Expanded => {
+                        if m.work >= self.turn_end {
+                            self.pass_turn(m.work);
+                        }
+                    }
+                    FloodStep::Reached | FloodStep::Met => self.sides = Sides::Joined,
+                    FloodStep::Exhausted => {
+                        let (side, from, to) = side;
+                        self.sides = Sides::Proved {
+                            side,
+                            from: Some(from),
+                            to: Some(to),
+                        };
+                    }
+                }
                 continue;
             }
             if self.astar.is_none() {
@@ -926,29 +1044,6 @@ impl RouteSearch {
                 let w = self.params.heuristic_weight;
                 self.astar = Some(Astar::new(ix, &mut self.layers[ix], s, t, w));
             }
-            if self.flood_state == FloodState::Running && self.flood_turn {
-                let coarse = self.coarse.filter(|_| !self.refining);
-                let (fine_layer, rest) = self.layers.split_at_mut(fine + 1);
-                let fine_layer = &mut fine_layer[fine];
-                let coarse_layer = coarse.map(|ix| &rest[ix - fine - 1]);
-                let flood = self.flood.as_mut().expect("flood");
-                let step = flood.step(fine_layer, map, m, |layer, i| {
-                    if layer.flags[i] & CLOSED != 0 {
-                        return true;
-                    }
-                    coarse_layer.is_some_and(|cl| {
-                        let q = cl.grid.nearest_cell(&layer.grid.center_of(i));
-                        cl.grid.index(q).is_some_and(|j| cl.flags[j] & CLOSED != 0)
-                    })
-                })?;
-                match step {
-                    FloodStep::Expanded => {}
-                    FloodStep::Reached | FloodStep::Met => self.flood_state = FloodState::Stopped,
-                    FloodStep::Exhausted => self.flood_state = FloodState::Exhausted,
-                }
-                self.flood_turn = false;
-                continue;
-            }
             let astar = self.astar.as_mut().expect("astar");
             let ix = astar.layer;
             let step = astar.step(
@@ -961,7 +1056,11 @@ impl RouteSearch {
                 &self.goal,
             )?;
             match step {
-                AstarStep::Expanded => self.flood_turn = true,
+                AstarStep::Expanded => {
+                    if running && m.work >= self.turn_end {
+                        self.pass_turn(m.work);
+                    }
+                }
                 AstarStep::Reached => {
                     let astar = self.astar.take().expect("astar");
                     let t = astar.t.expect("reached target");
@@ -972,10 +1071,9 @@ impl RouteSearch {
                     } else {
                         After::Fine
                     };
-                    self.flood_state = match self.flood_state {
-                        FloodState::Running => FloodState::Stopped,
-                        s => s,
-                    };
+                    if running {
+                        self.sides = Sides::Joined;
+                    }
                     self.reached_target = cause.is_some();
                     let grid = self.layers[ix].grid;
                     let expanded = astar.expanded;
@@ -1006,13 +1104,8 @@ impl RouteSearch {
                         }
                         continue;
                     }
-                    self.rcheck = Some(RCheck {
-                        side: Endpoint::Start,
-                        snap: None,
-                        from: None,
-                        flood: None,
-                        proved: false,
-                    });
+                    // The floods decide: a proof, or no verdict when they meet.
+                    self.astar_exhausted = true;
                 }
                 AstarStep::Cap => {
                     return Ok(RouteProgress::Failed(RouteError::ExpansionCap {
@@ -1195,98 +1288,92 @@ impl RouteSearch {
         }
     }
 
-    /// The checks of a verdict once a side is exhausted on the grid ([`RCheck`]): `None` when
-    /// the over-approximation at the clearance joins the two sides (no verdict), else
-    /// `TooNarrow` or `SealedOff`. The relaxed flood takes every cell whose centre is at least
-    /// `c − h·√3/2` from the obstacles and joins two face neighbours when the centre of their
-    /// shared face is at least `c − h/√2` from the obstacles: every point at least `c` from
-    /// the obstacles lies in such a cell's Voronoi cube, and a path through free space passes
-    /// from cube to cube through shared faces (1-Lipschitz distance: a face point at `c` puts
-    /// the face centre within `h/√2` of it), so an exhausted relaxed flood proves that no path
-    /// keeps `c`, at any resolution (up to the rounding of the distance queries). The cause then
-    /// comes from an exact flood at the radius: `TooNarrow` if it joins the sides (a route
-    /// without the margin exists), `SealedOff` if not (no route at the radius that the grid
-    /// resolves).
-    fn rcheck(
+    /// The levels the floods test cells at ([`Balls`]): down to the relaxed floods'
+    /// `c − h·√3/2` (or the radius, if lower), up to the clearance.
+    fn balls(&self) -> Balls {
+        let h = self.layers[self.fine].grid.h;
+        let c = self.clearance;
+        Balls {
+            low: (c - h * 3.0_f64.sqrt() / 2.0).min(self.radius),
+            high: c,
+        }
+    }
+
+    /// Passes the turn to the next search: the A* (unless it ran dry), the goal-side flood,
+    /// the start-side flood.
+    fn pass_turn(&mut self, work: usize) {
+        self.turn = match self.turn {
+            Turn::Astar => Turn::Goal,
+            Turn::Goal => Turn::Start,
+            Turn::Start if self.astar_exhausted => Turn::Goal,
+            Turn::Start => Turn::Astar,
+        };
+        self.turn_end = work + TURN_UNITS;
+    }
+
+    /// The goal flood's first cell when no cell at the clearance joins the goal: the nearest
+    /// cell at the radius (the old snap rules), `None` if there is none.
+    fn goal_seed(&mut self, map: &StaticMap, m: &mut Meter) -> Result<Option<usize>, Paused> {
+        let fine = self.fine;
+        let mut cur = match std::mem::replace(&mut self.goal_seed, SnapState::NotStarted) {
+            SnapState::Done(r) => {
+                self.goal_seed = SnapState::Done(r);
+                return Ok(r);
+            }
+            SnapState::Running(cur) => cur,
+            SnapState::NotStarted => {
+                let grid = self.layers[fine].grid;
+                let sd = self.sd_target.unwrap_or(f64::NEG_INFINITY);
+                self.snap_cursor(&grid, &self.target, sd, self.radius)
+            }
+        };
+        let r = cur.run(&mut self.layers[fine], map, &self.target, m);
+        self.goal_seed = match r {
+            Ok(cell) => SnapState::Done(cell),
+            Err(Paused) => SnapState::Running(cur),
+        };
+        r
+    }
+
+    /// The cause of a proved verdict: the relaxed flood at the clearance from `side` ran dry,
+    /// which proves that no path keeps `c`. The relaxed flood takes every cell whose centre is
+    /// at least `c − h·√3/2` from the obstacles (less at the outer cells, whose cubes reach
+    /// the bounds) and joins two face neighbours when the centre of their shared face is at
+    /// least `c − h/√2` from them: every point at least `c` from the obstacles lies in such a
+    /// cell's Voronoi cube, and a path through free space passes from cube to cube through
+    /// shared faces (1-Lipschitz distance: a face point at `c` puts the face centre within
+    /// `h/√2` of it), so an exhausted relaxed flood proves that no path keeps `c`, at any
+    /// resolution (up to the rounding of the distance queries). Bounds stamped by balls only
+    /// ever admit a cell or face the query would have admitted. The cause then comes from an
+    /// exact flood at the radius: `TooNarrow` if it joins the sides (a route without the
+    /// margin exists), `SealedOff` if not (no route at the radius that the grid resolves).
+    fn cause_of(
         &mut self,
         map: &StaticMap,
         m: &mut Meter,
-        start_cell: usize,
-        target_cell: Option<usize>,
-    ) -> Result<Option<UnreachableCause>, Paused> {
-        let c = self.clearance;
-        let r = self.radius;
-        let fine = self.fine;
-        let grid = self.layers[fine].grid;
-        let margins: [f64; 3] = std::array::from_fn(|a| grid.origin[a] - map.bounds().min[a]);
-        let narrow = UnreachableCause::TooNarrow { clearance_m: c };
-        let mut rc = self.rcheck.take().expect("rcheck");
-        let res = (|| {
-            let (from, to) = match rc.side {
-                Endpoint::Start => (Some(start_cell), target_cell),
-                Endpoint::Goal => {
-                    let from = match (target_cell, rc.from) {
-                        (Some(t), _) => Some(t),
-                        (None, Some(f)) => f,
-                        (None, None) => {
-                            let sd = self.sd_target.unwrap_or(f64::NEG_INFINITY);
-                            let mut cur = match rc.snap.take() {
-                                Some(cur) => cur,
-                                None => self.snap_cursor(&grid, &self.target, sd, r),
-                            };
-                            let res = cur.run(&mut self.layers[fine], map, &self.target, m);
-                            match res {
-                                Ok(f) => {
-                                    rc.from = Some(f);
-                                    f
-                                }
-                                Err(Paused) => {
-                                    rc.snap = Some(cur);
-                                    return Err(Paused);
-                                }
-                            }
-                        }
-                    };
-                    (from, Some(start_cell))
-                }
-            };
-            let (Some(from), Some(to)) = (from, to) else {
-                return Ok(Some(UnreachableCause::SealedOff));
-            };
-            let layer = &mut self.layers[fine];
-            if !rc.proved {
-                let flood = rc.flood.get_or_insert_with(|| Flood {
-                    margins,
-                    ..Flood::new(layer, from, to, FLOOD_CR, c, false)
-                });
-                loop {
-                    match flood.step(layer, map, m, |_, _| false)? {
-                        FloodStep::Expanded => {}
-                        // A passage the grid cannot resolve may keep the clearance.
-                        FloodStep::Reached | FloodStep::Met => return Ok(None),
-                        FloodStep::Exhausted => break,
-                    }
-                }
-                rc.proved = true;
-                rc.flood = None;
-            }
-            if r >= c {
-                return Ok(Some(UnreachableCause::SealedOff));
-            }
-            let flood = rc
-                .flood
-                .get_or_insert_with(|| Flood::new(layer, from, to, FLOOD_R, r, true));
-            loop {
-                match flood.step(layer, map, m, |_, _| false)? {
-                    FloodStep::Expanded => {}
-                    FloodStep::Reached | FloodStep::Met => return Ok(Some(narrow)),
-                    FloodStep::Exhausted => return Ok(Some(UnreachableCause::SealedOff)),
-                }
-            }
-        })();
-        if res.is_err() {
-            self.rcheck = Some(rc);
+        from: Option<usize>,
+        to: Option<usize>,
+        balls: &Balls,
+    ) -> Result<UnreachableCause, Paused> {
+        let (c, r) = (self.clearance, self.radius);
+        let (Some(from), Some(to)) = (from, to) else {
+            return Ok(UnreachableCause::SealedOff);
+        };
+        if r >= c {
+            return Ok(UnreachableCause::SealedOff);
         }
-        res
+        let layer = &mut self.layers[self.fine];
+        let flood = self
+            .cause_flood
+            .get_or_insert_with(|| Flood::new(layer, from, to, FLOOD_R, r, true));
+        loop {
+            match flood.step(layer, map, m, balls, |_, _| false)? {
+                FloodStep::Expanded => {}
+                FloodStep::Reached | FloodStep::Met => {
+                    return Ok(UnreachableCause::TooNarrow { clearance_m: c });
+                }
+                FloodStep::Exhausted => return Ok(UnreachableCause::SealedOff),
+            }
+        }
     }
 }
