@@ -64,9 +64,9 @@ pub enum UnreachableCause {
         /// The goal's signed distance to the nearest obstacle, in metres (negative inside).
         signed_distance_m: f64,
     },
-    /// No path keeps the inflated clearance (proved, see the crate docs), and the grid finds
-    /// none at the vehicle radius alone either: any remaining opening is narrower than about
-    /// `2·radius + h` (`h` the fine grid's cell size).
+    /// No path keeps the inflated clearance (proved, see the crate docs), and none keeps the
+    /// vehicle radius alone either (proved, or none the fine grid resolves): any remaining
+    /// opening is narrower than about `2·radius + h` (`h` the fine grid's cell size).
     SealedOff,
     /// No path keeps the inflated clearance (proved, see the crate docs), but one keeps the
     /// vehicle radius: the vehicle would have to give up its safety margin to pass.

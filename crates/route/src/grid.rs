@@ -220,22 +220,25 @@ impl PartialOrd for Open {
 }
 
 /// Per-cell flag: the signed distance of the centre is in [`Layer::sd`].
-pub(crate) const EVALUATED: u8 = 1;
+pub(crate) const EVALUATED: u16 = 1;
 /// Per-cell flag: expanded by the A* from the start (closed set).
-pub(crate) const CLOSED: u8 = 2;
+pub(crate) const CLOSED: u16 = 2;
 /// Per-cell flag: the A* from the start holds a tentative cost for it.
-pub(crate) const SEEN: u8 = 4;
+pub(crate) const SEEN: u16 = 4;
 /// Per-cell flag: reached by the relaxed flood at the inflated clearance from the goal.
-pub(crate) const FLOOD_G: u8 = 8;
+pub(crate) const FLOOD_G: u16 = 8;
 /// Per-cell flag: reached by the exact flood at the vehicle radius (the verdict's cause).
-pub(crate) const FLOOD_R: u8 = 16;
+pub(crate) const FLOOD_R: u16 = 16;
 /// Per-cell flag: reached by the relaxed flood at the inflated clearance from the start.
-pub(crate) const FLOOD_S: u8 = 32;
+pub(crate) const FLOOD_S: u16 = 32;
 /// Per-cell flag: [`Layer`]'s stored value is a lower bound on the centre's signed distance
 /// stamped by a free ball ([`Layer::query_stamped`]), not (yet) its evaluated value.
-pub(crate) const BOUND: u8 = 64;
+pub(crate) const BOUND: u16 = 64;
 /// Per-cell flag: an upper bound on the centre's signed distance is stored (a blocked ball).
-pub(crate) const UBOUND: u8 = 128;
+pub(crate) const UBOUND: u16 = 128;
+/// Per-cell flag: reached by the exact flood at the vehicle radius (the verdict's cause when
+/// the relaxed one at the radius joins the sides).
+pub(crate) const FLOOD_X: u16 = 256;
 
 /// Largest radius of a ball of bounds, in cells (a ball stamps at most `(2k + 1)³` cells).
 pub(crate) const MAX_BALL_CELLS: i64 = 10;
@@ -243,8 +246,12 @@ pub(crate) const MAX_BALL_CELLS: i64 = 10;
 /// with `cargo run --release -p trust-route --example route_timing` (see decision 0019).
 pub(crate) const STAMPED_CELLS_PER_UNIT: u32 = 1024;
 
+/// The 26 neighbour offsets of a cell and their lengths in cells (1, √2 or √3), computed once.
+pub(crate) static NEIGHBOUR_STEPS: std::sync::LazyLock<[([i64; 3], f64); 26]> =
+    std::sync::LazyLock::new(neighbour_steps);
+
 /// The 26 neighbour offsets of a cell and their lengths in cells (1, √2 or √3).
-pub(crate) fn neighbour_steps() -> [([i64; 3], f64); 26] {
+fn neighbour_steps() -> [([i64; 3], f64); 26] {
     let mut out = [([0; 3], 0.0); 26];
     let mut n = 0;
     for z in -1..=1_i64 {
@@ -275,7 +282,7 @@ pub(crate) struct Layer {
     ub: Vec<f32>,
     /// [`EVALUATED`], [`CLOSED`], [`SEEN`], [`FLOOD_G`], [`FLOOD_R`], [`FLOOD_S`], [`BOUND`],
     /// [`UBOUND`].
-    pub(crate) flags: Vec<u8>,
+    pub(crate) flags: Vec<u16>,
     /// Slope bound of the map's signed distance ([`ESDF_LIPSCHITZ`] or 1), valid for the
     /// whole map (its shapes and its ESDF alike).
     pub(crate) lipschitz: f64,

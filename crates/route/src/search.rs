@@ -14,8 +14,8 @@ use trust_geometry::StaticMap;
 use crate::Vec3;
 use crate::error::{Endpoint, RouteError, UnreachableCause};
 use crate::grid::{
-    Balls, CLOSED, FLOOD_G, FLOOD_R, FLOOD_S, Grid, Layer, Meter, Open, Paused, SEEN, SIGHT_UNIT_M,
-    neighbour_steps, octile,
+    Balls, CLOSED, FLOOD_G, FLOOD_R, FLOOD_S, FLOOD_X, Grid, Layer, Meter, NEIGHBOUR_STEPS, Open,
+    Paused, SEEN, SIGHT_UNIT_M, octile,
 };
 use crate::params::RouteParams;
 use crate::route::GlobalRoute;
@@ -104,6 +104,9 @@ pub struct RouteSearch {
     fine: usize,
     /// The coarse layer searched first, if any (cleared when its ends do not snap).
     coarse: Option<usize>,
+    /// The layer the relaxed floods try a proof on first ([`VERDICT_COARSENING`] times the
+    /// fine cell), if any; when its floods meet, they start again on the fine layer.
+    verdict_layer: Option<usize>,
     start_snap: Vec<SnapState>,
     target_snap: Vec<SnapState>,
     /// Gradient steps out of the obstacle burying the goal: the point reached and the count.
@@ -129,6 +132,8 @@ pub struct RouteSearch {
     astar_exhausted: bool,
     /// The exact flood at the radius once a side is proved sealed (the verdict's cause).
     cause_flood: Option<Flood>,
+    /// Which of [`RouteSearch::cause_of`]'s floods runs.
+    cause_stage: u8,
     /// Parts of a unit bought and not yet spent ([`Meter::charge_parts`]).
     credit: u32,
     finishing: Option<Finishing>,
@@ -140,16 +145,19 @@ pub struct RouteSearch {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Sides {
     NotStarted,
-    /// Both floods run: `goal` is the goal flood's first cell.
+    /// Both floods run on layer `layer`: `goal` and `start` are their first cells.
     Running {
+        layer: usize,
+        start: usize,
         goal: usize,
     },
     /// The floods met (or the A* reached the goal): no proof to come from them.
     Joined,
     /// The flood from `side` ran dry without meeting the other side: no path keeps the
     /// clearance. `from` is its first cell (`None`: no cell near the goal at all), `to` the
-    /// other side's.
+    /// other side's, both on layer `layer`.
     Proved {
+        layer: usize,
         side: Endpoint,
         from: Option<usize>,
         to: Option<usize>,
@@ -294,7 +302,7 @@ impl Astar {
         max_expansions: usize,
         goal: &Vec3,
     ) -> Result<AstarStep, Paused> {
-        let steps = neighbour_steps();
+        let steps = &*NEIGHBOUR_STEPS;
         let h = layer.grid.h;
         loop {
             if let Some((i, gi, k)) = self.cur {
@@ -375,7 +383,7 @@ impl Astar {
 /// (like a greedy search) when it is.
 #[derive(Debug, Clone)]
 struct Flood {
-    flag: u8,
+    flag: u16,
     level: f64,
     /// Edges must be clear at `level` (a route); `false`: face neighbours within
     /// [`Flood::slack`] of `level` whose shared face may hold a point at `level` join (a relaxed
@@ -400,7 +408,7 @@ impl Flood {
         layer: &mut Layer,
         from: usize,
         target: usize,
-        flag: u8,
+        flag: u16,
         level: f64,
         exact: bool,
     ) -> Self {
@@ -456,7 +464,7 @@ impl Flood {
         met: impl Fn(&Layer, usize) -> bool,
     ) -> Result<FloodStep, Paused> {
         let steps: &[([i64; 3], f64)] = if self.exact {
-            &neighbour_steps()
+            &*NEIGHBOUR_STEPS
         } else {
             &FACE_STEPS
         };
@@ -528,13 +536,19 @@ const FLOOD_EXPANSION_PARTS: u32 = 4;
 /// the goal-side and the start-side relaxed floods take turns).
 const TURN_UNITS: usize = 32;
 
+/// How much coarser than the fine grid the layer is on which the relaxed floods try a proof
+/// first: 8 times fewer cells. The over-approximation stays sound at any cell size; a coarser
+/// one only leaks through thinner walls (walls thinner than about `(2.7·h − 2c)` between
+/// cells of size `h`), and then the floods start again on the fine grid.
+const VERDICT_COARSENING: f64 = 2.0;
+
 /// A relaxed flood at clearance `c` from cell `from` toward cell `to`, flagging `flag`.
 fn relaxed_flood(
     layer: &mut Layer,
     map: &StaticMap,
     from: usize,
     to: usize,
-    flag: u8,
+    flag: u16,
     c: f64,
 ) -> Flood {
     let grid = layer.grid;
@@ -664,6 +678,8 @@ impl RouteSearch {
             turn_end: 0,
             astar_exhausted: false,
             cause_flood: None,
+            cause_stage: 0,
+            verdict_layer: None,
             credit: 0,
             finishing: None,
             coarse_route: None,
@@ -824,6 +840,15 @@ impl RouteSearch {
             (Err(e), _) => return Err(e),
         }
         self.fine = 0;
+        // Cells larger than the clearance leak through walls thinner than 0.7·c: no layer
+        // coarser than that (E4's fine grid, coarsened to fit, is already about c).
+        let vh = self.layers[0].grid.h * VERDICT_COARSENING;
+        if vh <= c * (1.0 + 1e-9)
+            && let Ok(vg) = Grid::new(map.bounds(), vh, p.max_cells, vh)
+        {
+            self.layers.push(Layer::new(vg, map));
+            self.verdict_layer = Some(self.layers.len() - 1);
+        }
         self.start_snap = vec![SnapState::NotStarted; self.layers.len()];
         self.target_snap = vec![SnapState::NotStarted; self.layers.len()];
         self.built = true;
@@ -934,14 +959,22 @@ impl RouteSearch {
                 Some(t) => Some(t),
                 None => self.goal_seed(map, m)?,
             };
-            let layer = &mut self.layers[fine];
             self.sides = match goal {
-                Some(g) => {
-                    self.goal_flood = Some(relaxed_flood(layer, map, g, start_cell, FLOOD_G, c));
-                    self.start_flood = Some(relaxed_flood(layer, map, start_cell, g, FLOOD_S, c));
-                    Sides::Running { goal: g }
-                }
+                Some(g) => match self.verdict_layer {
+                    Some(v) => {
+                        // The cells holding the fine ends' centres (which keep the clearance)
+                        // are in the relaxed free space of the coarser layer.
+                        let (fg, vg) = (self.layers[fine].grid, self.layers[v].grid);
+                        let at = |i: usize| vg.index(vg.nearest_cell(&fg.center_of(i)));
+                        match (at(start_cell), at(g)) {
+                            (Some(vs), Some(vgoal)) => self.start_floods(map, v, vs, vgoal),
+                            _ => self.start_floods(map, fine, start_cell, g),
+                        }
+                    }
+                    None => self.start_floods(map, fine, start_cell, g),
+                },
                 None => Sides::Proved {
+                    layer: fine,
                     side: Endpoint::Goal,
                     from: None,
                     to: Some(start_cell),
@@ -949,7 +982,6 @@ impl RouteSearch {
             };
             self.turn_end = m.work + TURN_UNITS;
         }
-        let balls = self.balls();
         loop {
             if let Some(f) = &mut self.finishing {
                 f.run(map, c, m)?;
@@ -959,10 +991,28 @@ impl RouteSearch {
                 }
                 continue;
             }
-            if let Sides::Proved { from, to, .. } = self.sides {
+            if let Sides::Proved {
+                layer,
+                side,
+                from,
+                to,
+            } = self.sides
+            {
                 let verdict = match cause {
                     Some(cause) => cause,
-                    None => self.cause_of(map, m, from, to, &balls)?,
+                    None => {
+                        // The same ends on the fine layer, for the cause's later stages.
+                        let goal = match target_cell {
+                            Some(t) => Some(t),
+                            None => self.goal_seed(map, m)?,
+                        };
+                        let fine_ends = match (side, goal) {
+                            (Endpoint::Start, g) => (start_cell, g),
+                            (Endpoint::Goal, Some(g)) => (g, Some(start_cell)),
+                            (Endpoint::Goal, None) => (start_cell, None),
+                        };
+                        self.cause_of(map, m, layer, (from, to), fine_ends)?
+                    }
                 };
                 self.sides = Sides::Joined;
                 if let Some(answer) = self.verdict(verdict) {
@@ -990,15 +1040,31 @@ impl RouteSearch {
             } else if self.turn == Turn::Astar && self.astar_exhausted {
                 self.pass_turn(m.work);
             }
-            if let (Sides::Running { goal }, Turn::Goal | Turn::Start) = (self.sides, self.turn) {
-                let coarse = self.coarse.filter(|_| !self.refining);
-                let (fine_layer, rest) = self.layers.split_at_mut(fine + 1);
-                let fine_layer = &mut fine_layer[fine];
-                let coarse_layer = coarse.map(|ix| &rest[ix - fine - 1]);
+            if let (
+                Sides::Running {
+                    layer: ix,
+                    start,
+                    goal,
+                },
+                Turn::Goal | Turn::Start,
+            ) = (self.sides, self.turn)
+            {
+                let balls = self.balls(ix);
+                let coarse = self.coarse.filter(|_| !self.refining && ix == fine);
+                let (low, high) = self.layers.split_at_mut(ix + 1);
+                let layer = &mut low[ix];
+                let coarse_layer = coarse.map(|cx| &high[cx - ix - 1]);
                 let (side, step) = if self.turn == Turn::Goal {
                     let flood = self.goal_flood.as_mut().expect("goal flood");
-                    let step = flood.step(fine_layer, map, m, &balls, |layer, i| {
-                        if layer.flags[i] & (CLOSED | FLOOD_S) != 0 {
+                    let step = flood.step(layer, map, m, &balls, |layer, i| {
+                        // The start side's cells; on the fine layer also the A*'s (reached
+                        // from the start at the clearance).
+                        let closed = if ix == fine {
+                            CLOSED | FLOOD_S
+                        } else {
+                            FLOOD_S
+                        };
+                        if layer.flags[i] & closed != 0 {
                             return true;
                         }
                         coarse_layer.is_some_and(|cl| {
@@ -1006,13 +1072,13 @@ impl RouteSearch {
                             cl.grid.index(q).is_some_and(|j| cl.flags[j] & CLOSED != 0)
                         })
                     })?;
-                    ((Endpoint::Goal, goal, start_cell), step)
+                    ((Endpoint::Goal, goal, start), step)
                 } else {
                     let flood = self.start_flood.as_mut().expect("start flood");
-                    let step = flood.step(fine_layer, map, m, &balls, |layer, i| {
+                    let step = flood.step(layer, map, m, &balls, |layer, i| {
                         layer.flags[i] & FLOOD_G != 0
                     })?;
-                    ((Endpoint::Start, start_cell, goal), step)
+                    ((Endpoint::Start, start, goal), step)
                 };
                 match step {
                     FloodStep::Expanded => {
@@ -1020,10 +1086,22 @@ impl RouteSearch {
                             self.pass_turn(m.work);
                         }
                     }
+                    // The coarser layer could not separate the sides: try the fine one.
+                    FloodStep::Reached | FloodStep::Met if ix != fine => {
+                        let g = match target_cell {
+                            Some(t) => Some(t),
+                            None => self.goal_seed(map, m)?,
+                        };
+                        self.sides = match g {
+                            Some(g) => self.start_floods(map, fine, start_cell, g),
+                            None => Sides::Joined,
+                        };
+                    }
                     FloodStep::Reached | FloodStep::Met => self.sides = Sides::Joined,
                     FloodStep::Exhausted => {
                         let (side, from, to) = side;
                         self.sides = Sides::Proved {
+                            layer: ix,
                             side,
                             from: Some(from),
                             to: Some(to),
@@ -1290,12 +1368,26 @@ impl RouteSearch {
 
     /// The levels the floods test cells at ([`Balls`]): down to the relaxed floods'
     /// `c − h·√3/2` (or the radius, if lower), up to the clearance.
-    fn balls(&self) -> Balls {
-        let h = self.layers[self.fine].grid.h;
+    fn balls(&self, layer: usize) -> Balls {
+        let h = self.layers[layer].grid.h;
         let c = self.clearance;
         Balls {
-            low: (c - h * 3.0_f64.sqrt() / 2.0).min(self.radius),
+            low: c.min(self.radius) - h * 3.0_f64.sqrt() / 2.0,
             high: c,
+        }
+    }
+
+    /// Starts the two relaxed floods at the clearance on layer `ix`, from cells `start` and
+    /// `goal` of that layer.
+    fn start_floods(&mut self, map: &StaticMap, ix: usize, start: usize, goal: usize) -> Sides {
+        let c = self.clearance;
+        let layer = &mut self.layers[ix];
+        self.goal_flood = Some(relaxed_flood(layer, map, goal, start, FLOOD_G, c));
+        self.start_flood = Some(relaxed_flood(layer, map, start, goal, FLOOD_S, c));
+        Sides::Running {
+            layer: ix,
+            start,
+            goal,
         }
     }
 
@@ -1335,25 +1427,27 @@ impl RouteSearch {
         r
     }
 
-    /// The cause of a proved verdict: the relaxed flood at the clearance from `side` ran dry,
-    /// which proves that no path keeps `c`. The relaxed flood takes every cell whose centre is
-    /// at least `c − h·√3/2` from the obstacles (less at the outer cells, whose cubes reach
-    /// the bounds) and joins two face neighbours when the centre of their shared face is at
-    /// least `c − h/√2` from them: every point at least `c` from the obstacles lies in such a
-    /// cell's Voronoi cube, and a path through free space passes from cube to cube through
-    /// shared faces (1-Lipschitz distance: a face point at `c` puts the face centre within
-    /// `h/√2` of it), so an exhausted relaxed flood proves that no path keeps `c`, at any
+    /// The cause of a proved verdict: the relaxed flood at the clearance from `side` ran dry
+    /// on layer `ix`, which proves that no path keeps `c`. The relaxed flood takes every cell
+    /// whose centre is at least `c − h·√3/2` from the obstacles (less at the outer cells, whose
+    /// cubes reach the bounds) and joins two face neighbours when the centre of their shared
+    /// face is at least `c − h/√2` from them: every point at least `c` from the obstacles lies
+    /// in such a cell's Voronoi cube, and a path through free space passes from cube to cube
+    /// through shared faces (1-Lipschitz distance: a face point at `c` puts the face centre
+    /// within `h/√2` of it), so an exhausted relaxed flood proves that no path keeps `c`, at any
     /// resolution (up to the rounding of the distance queries). Bounds stamped by balls only
-    /// ever admit a cell or face the query would have admitted. The cause then comes from an
-    /// exact flood at the radius: `TooNarrow` if it joins the sides (a route without the
-    /// margin exists), `SealedOff` if not (no route at the radius that the grid resolves).
+    /// ever admit a cell or face the query would have admitted. The cause then comes from the
+    /// same relaxed flood at the radius (on the proof's layer, then on the fine one):
+    /// `SealedOff` if it runs dry (proved: no path keeps the radius); else from an exact flood
+    /// at the radius on the fine layer: `TooNarrow` if it joins the sides (a path keeping the
+    /// radius exists), `SealedOff` if not (none that the fine grid resolves).
     fn cause_of(
         &mut self,
         map: &StaticMap,
         m: &mut Meter,
-        from: Option<usize>,
-        to: Option<usize>,
-        balls: &Balls,
+        ix: usize,
+        (from, to): (Option<usize>, Option<usize>),
+        (ffrom, fto): (usize, Option<usize>),
     ) -> Result<UnreachableCause, Paused> {
         let (c, r) = (self.clearance, self.radius);
         let (Some(from), Some(to)) = (from, to) else {
@@ -1362,18 +1456,48 @@ impl RouteSearch {
         if r >= c {
             return Ok(UnreachableCause::SealedOff);
         }
-        let layer = &mut self.layers[self.fine];
-        let flood = self
-            .cause_flood
-            .get_or_insert_with(|| Flood::new(layer, from, to, FLOOD_R, r, true));
+        let fine = self.fine;
+        let Some(fto) = fto else {
+            return Ok(UnreachableCause::SealedOff);
+        };
         loop {
-            match flood.step(layer, map, m, balls, |_, _| false)? {
-                FloodStep::Expanded => {}
-                FloodStep::Reached | FloodStep::Met => {
-                    return Ok(UnreachableCause::TooNarrow { clearance_m: c });
+            // Stages: the relaxed flood at the radius on the proof's layer, then on the fine
+            // layer (if another), then the exact flood at the radius on the fine layer.
+            let stage = self.cause_stage;
+            let (lx, exact) = match stage {
+                0 => (ix, false),
+                1 if ix != fine => (fine, false),
+                1 => {
+                    self.cause_stage = 2;
+                    continue;
                 }
-                FloodStep::Exhausted => return Ok(UnreachableCause::SealedOff),
+                _ => (fine, true),
+            };
+            let (a, b) = if lx == ix { (from, to) } else { (ffrom, fto) };
+            let balls = self.balls(lx);
+            let layer = &mut self.layers[lx];
+            let flood = self.cause_flood.get_or_insert_with(|| {
+                if exact {
+                    Flood::new(layer, a, b, FLOOD_X, r, true)
+                } else {
+                    relaxed_flood(layer, map, a, b, FLOOD_R, r)
+                }
+            });
+            let joined = loop {
+                match flood.step(layer, map, m, &balls, |_, _| false)? {
+                    FloodStep::Expanded => {}
+                    FloodStep::Reached | FloodStep::Met => break true,
+                    FloodStep::Exhausted => break false,
+                }
+            };
+            self.cause_flood = None;
+            if !joined {
+                return Ok(UnreachableCause::SealedOff);
             }
+            if exact {
+                return Ok(UnreachableCause::TooNarrow { clearance_m: c });
+            }
+            self.cause_stage = stage + 1;
         }
     }
 }
