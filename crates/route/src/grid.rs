@@ -87,6 +87,9 @@ pub(crate) const PARTS_PER_UNIT: u32 = 64;
 /// Metres of a line-of-sight query charged as one more unit ([`Meter::charge_sight`]).
 pub(crate) const SIGHT_UNIT_M: f64 = 2.0;
 
+/// Cells per side of a storage brick ([`Grid::index`]).
+const BRICK: usize = 4;
+
 /// The grid the search runs on: cell centres `origin + h · (i, j, k)`, all inside the bounds.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Grid {
@@ -142,23 +145,61 @@ impl Grid {
         Ok(Self { origin, h, dims })
     }
 
+    /// Bricks per axis ([`BRICK`] cells a side, the last ones padded).
+    fn bricks(&self) -> [usize; 3] {
+        self.dims.map(|d| d.div_ceil(BRICK))
+    }
+
+    /// Length of the per-cell arrays: the cells in bricks of `BRICK³` (the padding cells at
+    /// the far faces are never indexed).
     pub(crate) fn len(&self) -> usize {
+        self.bricks().iter().product::<usize>() * BRICK * BRICK * BRICK
+    }
+
+    /// The number of cells.
+    pub(crate) fn cells(&self) -> usize {
         self.dims[0] * self.dims[1] * self.dims[2]
     }
 
+    /// The index of every cell (not the padding).
+    #[cfg(test)]
+    pub(crate) fn indices(&self) -> impl Iterator<Item = usize> + '_ {
+        let [nx, ny, nz] = self.dims.map(|d| d as i64);
+        (0..nz).flat_map(move |z| {
+            (0..ny).flat_map(move |y| (0..nx).filter_map(move |x| self.index([x, y, z])))
+        })
+    }
+
+    /// Cells are stored brick by brick (`BRICK³` cells each, x fastest within a brick and
+    /// across bricks): a cell's face neighbours mostly share its brick, so a flood or an A*
+    /// touches a few cache lines per expansion where a row-major layout touched one per
+    /// neighbour in y and z.
     pub(crate) fn index(&self, c: [i64; 3]) -> Option<usize> {
         if (0..3).all(|a| c[a] >= 0 && (c[a] as usize) < self.dims[a]) {
-            Some(c[0] as usize + self.dims[0] * (c[1] as usize + self.dims[1] * c[2] as usize))
+            let [x, y, z] = c.map(|v| v as usize);
+            let nb = self.bricks();
+            let brick = x / BRICK + nb[0] * (y / BRICK + nb[1] * (z / BRICK));
+            let local = x % BRICK + BRICK * (y % BRICK + BRICK * (z % BRICK));
+            Some(brick * BRICK * BRICK * BRICK + local)
         } else {
             None
         }
     }
 
     pub(crate) fn coords(&self, i: usize) -> [i64; 3] {
-        let x = i % self.dims[0];
-        let y = (i / self.dims[0]) % self.dims[1];
-        let z = i / (self.dims[0] * self.dims[1]);
-        [x as i64, y as i64, z as i64]
+        let nb = self.bricks();
+        let (brick, local) = (i / (BRICK * BRICK * BRICK), i % (BRICK * BRICK * BRICK));
+        let b = [
+            brick % nb[0],
+            (brick / nb[0]) % nb[1],
+            brick / (nb[0] * nb[1]),
+        ];
+        let l = [
+            local % BRICK,
+            (local / BRICK) % BRICK,
+            local / (BRICK * BRICK),
+        ];
+        [0, 1, 2].map(|a| (b[a] * BRICK + l[a]) as i64)
     }
 
     pub(crate) fn center(&self, c: [i64; 3]) -> Vec3 {
@@ -559,7 +600,7 @@ mod tests {
     fn grid_coarsens_to_fit_the_cap_and_errors_past_the_coarsening_bound() {
         let b = Aabb::new(Vec3::zeros(), Vec3::new(100.0, 100.0, 10.0)).unwrap();
         let g = Grid::new(&b, 0.1, 1000, 100.0).unwrap();
-        assert!(g.len() <= 1000);
+        assert!(g.cells() <= 1000);
         assert!(g.h > 0.1);
         let e = Grid::new(&b, 0.1, 1000, 0.2).unwrap_err();
         assert!(
@@ -635,9 +676,10 @@ mod tests {
             let mut layer = Layer::new(grid, &map);
             let balls = Balls { low, high: low + span };
             let mut m = Meter { work: 0, limit: usize::MAX, prepaid: 0, credit: 0 };
-            let n = grid.len();
+            let cells: Vec<usize> = grid.indices().collect();
+            let n = cells.len();
             let levels = [low, low + 0.5 * span, low + span];
-            for (step, i) in (0..n).map(|k| (k * stride * 7919) % n).enumerate() {
+            for (step, i) in (0..n).map(|k| cells[(k * stride * 7919) % n]).enumerate() {
                 let level = levels[step % 3];
                 let truth = map.signed_distance(&grid.center_of(i));
                 let said = layer.at_least(&map, i, level, &balls, &mut m).unwrap();
@@ -649,6 +691,20 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn bricks_index_every_cell_once_and_round_trip() {
+        let b = Aabb::new(Vec3::zeros(), Vec3::new(1.3, 0.7, 0.9)).unwrap();
+        let g = Grid::new(&b, 0.1, 1_000_000, 0.1).unwrap();
+        let mut seen = vec![false; g.len()];
+        for i in g.indices() {
+            assert!(!seen[i], "cell {i} twice");
+            seen[i] = true;
+            assert_eq!(g.index(g.coords(i)), Some(i));
+        }
+        assert_eq!(seen.iter().filter(|&&v| v).count(), g.cells());
+        assert_eq!(g.index([g.dims[0] as i64, 0, 0]), None);
     }
 
     #[test]
@@ -670,13 +726,13 @@ mod tests {
             credit: 0,
         };
         let mut queries = 0;
-        for i in 0..grid.len() {
+        for i in grid.indices() {
             let before = layer.flags[i] & (EVALUATED | BOUND);
             let free = layer.at_least(&map, i, 0.4, &balls, &mut m).unwrap();
             queries += usize::from(before == 0);
             assert_eq!(free, map.signed_distance(&grid.center_of(i)) >= 0.4);
         }
-        assert!(queries * 20 < grid.len(), "{queries} of {}", grid.len());
+        assert!(queries * 20 < grid.cells(), "{queries} of {}", grid.cells());
     }
 
     #[test]
@@ -692,7 +748,8 @@ mod tests {
             prepaid: 0,
             credit: 0,
         };
-        for i in (0..layer.grid.len()).step_by(97) {
+        let grid = layer.grid;
+        for i in grid.indices().step_by(97) {
             let d = layer.sd(&map, i, &mut m).unwrap();
             assert!(d <= map.signed_distance(&layer.grid.center_of(i)));
         }

@@ -7,7 +7,7 @@
 //! Cached signed distances make a retry free of charge. Hence the sequence of queries, and the
 //! result, do not depend on how the work is sliced.
 
-use std::collections::BinaryHeap;
+use std::collections::{BinaryHeap, VecDeque};
 
 use trust_geometry::StaticMap;
 
@@ -378,9 +378,9 @@ impl Astar {
     }
 }
 
-/// A best-first flood over the cells at least `level` from the obstacles, from one cell toward
-/// another: it visits the whole component when the other cell is not in it, and heads for it
-/// (like a greedy search) when it is.
+/// A breadth-first flood over the cells at least `level` from the obstacles, from one cell
+/// toward another: it visits the whole component when the other cell is not in it, and stops
+/// when it reaches that cell (or meets the other side's search).
 #[derive(Debug, Clone)]
 struct Flood {
     flag: u16,
@@ -392,8 +392,50 @@ struct Flood {
     /// For a relaxed flood: the distance from the bounds to the outer cell centres per axis.
     margins: [f64; 3],
     target: usize,
-    open: BinaryHeap<Open>,
+    open: Queue,
     cur: Option<(usize, usize)>,
+}
+
+/// A flood's cells to expand.
+#[derive(Debug, Clone)]
+enum Queue {
+    /// First in, first out: for the proofs, whose order does not matter; O(1) where a heap
+    /// over a large frontier misses the caches.
+    Fifo(VecDeque<u32>),
+    /// Nearest to the target first: for a flood expected to leak toward the other side (the
+    /// cause's), which then heads there instead of filling the world.
+    Greedy(BinaryHeap<Open>),
+}
+
+impl Queue {
+    fn push(&mut self, cell: usize, grid: &Grid, target: usize) {
+        match self {
+            Self::Fifo(q) => q.push_back(cell as u32),
+            Self::Greedy(h) => h.push(Open {
+                f: octile(grid.coords(cell), grid.coords(target), 1.0),
+                g: 0.0,
+                cell: cell as u32,
+            }),
+        }
+    }
+
+    fn front(&self) -> Option<usize> {
+        match self {
+            Self::Fifo(q) => q.front().map(|&c| c as usize),
+            Self::Greedy(h) => h.peek().map(|o| o.cell as usize),
+        }
+    }
+
+    fn pop(&mut self) {
+        match self {
+            Self::Fifo(q) => {
+                q.pop_front();
+            }
+            Self::Greedy(h) => {
+                h.pop();
+            }
+        }
+    }
 }
 
 enum FloodStep {
@@ -411,14 +453,15 @@ impl Flood {
         flag: u16,
         level: f64,
         exact: bool,
+        greedy: bool,
     ) -> Self {
         layer.flags[from] |= flag;
-        let mut open = BinaryHeap::new();
-        open.push(Open {
-            f: octile(layer.grid.coords(from), layer.grid.coords(target), 1.0),
-            g: 0.0,
-            cell: from as u32,
-        });
+        let mut open = if greedy {
+            Queue::Greedy(BinaryHeap::new())
+        } else {
+            Queue::Fifo(VecDeque::new())
+        };
+        open.push(from, &layer.grid, target);
         Self {
             flag,
             level,
@@ -486,19 +529,14 @@ impl Flood {
                     })
                 {
                     layer.flags[j] |= self.flag;
-                    self.open.push(Open {
-                        f: octile(layer.grid.coords(j), layer.grid.coords(self.target), 1.0),
-                        g: 0.0,
-                        cell: j as u32,
-                    });
+                    self.open.push(j, &layer.grid, self.target);
                 }
                 self.cur = Some((i, k + 1));
                 continue;
             }
-            let Some(&top) = self.open.peek() else {
+            let Some(i) = self.open.front() else {
                 return Ok(FloodStep::Exhausted);
             };
-            let i = top.cell as usize;
             if i == self.target {
                 return Ok(FloodStep::Reached);
             }
@@ -530,7 +568,7 @@ const FACE_STEPS: [([i64; 3], f64); 6] = [
 /// (six neighbours whose bounds are mostly known); an exact flood's (26 neighbours and their
 /// edges) is charged twice that. Measured with `cargo run --release -p trust-route --example
 /// route_timing` (decision 0019).
-const FLOOD_EXPANSION_PARTS: u32 = 4;
+const FLOOD_EXPANSION_PARTS: u32 = 16;
 
 /// Units of work a search keeps the turn for before the next one's ([`RouteSearch`]: the A*,
 /// the goal-side and the start-side relaxed floods take turns).
@@ -550,12 +588,13 @@ fn relaxed_flood(
     to: usize,
     flag: u16,
     c: f64,
+    greedy: bool,
 ) -> Flood {
     let grid = layer.grid;
     let margins: [f64; 3] = std::array::from_fn(|a| grid.origin[a] - map.bounds().min[a]);
     Flood {
         margins,
-        ..Flood::new(layer, from, to, flag, c, false)
+        ..Flood::new(layer, from, to, flag, c, false, greedy)
     }
 }
 
@@ -866,7 +905,7 @@ impl RouteSearch {
         let g = &self.layers[self.fine].grid;
         self.coarse.is_some()
             && g.h == self.h0(map)
-            && g.len() <= p.refine_max_cells.min(p.max_cells)
+            && g.cells() <= p.refine_max_cells.min(p.max_cells)
     }
 
     /// The whole search as a function of its memoised state: returns the answer, or `Paused`.
@@ -1011,7 +1050,7 @@ impl RouteSearch {
                             (Endpoint::Goal, Some(g)) => (g, Some(start_cell)),
                             (Endpoint::Goal, None) => (start_cell, None),
                         };
-                        self.cause_of(map, m, layer, (from, to), fine_ends)?
+                        self.cause_of(map, m, layer, side, (from, to), fine_ends)?
                     }
                 };
                 self.sides = Sides::Joined;
@@ -1037,7 +1076,10 @@ impl RouteSearch {
             }
             if !running {
                 self.turn = Turn::Astar;
-            } else if self.turn == Turn::Astar && self.astar_exhausted {
+            } else if (self.turn == Turn::Astar && self.astar_exhausted)
+                || (self.turn == Turn::Start && self.start_flood.is_none())
+            {
+                // The A* ran dry, or the start side's flood is not (or no longer) running.
                 self.pass_turn(m.work);
             }
             if let (
@@ -1182,8 +1224,17 @@ impl RouteSearch {
                         }
                         continue;
                     }
-                    // The floods decide: a proof, or no verdict when they meet.
+                    // The floods decide: a proof, or no verdict when they meet. The start side's
+                    // flood on the fine layer starts now.
                     self.astar_exhausted = true;
+                    if let Sides::Running { layer, start, goal } = self.sides
+                        && layer == fine
+                        && self.start_flood.is_none()
+                    {
+                        let l = &mut self.layers[fine];
+                        self.start_flood =
+                            Some(relaxed_flood(l, map, start, goal, FLOOD_S, c, false));
+                    }
                 }
                 AstarStep::Cap => {
                     return Ok(RouteProgress::Failed(RouteError::ExpansionCap {
@@ -1377,13 +1428,17 @@ impl RouteSearch {
         }
     }
 
-    /// Starts the two relaxed floods at the clearance on layer `ix`, from cells `start` and
-    /// `goal` of that layer.
+    /// Starts the relaxed floods at the clearance on layer `ix`, from cells `start` and `goal`
+    /// of that layer. On the coarser verdict layer both run beside the A* (a cheap screen);
+    /// on the fine layer only the goal side's does, the start side's once the A* (which
+    /// explores the start's side at the clearance) has run dry: in the common case, a goal
+    /// that can be reached, a fine start-side flood would only slow the A* down.
     fn start_floods(&mut self, map: &StaticMap, ix: usize, start: usize, goal: usize) -> Sides {
         let c = self.clearance;
+        let both = ix != self.fine || self.astar_exhausted;
         let layer = &mut self.layers[ix];
-        self.goal_flood = Some(relaxed_flood(layer, map, goal, start, FLOOD_G, c));
-        self.start_flood = Some(relaxed_flood(layer, map, start, goal, FLOOD_S, c));
+        self.goal_flood = Some(relaxed_flood(layer, map, goal, start, FLOOD_G, c, false));
+        self.start_flood = both.then(|| relaxed_flood(layer, map, start, goal, FLOOD_S, c, false));
         Sides::Running {
             layer: ix,
             start,
@@ -1392,13 +1447,14 @@ impl RouteSearch {
     }
 
     /// Passes the turn to the next search: the A* (unless it ran dry), the goal-side flood,
-    /// the start-side flood.
+    /// the start-side flood (if it runs).
     fn pass_turn(&mut self, work: usize) {
+        let start = self.start_flood.is_some();
         self.turn = match self.turn {
             Turn::Astar => Turn::Goal,
-            Turn::Goal => Turn::Start,
-            Turn::Start if self.astar_exhausted => Turn::Goal,
-            Turn::Start => Turn::Astar,
+            Turn::Goal if start => Turn::Start,
+            Turn::Goal | Turn::Start if self.astar_exhausted => Turn::Goal,
+            Turn::Goal | Turn::Start => Turn::Astar,
         };
         self.turn_end = work + TURN_UNITS;
     }
@@ -1446,6 +1502,7 @@ impl RouteSearch {
         map: &StaticMap,
         m: &mut Meter,
         ix: usize,
+        side: Endpoint,
         (from, to): (Option<usize>, Option<usize>),
         (ffrom, fto): (usize, Option<usize>),
     ) -> Result<UnreachableCause, Paused> {
@@ -1478,13 +1535,25 @@ impl RouteSearch {
             let layer = &mut self.layers[lx];
             let flood = self.cause_flood.get_or_insert_with(|| {
                 if exact {
-                    Flood::new(layer, a, b, FLOOD_X, r, true)
+                    Flood::new(layer, a, b, FLOOD_X, r, true, true)
                 } else {
-                    relaxed_flood(layer, map, a, b, FLOOD_R, r)
+                    relaxed_flood(layer, map, a, b, FLOOD_R, r, true)
                 }
             });
+            // Cells known to be joined to the other side: its flood's (a relaxed flood at
+            // the clearance joins no fewer cells than one at the radius), and on the fine
+            // layer the A*'s, joined to the start by edges that keep the clearance.
+            let other = match (side, exact) {
+                (Endpoint::Goal, false) => FLOOD_S,
+                (Endpoint::Start, false) => FLOOD_G,
+                (_, true) => 0,
+            } | if lx == fine && side == Endpoint::Goal {
+                CLOSED
+            } else {
+                0
+            };
             let joined = loop {
-                match flood.step(layer, map, m, &balls, |_, _| false)? {
+                match flood.step(layer, map, m, &balls, |l, i| l.flags[i] & other != 0)? {
                     FloodStep::Expanded => {}
                     FloodStep::Reached | FloodStep::Met => break true,
                     FloodStep::Exhausted => break false,
