@@ -1228,10 +1228,9 @@ impl RouteSearch {
                     // flood on the fine layer starts now.
                     self.astar_exhausted = true;
                     if let Sides::Running { layer, start, goal } = self.sides
-                        && layer == fine
                         && self.start_flood.is_none()
                     {
-                        let l = &mut self.layers[fine];
+                        let l = &mut self.layers[layer];
                         self.start_flood =
                             Some(relaxed_flood(l, map, start, goal, FLOOD_S, c, false));
                     }
@@ -1435,7 +1434,7 @@ impl RouteSearch {
     /// that can be reached, a fine start-side flood would only slow the A* down.
     fn start_floods(&mut self, map: &StaticMap, ix: usize, start: usize, goal: usize) -> Sides {
         let c = self.clearance;
-        let both = ix != self.fine || self.astar_exhausted;
+        let both = self.astar_exhausted;
         let layer = &mut self.layers[ix];
         self.goal_flood = Some(relaxed_flood(layer, map, goal, start, FLOOD_G, c, false));
         self.start_flood = both.then(|| relaxed_flood(layer, map, start, goal, FLOOD_S, c, false));
