@@ -130,6 +130,10 @@ pub struct RouteSearch {
     turn_end: usize,
     /// The A* on the fine grid ran dry (the floods go on alone).
     astar_exhausted: bool,
+    /// The floods met on the coarser verdict layer: a proof on the fine one is unlikely (walls
+    /// thinner than that layer resolves), so the fine goal-side flood gets shorter turns
+    /// ([`UNLIKELY_TURN_UNITS`]) and the A* most of the work.
+    unlikely: bool,
     /// The exact flood at the radius once a side is proved sealed (the verdict's cause).
     cause_flood: Option<Flood>,
     /// Which of [`RouteSearch::cause_of`]'s floods runs.
@@ -574,6 +578,10 @@ const FLOOD_EXPANSION_PARTS: u32 = 16;
 /// the goal-side and the start-side relaxed floods take turns).
 const TURN_UNITS: usize = 32;
 
+/// A flood's turn once a proof has become unlikely ([`RouteSearch`]'s `unlikely`): the A*
+/// then gets four fifths of the work.
+const UNLIKELY_TURN_UNITS: usize = 8;
+
 /// How much coarser than the fine grid the layer is on which the relaxed floods try a proof
 /// first: 8 times fewer cells. The over-approximation stays sound at any cell size; a coarser
 /// one only leaks through thinner walls (walls thinner than about `(2.7·h − 2c)` between
@@ -716,6 +724,7 @@ impl RouteSearch {
             turn: Turn::Astar,
             turn_end: 0,
             astar_exhausted: false,
+            unlikely: false,
             cause_flood: None,
             cause_stage: 0,
             verdict_layer: None,
@@ -1092,15 +1101,24 @@ impl RouteSearch {
             ) = (self.sides, self.turn)
             {
                 let balls = self.balls(ix);
-                let coarse = self.coarse.filter(|_| !self.refining && ix == fine);
-                let (low, high) = self.layers.split_at_mut(ix + 1);
-                let layer = &mut low[ix];
-                let coarse_layer = coarse.map(|cx| &high[cx - ix - 1]);
+                let coarse = self.coarse.filter(|_| !self.refining);
+                // The flood's layer, and the A*'s layers (fine, coarse) to read from.
+                let (mut layer, mut fine_l, mut coarse_l) = (None, None, None);
+                for (k, l) in self.layers.iter_mut().enumerate() {
+                    if k == ix {
+                        layer = Some(l);
+                    } else if k == fine {
+                        fine_l = Some(&*l);
+                    } else if Some(k) == coarse {
+                        coarse_l = Some(&*l);
+                    }
+                }
+                let layer = layer.expect("the flood's layer");
                 let (side, step) = if self.turn == Turn::Goal {
                     let flood = self.goal_flood.as_mut().expect("goal flood");
                     let step = flood.step(layer, map, m, &balls, |layer, i| {
-                        // The start side's cells; on the fine layer also the A*'s (reached
-                        // from the start at the clearance).
+                        // The start side's cells, and the A*'s (reached from the start at the
+                        // clearance) on its layers: no proof to come from this side.
                         let closed = if ix == fine {
                             CLOSED | FLOOD_S
                         } else {
@@ -1109,9 +1127,10 @@ impl RouteSearch {
                         if layer.flags[i] & closed != 0 {
                             return true;
                         }
-                        coarse_layer.is_some_and(|cl| {
-                            let q = cl.grid.nearest_cell(&layer.grid.center_of(i));
-                            cl.grid.index(q).is_some_and(|j| cl.flags[j] & CLOSED != 0)
+                        let p = layer.grid.center_of(i);
+                        [fine_l, coarse_l].into_iter().flatten().any(|al| {
+                            let q = al.grid.nearest_cell(&p);
+                            al.grid.index(q).is_some_and(|j| al.flags[j] & CLOSED != 0)
                         })
                     })?;
                     ((Endpoint::Goal, goal, start), step)
@@ -1134,6 +1153,7 @@ impl RouteSearch {
                             Some(t) => Some(t),
                             None => self.goal_seed(map, m)?,
                         };
+                        self.unlikely = true;
                         self.sides = match g {
                             Some(g) => self.start_floods(map, fine, start_cell, g),
                             None => Sides::Joined,
@@ -1455,7 +1475,13 @@ impl RouteSearch {
             Turn::Goal | Turn::Start if self.astar_exhausted => Turn::Goal,
             Turn::Goal | Turn::Start => Turn::Astar,
         };
-        self.turn_end = work + TURN_UNITS;
+        let short = self.unlikely && self.turn != Turn::Astar && !self.astar_exhausted;
+        self.turn_end = work
+            + if short {
+                UNLIKELY_TURN_UNITS
+            } else {
+                TURN_UNITS
+            };
     }
 
     /// The goal flood's first cell when no cell at the clearance joins the goal: the nearest
