@@ -961,3 +961,81 @@ proptest! {
         prop_assert_eq!(sliced.work_done(), whole.work_done());
     }
 }
+
+/// A box around `centre` (outer half-size `half`, walls `t` thick) with a square hole of side
+/// `hole` in its +x wall (none when `hole` is 0).
+fn box_with_hole(centre: Vec3, half: f64, t: f64, hole: f64) -> Vec<Shape> {
+    let (lo, hi) = (centre - Vec3::repeat(half), centre + Vec3::repeat(half));
+    let mut out: Vec<Shape> = Vec::new();
+    for a in 0..3 {
+        for side in [false, true] {
+            let (mut min, mut max) = (lo, hi);
+            if side {
+                min[a] = hi[a] - t;
+            } else {
+                max[a] = lo[a] + t;
+            }
+            if a == 0 && side && hole > 0.0 {
+                // The +x wall in four pieces around the hole.
+                let (y0, y1) = (centre.y - hole / 2.0, centre.y + hole / 2.0);
+                let (z0, z1) = (centre.z - hole / 2.0, centre.z + hole / 2.0);
+                for (ylo, yhi, zlo, zhi) in [
+                    (min.y, y0, min.z, max.z),
+                    (y1, max.y, min.z, max.z),
+                    (y0, y1, min.z, z0),
+                    (y0, y1, z1, max.z),
+                ] {
+                    let (p, q) = (Vec3::new(min.x, ylo, zlo), Vec3::new(max.x, yhi, zhi));
+                    out.push(AaBox::new(p, q).unwrap().into());
+                }
+                continue;
+            }
+            out.push(AaBox::new(min, max).unwrap().into());
+        }
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(
+        std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(8)
+    ))]
+
+    /// A verdict is a proof: whatever the box, its wall thickness and its hole (sealed, too
+    /// narrow, or wide enough), a goal declared unreachable at the clearance has no route at
+    /// that clearance on a grid twice finer either (the proof's floods run on layers
+    /// twice coarser than the fine grid and with bounds stamped from other cells' distances);
+    /// a hole wide enough for the grid to resolve gives a route.
+    #[test]
+    fn a_verdict_is_never_given_where_a_finer_grid_finds_a_route(
+        half in 0.8_f64..2.0,
+        t in 0.02_f64..0.5,
+        hole in prop_oneof![Just(0.0), 0.1_f64..1.6],
+        r in 0.1_f64..0.3,
+        side in any::<bool>(),
+    ) {
+        let centre = Vec3::new(7.0, 3.0, 3.0);
+        let map = StaticMap::from_shapes(bounds([10.0, 6.0, 6.0]), box_with_hole(centre, half, t, hole)).unwrap();
+        let outside = Vec3::new(1.5, 3.0, 3.0);
+        let (s, g) = if side { (outside, centre) } else { (centre, outside) };
+        let answer = planner().plan(&map, &s, &g, r);
+        let c = r * 1.5;
+        if let Err(RouteError::Unreachable { cause, .. }) = &answer {
+            let fine = RoutePlanner::new(RouteParams {
+                cells_per_clearance: 4.0,
+                coarse_factor: 1.0,
+                ..RouteParams::default()
+            })
+            .unwrap();
+            match fine.plan(&map, &s, &g, r) {
+                Ok(route) => prop_assert!(false, "{cause}, but a finer grid found {:?}", route.points()),
+                Err(_) => {}
+            }
+        }
+        // A hole wider than 2c plus a fine cell (and the diagonal a box corner costs) is open.
+        if hole > 2.0 * c + c / 2.0 * 3.0_f64.sqrt() + 0.05 {
+            let route = answer.map_err(|e| TestCaseError::fail(format!("hole {hole}, c {c}: {e}")))?;
+            assert_clear(&map, &route);
+        }
+    }
+}
