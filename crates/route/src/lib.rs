@@ -20,8 +20,9 @@
 //! How: the straight line if it is clear; else weighted A\* ([`DEFAULT_HEURISTIC_WEIGHT`]) on a
 //! 26-connected grid whose occupancy is computed lazily, coarse to fine
 //! ([`RouteParams::coarse_factor`], [`RouteParams::refine_max_cells`]); then a shortcut. Every edge
-//! is clear at the inflated clearance `c`, a slot `2c + h` wide stays open, and an exhausted goal-side
-//! flood re-checked by a relaxed flood proves unreachability. [`RouteSearch::advance`] does at most its
+//! is clear at the inflated clearance `c`, a slot `2c + h` wide stays open, and unreachability is
+//! proved by relaxed floods (an over-approximation of the free space) beside the A\*, first on a
+//! layer twice as coarse, then on the fine one. [`RouteSearch::advance`] does at most its
 //! budget of units of work (a distance query, a line-of-sight query or an expansion); the answer does
 //! not depend on the slicing and no clock is read. The reasoning, the proofs, the measured costs and
 //! the rejected alternatives (JPS, Theta\*): `docs/decisions/0003-route-searched-in-slices.md` and

@@ -32,8 +32,8 @@ pub struct RouteParams {
     /// Cells per inflated clearance: `h₀ = c / cells_per_clearance`. Range `[0.5, 8]`; default 2
     /// (gaps as narrow as `2c + h` stay open while the grid stays coarse: see the crate docs).
     pub cells_per_clearance: f64,
-    /// Cap on the number of grid cells (memory: 13 bytes per cell, touched lazily). Range
-    /// `[1, 100_000_000]`; default 4 000 000 (52 MB at most; an E4 world at 0.45 m cells).
+    /// Cap on the number of grid cells (memory: 23 bytes per cell, touched lazily). Range
+    /// `[1, 100_000_000]`; default 4 000 000 (92 MB at most; an E4 world at 0.45 m cells).
     pub max_cells: usize,
     /// How much coarser than `h₀` the grid may become to fit `max_cells`. Range `[1, 16]`;
     /// default 4.
@@ -64,7 +64,7 @@ pub struct RouteParams {
     /// 9.3 m, and the flight took 3.4 × d/v_max. Small grids are cheap to search (every room of
     /// the suite, the variants and two holdout sets: ≤ 2 ms), large ones are not (a 40 × 40 m
     /// shaft: 0.6 s instead of 8 ms), hence the cap. Range `[0, 100 000 000]` (`max_cells` applies too), 0 never refines;
-    /// default 1 000 000 (13 MB at most; the slowest fine search measured under it, a
+    /// default 1 000 000 (23 MB at most; the slowest fine search measured under it, a
     /// Crazyflie-scale U-trap, 99 ms).
     pub refine_max_cells: usize,
     /// Replace the grid path by the greedy line-of-sight shortcut (each kept segment checked with

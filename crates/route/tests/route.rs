@@ -1027,9 +1027,8 @@ proptest! {
                 ..RouteParams::default()
             })
             .unwrap();
-            match fine.plan(&map, &s, &g, r) {
-                Ok(route) => prop_assert!(false, "{cause}, but a finer grid found {:?}", route.points()),
-                Err(_) => {}
+            if let Ok(route) = fine.plan(&map, &s, &g, r) {
+                prop_assert!(false, "{cause}, but a finer grid found {:?}", route.points());
             }
         }
         // A hole wider than 2c plus a fine cell (and the diagonal a box corner costs) is open.
