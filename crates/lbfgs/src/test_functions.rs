@@ -31,6 +31,19 @@ pub fn rosenbrock_start(dimension: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Central finite difference of a scalar function: `(f(x + h) − f(x − h)) / (2h)`.
+///
+/// The one-variable companion of [`central_difference_gradient`], for checking a hand-written
+/// derivative in a test.
+pub fn central_difference<F>(mut f: F, x: f64, h: f64) -> f64
+where
+    F: FnMut(f64) -> f64,
+{
+    let ahead = f(x + h);
+    let behind = f(x - h);
+    (ahead - behind) / (2.0 * h)
+}
+
 /// Central finite-difference gradient of the cost part of a fused cost-and-gradient function:
 /// `grad[i] = (f(x + h·eᵢ) − f(x − h·eᵢ)) / (2h)`.
 ///

@@ -88,7 +88,7 @@ fn tail_gradients_match_finite_differences_inside_and_outside_the_ramp() {
                 base.grad_p[axis]
             );
         }
-        let fd_t = (tail(p, v, t + h).cost - tail(p, v, t - h).cost) / (2.0 * h);
+        let fd_t = trust_lbfgs::test_functions::central_difference(|s| tail(p, v, s).cost, t, h);
         assert!(
             (fd_t - base.grad_t).abs() < 1e-5 * (1.0 + fd_t.abs()),
             "∂/∂t: fd {fd_t} vs {}",

@@ -728,7 +728,7 @@ fn dropping_the_coupling_would_be_detected() {
             &mut b,
         )
     };
-    let fd = (f(0.7 + h) - f(0.7 - h)) / (2.0 * h);
+    let fd = trust_lbfgs::test_functions::central_difference(&f, 0.7, h);
     assert!(
         (fd - gt[0]).abs() <= 1e-4 * (fd.abs() + gt[0].abs()) + 1e-7,
         "{fd} vs {}",

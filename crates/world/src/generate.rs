@@ -69,6 +69,29 @@ fn out_of_work(field: String, count: usize, placed: usize) -> Problem {
     )
 }
 
+/// One placement by rejection, the routine of every generator: up to [`PLACEMENT_ATTEMPTS`]
+/// draws, each spending `cost` tests of `work` first; `draw` returns `Ok(Some(_))` for an
+/// accepted draw, `Ok(None)` for a rejected one. `Ok(None)` when every attempt was rejected.
+///
+/// # Errors
+/// `out_of_work()` once the budget is gone; an error of `draw`.
+fn place_by_rejection<T>(
+    work: &mut Work,
+    cost: usize,
+    out_of_work: impl FnOnce() -> Problem,
+    mut draw: impl FnMut() -> Result<Option<T>, Problem>,
+) -> Result<Option<T>, Problem> {
+    for _ in 0..PLACEMENT_ATTEMPTS {
+        if !work.spend(cost) {
+            return Err(out_of_work());
+        }
+        if let Some(t) = draw()? {
+            return Ok(Some(t));
+        }
+    }
+    Ok(None)
+}
+
 impl Layout {
     pub(crate) fn shape_origin(&self, i: usize) -> String {
         if i < self.generated_shape_count {
@@ -372,12 +395,10 @@ fn random_group(
     let sin_climb = g.max_climb_deg.to_radians().sin();
     // Validation caps the count (scale policy); the capacity is capped again here.
     let mut out = Vec::with_capacity(g.count.min(crate::scenario::scale::MAX_OBSTACLE_COUNT));
+    let cost = if g.avoid_static { statics.len() } else { 1 };
     for i in 0..g.count {
-        let mut placed = None;
-        for _ in 0..PLACEMENT_ATTEMPTS {
-            if !work.spend(if g.avoid_static { statics.len() } else { 1 }) {
-                return Err(out_of_work(format!("{field}.count"), g.count, i));
-            }
+        let out_of_work = || out_of_work(format!("{field}.count"), g.count, i);
+        let placed = place_by_rejection(work, cost, out_of_work, || {
             let cylinder = rng.random_bool(g.cylinder_fraction);
             let shape = if cylinder {
                 let radius = uniform(rng, g.cylinder_radius_m);
@@ -427,7 +448,7 @@ fn random_group(
             if shape.signed_distance(&position, &ends.start) < clear
                 || shape.signed_distance(&position, &ends.goal) < clear
             {
-                continue;
+                return Ok(None);
             }
             if g.avoid_static {
                 let bound = e.norm();
@@ -435,18 +456,17 @@ fn random_group(
                     .iter()
                     .any(|s| s.signed_distance(&position) <= bound)
                 {
-                    continue;
+                    return Ok(None);
                 }
             }
-            placed = Some(MovingObstacle {
+            Ok(Some(MovingObstacle {
                 shape,
                 position,
                 velocity: direction * speed,
                 motion: motion.clone(),
                 region: *region,
-            });
-            break;
-        }
+            }))
+        })?;
         match placed {
             Some(o) => out.push(o),
             None => {
@@ -552,11 +572,9 @@ fn e4_static(
     ];
     for (name, count) in kinds {
         for i in 0..count {
-            let mut ok = false;
-            for _ in 0..PLACEMENT_ATTEMPTS {
-                if !work.spend(placed.len()) {
-                    return Err(out_of_work(format!("world.generator.{name}"), count, i));
-                }
+            let out_of_work = || out_of_work(format!("world.generator.{name}"), count, i);
+            let cost = placed.len();
+            let shape = place_by_rejection(work, cost, out_of_work, || {
                 let (foot, shape) = match name {
                     "block_count" => {
                         let sx = uniform(rng, e.block_size_m);
@@ -603,13 +621,11 @@ fn e4_static(
                         )
                     }
                 };
-                if accept(foot, &mut placed) {
-                    shapes.push(shape);
-                    ok = true;
-                    break;
-                }
-            }
-            if !ok {
+                Ok(accept(foot, &mut placed).then_some(shape))
+            })?;
+            if let Some(shape) = shape {
+                shapes.push(shape);
+            } else {
                 return Err(Problem::new(
                     format!("world.generator.{name}"),
                     count,

@@ -16,7 +16,7 @@ use crate::minco::{BoundaryState, MincoGrad, MincoS3};
 /// What both objectives share: MINCO, the sampled penalties, the jerk energy and the adjoint
 /// propagation, with all buffers preallocated.
 #[derive(Debug, Clone)]
-struct ObjectiveCore<'a> {
+pub(crate) struct ObjectiveCore<'a> {
     minco: MincoS3,
     integrator: TrapezoidIntegrator,
     penalties: PenaltyIntegrand<'a>,
@@ -124,6 +124,63 @@ impl<'a> ObjectiveCore<'a> {
         )?;
         self.minco
             .propagate_grad(&self.grad_c, &self.grad_t, &mut self.grad)
+    }
+
+    /// Shared start of both objectives' `cost_with_bound`: forgets the last gradient and reads
+    /// the inner waypoints from `x`. `false` (nothing read) when `x` is not `dimension` long.
+    fn begin_cost(&mut self, x: &[f64], dimension: usize) -> bool {
+        self.gradient_ready = false;
+        if x.len() != dimension {
+            return false;
+        }
+        for (i, w) in self.waypoints.iter_mut().enumerate() {
+            *w = get(x, i);
+        }
+        true
+    }
+
+    /// Shared start of both objectives' `gradient`: checks `g`'s length, computes the core's
+    /// gradient (the last cost must be finite; `g` is zeroed if not) and writes the inner
+    /// waypoints' part of `g`.
+    fn begin_gradient(&mut self, g: &mut [f64], dimension: usize) -> Result<(), PlanError> {
+        check_len("g", dimension, g.len())?;
+        if let Err(e) = self.gradient_after_cost() {
+            g.fill(0.0);
+            return Err(e);
+        }
+        for (i, gw) in self.grad.waypoints.iter().enumerate() {
+            put(g, i, gw);
+        }
+        Ok(())
+    }
+
+    /// The last cost must be finite; computes the core's gradient.
+    fn gradient_after_cost(&mut self) -> Result<(), PlanError> {
+        if !self.gradient_ready {
+            return Err(component(MincoError::NotSolved {
+                operation: "gradient (no finite cost evaluated)",
+            }));
+        }
+        self.gradient_ready = false;
+        self.evaluate_gradient().map_err(component)
+    }
+
+    /// Shared end of `cost`: rejects a non-finite cost, records the breakdown, allows the
+    /// gradient.
+    fn record_cost(&mut self, cost: f64, [ht, hs]: [f64; 2], [io, id, ie]: [f64; 3]) -> f64 {
+        if !cost.is_finite() {
+            return f64::INFINITY;
+        }
+        self.last = CostBreakdown {
+            ht,
+            hs,
+            io,
+            id,
+            ie,
+            total: cost,
+        };
+        self.gradient_ready = true;
+        cost
     }
 
     fn trajectory(&self) -> Result<PolyTraj, PlanError> {
@@ -279,7 +336,7 @@ impl<'a> UtfMincoObjective<'a> {
 
     /// Number of pieces `n`.
     pub fn pieces(&self) -> usize {
-        self.core.pieces()
+        SplitCost::pieces(self)
     }
 
     /// Length of the decision vector, `3(n−1) + 7`.
@@ -344,7 +401,7 @@ impl<'a> UtfMincoObjective<'a> {
     ///
     /// `x` and `g` must be [`dimension`](Self::dimension) long; otherwise the result is `+∞`.
     pub fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
-        eval_fused(self, x, g)
+        SplitCost::eval(self, x, g)
     }
 
     /// `J(x)` alone; `+∞` where MINCO cannot be solved, the cost is not finite or `x` has the
@@ -361,13 +418,9 @@ impl<'a> UtfMincoObjective<'a> {
     /// [`Self::cost`]. This is what [`trust_lbfgs::SplitObjective::cost`] asks for: a line
     /// search rejects such trial points without needing their exact cost.
     pub fn cost_with_bound(&mut self, x: &[f64], bound: f64) -> f64 {
-        self.core.gradient_ready = false;
         let n = self.pieces();
-        if x.len() != self.dimension() {
+        if !self.core.begin_cost(x, self.dimension()) {
             return f64::INFINITY;
-        }
-        for (i, w) in self.core.waypoints.iter_mut().enumerate() {
-            *w = get(x, i);
         }
         let (p_f, v_f) = (get(x, n - 1), get(x, n));
         let (t_map, dt_dtau) = positive_time(x[3 * n + 3]);
@@ -401,7 +454,7 @@ impl<'a> UtfMincoObjective<'a> {
         } else {
             hs_objective
         };
-        record_cost(cost, &mut self.core, [total, hs], terms)
+        self.core.record_cost(cost, [total, hs], terms)
     }
 
     /// `∇J` at the point of the last [`Self::cost`] call, written into `g`.
@@ -412,17 +465,10 @@ impl<'a> UtfMincoObjective<'a> {
     /// gradient is not finite. `g` is then zeroed.
     pub fn gradient(&mut self, g: &mut [f64]) -> Result<(), PlanError> {
         let n = self.pieces();
-        check_len("g", self.dimension(), g.len())?;
-        if let Err(e) = begin_gradient(&mut self.core) {
-            g.fill(0.0);
-            return Err(e);
-        }
+        self.core.begin_gradient(g, self.dimension())?;
         let w = &self.core.weights;
         let (hs_p, hs_v, dt_dtau) = self.terminal_grad;
         let grad = &self.core.grad;
-        for (i, gw) in grad.waypoints.iter().enumerate() {
-            put(g, i, gw);
-        }
         let tail = &self.tail;
         put(g, n - 1, &(grad.tail[0] + hs_p * w.terminal + tail.grad_p));
         put(g, n, &(grad.tail[1] + hs_v * w.terminal + tail.grad_v));
@@ -433,7 +479,7 @@ impl<'a> UtfMincoObjective<'a> {
     /// The unweighted cost terms and `J` at the last finite cost evaluation (one that did not
     /// stop early at its bound).
     pub fn breakdown(&self) -> CostBreakdown {
-        self.core.last
+        SplitCost::breakdown(self)
     }
 
     /// The trajectory of the last evaluation (starts at `start.t`); after a
@@ -443,7 +489,7 @@ impl<'a> UtfMincoObjective<'a> {
     /// # Errors
     /// If no evaluation has succeeded yet.
     pub fn trajectory(&self) -> Result<PolyTraj, PlanError> {
-        self.core.trajectory()
+        SplitCost::trajectory(self)
     }
 }
 
@@ -499,7 +545,7 @@ impl<'a> MincoObjective<'a> {
 
     /// Number of pieces `n`.
     pub fn pieces(&self) -> usize {
-        self.core.pieces()
+        SplitCost::pieces(self)
     }
 
     /// Length of the decision vector, `3(n−1) + n`.
@@ -537,7 +583,7 @@ impl<'a> MincoObjective<'a> {
     ///
     /// `x` and `g` must be [`dimension`](Self::dimension) long; otherwise the result is `+∞`.
     pub fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
-        eval_fused(self, x, g)
+        SplitCost::eval(self, x, g)
     }
 
     /// `J(x)` alone; `+∞` where MINCO cannot be solved, the cost is not finite or `x` has the
@@ -548,13 +594,9 @@ impl<'a> MincoObjective<'a> {
 
     /// [`Self::cost`], exact only up to `bound`; see [`UtfMincoObjective::cost_with_bound`].
     pub fn cost_with_bound(&mut self, x: &[f64], bound: f64) -> f64 {
-        self.core.gradient_ready = false;
         let n = self.pieces();
-        if x.len() != self.dimension() {
+        if !self.core.begin_cost(x, self.dimension()) {
             return f64::INFINITY;
-        }
-        for (i, w) in self.core.waypoints.iter_mut().enumerate() {
-            *w = get(x, i);
         }
         let taus = &x[3 * (n - 1)..];
         for ((d, slope), &tau) in self
@@ -578,7 +620,7 @@ impl<'a> MincoObjective<'a> {
             Err(_) => return f64::INFINITY,
         };
         let cost = w_time * total + w_terminal * hs + integral;
-        record_cost(cost, &mut self.core, [total, hs], terms)
+        self.core.record_cost(cost, [total, hs], terms)
     }
 
     /// `∇J` at the point of the last [`Self::cost`] call, written into `g`.
@@ -587,16 +629,9 @@ impl<'a> MincoObjective<'a> {
     /// As [`UtfMincoObjective::gradient`].
     pub fn gradient(&mut self, g: &mut [f64]) -> Result<(), PlanError> {
         let n = self.pieces();
-        check_len("g", self.dimension(), g.len())?;
-        if let Err(e) = begin_gradient(&mut self.core) {
-            g.fill(0.0);
-            return Err(e);
-        }
+        self.core.begin_gradient(g, self.dimension())?;
         let w = &self.core.weights;
         let grad = &self.core.grad;
-        for (i, gw) in grad.waypoints.iter().enumerate() {
-            put(g, i, gw);
-        }
         for ((gi, slope), dj) in g[3 * (n - 1)..]
             .iter_mut()
             .zip(&self.duration_slopes)
@@ -610,7 +645,7 @@ impl<'a> MincoObjective<'a> {
     /// The unweighted cost terms and `J` at the last finite cost evaluation (one that did not
     /// stop early at its bound).
     pub fn breakdown(&self) -> CostBreakdown {
-        self.core.last
+        SplitCost::breakdown(self)
     }
 
     /// The trajectory of the last evaluation (starts at `start.t`); after a
@@ -620,22 +655,35 @@ impl<'a> MincoObjective<'a> {
     /// # Errors
     /// If no evaluation has succeeded yet.
     pub fn trajectory(&self) -> Result<PolyTraj, PlanError> {
-        self.core.trajectory()
+        SplitCost::trajectory(self)
     }
 }
 
-/// The two halves of an objective, for [`eval_fused`] and the split L-BFGS solve.
+/// The two halves of an objective, for [`eval_fused`] and the split L-BFGS solve; what the two
+/// objectives share beyond their two halves is provided here, on their [`ObjectiveCore`].
 pub(crate) trait SplitCost {
     /// `J(x)`, exact up to `bound`, `+∞` where it cannot be evaluated.
     fn cost(&mut self, x: &[f64], bound: f64) -> f64;
     /// `∇J` at the last cost's point.
     fn gradient(&mut self, g: &mut [f64]) -> Result<(), PlanError>;
+    /// MINCO, the penalties and the state of the last evaluation.
+    fn core(&self) -> &ObjectiveCore<'_>;
     /// Fused cost and gradient (sets the state that `trajectory` and `breakdown` read).
-    fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64;
+    fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
+        eval_fused(self, x, g)
+    }
     /// The trajectory at the last evaluated point.
-    fn trajectory(&self) -> Result<PolyTraj, PlanError>;
+    fn trajectory(&self) -> Result<PolyTraj, PlanError> {
+        self.core().trajectory()
+    }
     /// The cost breakdown at the last evaluated point.
-    fn breakdown(&self) -> CostBreakdown;
+    fn breakdown(&self) -> CostBreakdown {
+        self.core().last
+    }
+    /// Number of pieces `n`.
+    fn pieces(&self) -> usize {
+        self.core().pieces()
+    }
 }
 
 impl SplitCost for UtfMincoObjective<'_> {
@@ -647,16 +695,8 @@ impl SplitCost for UtfMincoObjective<'_> {
         UtfMincoObjective::gradient(self, g)
     }
 
-    fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
-        UtfMincoObjective::eval(self, x, g)
-    }
-
-    fn trajectory(&self) -> Result<PolyTraj, PlanError> {
-        UtfMincoObjective::trajectory(self)
-    }
-
-    fn breakdown(&self) -> CostBreakdown {
-        UtfMincoObjective::breakdown(self)
+    fn core(&self) -> &ObjectiveCore<'_> {
+        &self.core
     }
 }
 
@@ -669,60 +709,19 @@ impl SplitCost for MincoObjective<'_> {
         MincoObjective::gradient(self, g)
     }
 
-    fn eval(&mut self, x: &[f64], g: &mut [f64]) -> f64 {
-        MincoObjective::eval(self, x, g)
-    }
-
-    fn trajectory(&self) -> Result<PolyTraj, PlanError> {
-        MincoObjective::trajectory(self)
-    }
-
-    fn breakdown(&self) -> CostBreakdown {
-        MincoObjective::breakdown(self)
+    fn core(&self) -> &ObjectiveCore<'_> {
+        &self.core
     }
 }
 
 /// Cost and gradient in one call: `+∞` with `g` zeroed if either is not available.
-fn eval_fused<O: SplitCost>(objective: &mut O, x: &[f64], g: &mut [f64]) -> f64 {
+fn eval_fused<O: SplitCost + ?Sized>(objective: &mut O, x: &[f64], g: &mut [f64]) -> f64 {
     let cost = objective.cost(x, f64::INFINITY);
     if !cost.is_finite() || objective.gradient(g).is_err() {
         g.fill(0.0);
         return f64::INFINITY;
     }
     cost
-}
-
-/// Shared end of `cost`: reject a non-finite cost, record the breakdown, allow the gradient.
-fn record_cost(
-    cost: f64,
-    core: &mut ObjectiveCore<'_>,
-    [ht, hs]: [f64; 2],
-    [io, id, ie]: [f64; 3],
-) -> f64 {
-    if !cost.is_finite() {
-        return f64::INFINITY;
-    }
-    core.last = CostBreakdown {
-        ht,
-        hs,
-        io,
-        id,
-        ie,
-        total: cost,
-    };
-    core.gradient_ready = true;
-    cost
-}
-
-/// Shared start of `gradient`: the last cost must be finite; computes the core's gradient.
-fn begin_gradient(core: &mut ObjectiveCore<'_>) -> Result<(), PlanError> {
-    if !core.gradient_ready {
-        return Err(component(MincoError::NotSolved {
-            operation: "gradient (no finite cost evaluated)",
-        }));
-    }
-    core.gradient_ready = false;
-    core.evaluate_gradient().map_err(component)
 }
 
 /// Shared end of `gradient`: a non-finite gradient is an error (and `g` is zeroed).

@@ -177,7 +177,8 @@ mod tests {
                 assert_relative_eq!(g[k][d], fd, epsilon = 1e-6, max_relative = 1e-6);
             }
         }
-        let fd_t = (piece_jerk_energy(&c, t + h) - piece_jerk_energy(&c, t - h)) / (2.0 * h);
+        let fd_t =
+            trust_lbfgs::test_functions::central_difference(|s| piece_jerk_energy(&c, s), t, h);
         assert_relative_eq!(gt[0], fd_t, max_relative = 1e-6);
     }
 
