@@ -75,10 +75,10 @@ fn members() -> Vec<Member> {
 /// `flightstack` (PX4/Crazyflie outputs, issue 35) reads the planner's trajectory type (`core`)
 /// and knows no simulator type, its tests build MINCO trajectories (`minco`); `sensing`
 /// (simulated sensors and the online map, issue 34) sits on `geometry` alone; `ros2` (the ROS 2
-/// node, issue 35) sits at the top beside `sim`: the planner and map of a scenario file
-/// (`world`, `planner`) and the PX4 setpoints of `flightstack`; its simulated ROS world
-/// (`dds_world`, issue 35 item 3) writes run logs with `flight`'s header and clearances, and
-/// `sim` runs it (`trust-sim dds-world`).
+/// node, issue 35) sits under `sim`: the planner and map of a scenario file (`world`,
+/// `planner`) and the PX4 setpoints of `flightstack`; its simulated ROS world (`dds_world`,
+/// issue 35 item 3) writes run logs with `flight`'s header and clearances, and `sim` runs it
+/// (`trust-sim dds-world`).
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
     const PLANNING: &[&str] = &[
         "trust-overrides",
