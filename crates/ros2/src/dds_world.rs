@@ -453,3 +453,59 @@ impl Tally {
         self.max_accel = self.max_accel.max(s.a.norm());
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use approx::assert_relative_eq;
+
+    use super::*;
+    use crate::msg::builtin_interfaces::Duration;
+    use crate::msg::geometry_msgs::{Transform, Twist};
+    use crate::msg::trajectory_msgs::MultiDOFJointTrajectoryPoint;
+
+    fn point(t: f64, x: f64, vx: f64) -> MultiDOFJointTrajectoryPoint {
+        MultiDOFJointTrajectoryPoint {
+            transforms: vec![Transform {
+                translation: Vector3 { x, y: 1.0, z: 2.0 },
+                ..Transform::default()
+            }],
+            velocities: vec![Twist {
+                linear: Vector3 {
+                    x: vx,
+                    y: 0.0,
+                    z: 0.0,
+                },
+                ..Twist::default()
+            }],
+            accelerations: vec![Twist::default()],
+            time_from_start: Duration::from_seconds(t).expect("duration"),
+        }
+    }
+
+    #[test]
+    fn the_reference_interpolates_the_samples_and_rests_at_the_end() {
+        let traj = MultiDOFJointTrajectory {
+            header: Time {
+                sec: 100,
+                nanosec: 0,
+            }
+            .into_header("map"),
+            joint_names: vec!["base_link".into()],
+            points: vec![
+                point(0.0, 0.0, 1.0),
+                point(0.5, 0.5, 1.0),
+                point(1.0, 1.0, 0.0),
+            ],
+        };
+        let r = reference_at(&traj, 100.25).expect("a reference");
+        assert_relative_eq!(r.p.x, 0.25, epsilon = 1e-9);
+        assert_relative_eq!(r.p.y, 1.0, epsilon = 1e-9);
+        assert_relative_eq!(r.v.x, 1.0, epsilon = 1e-9);
+        let before = reference_at(&traj, 99.0).expect("a reference");
+        assert_relative_eq!(before.p.x, 0.0, epsilon = 1e-9);
+        let after = reference_at(&traj, 105.0).expect("a reference");
+        assert_relative_eq!(after.p.x, 1.0, epsilon = 1e-9);
+        assert_relative_eq!(after.v.norm(), 0.0, epsilon = 1e-12);
+        assert!(reference_at(&MultiDOFJointTrajectory::default(), 0.0).is_none());
+    }
+}
