@@ -75,8 +75,10 @@ fn members() -> Vec<Member> {
 /// `flightstack` (PX4/Crazyflie outputs, issue 35) reads the planner's trajectory type (`core`)
 /// and knows no simulator type, its tests build MINCO trajectories (`minco`); `sensing`
 /// (simulated sensors and the online map, issue 34) sits on `geometry` alone; `ros2` (the ROS 2
-/// node, issue 35) sits at the top beside `sim`: the planner and map of a scenario file
-/// (`world`, `planner`) and the PX4 setpoints of `flightstack`.
+/// node, issue 35) sits under `sim`: the planner and map of a scenario file (`world`,
+/// `planner`) and the PX4 setpoints of `flightstack`; its simulated ROS world (`dds_world`,
+/// issue 35 item 3) writes run logs with `flight`'s header and clearances, and `sim` runs it
+/// (`trust-sim dds-world`).
 fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
     const PLANNING: &[&str] = &[
         "trust-overrides",
@@ -203,6 +205,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-vehicle",
                 "trust-world",
                 "trust-runlog",
+                "trust-flight",
                 "trust-flightstack",
             ]),
         ),
@@ -217,6 +220,7 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-plot",
                 "trust-experiments",
                 "trust-replay",
+                "trust-ros2",
             ]),
         ),
     ])

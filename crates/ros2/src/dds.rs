@@ -98,7 +98,24 @@ impl Default for DdsOptions {
     }
 }
 
-/// A topic of message type `M` named `name` (relative to the node's namespace).
+/// The absolute ROS name of topic `name` in `namespace`: an absolute `name` (`/fmu/in/x`) stays
+/// as it is, a relative one is put under the namespace (`odom` in `/` is `/odom`, in `/uav1`
+/// `/uav1/odom`).
+///
+/// ros2-client 0.12 makes the DDS topic of a relative name in the root namespace `rt//odom`
+/// (namespace `/`, then a `/` separator), which no other ROS 2 implementation reads as
+/// `/odom`; resolving every name here keeps the DDS names `rt/odom`, `rt/uav1/odom`. Found by
+/// the Cyclone DDS interop test (`tests/cyclone_interop.rs`).
+pub fn resolve_name(namespace: &str, name: &str) -> String {
+    if name.starts_with('/') {
+        name.to_owned()
+    } else {
+        format!("{}/{name}", namespace.trim_end_matches('/'))
+    }
+}
+
+/// A topic of message type `M` named `name` (relative to the node's namespace, see
+/// [`resolve_name`]).
 ///
 /// # Errors
 /// [`Ros2Error::Dds`] for an invalid name or a failed creation.
@@ -107,7 +124,8 @@ pub fn topic<M: RosMessage>(
     name: &str,
     qos: &QosProfile,
 ) -> Result<ros2_client::dds::rustdds::Topic, Ros2Error> {
-    let n = Name::parse(name).map_err(|e| Ros2Error::dds(format!("topic name {name}"), e))?;
+    let full = resolve_name(node.namespace(), name);
+    let n = Name::parse(&full).map_err(|e| Ros2Error::dds(format!("topic name {full}"), e))?;
     node.create_topic(&n, MessageTypeName::new(M::PACKAGE, M::NAME), qos)
         .map_err(|e| Ros2Error::dds(format!("create topic {name}"), e))
 }
@@ -346,5 +364,32 @@ impl DdsNode {
             }
             std::thread::sleep(StdDuration::from_millis(1));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The DDS topic of `name` for a node in `namespace`, as ros2-client writes it.
+    fn dds_topic(namespace: &str, name: &str) -> String {
+        let node = NodeName::new(namespace, "n").expect("node name");
+        Name::parse(&resolve_name(namespace, name))
+            .expect("valid name")
+            .to_dds_name("rt", &node, "")
+    }
+
+    #[test]
+    fn relative_names_in_the_root_namespace_are_rt_slash_name_not_rt_double_slash() {
+        assert_eq!(dds_topic("/", topics::ODOM), "rt/odom");
+        assert_eq!(dds_topic("/uav1", topics::ODOM), "rt/uav1/odom");
+        assert_eq!(
+            dds_topic("/", topics::PX4_SETPOINT),
+            "rt/fmu/in/trajectory_setpoint"
+        );
+        assert_eq!(
+            dds_topic("/uav1", topics::PX4_SETPOINT),
+            "rt/fmu/in/trajectory_setpoint"
+        );
     }
 }

@@ -47,6 +47,7 @@
 pub mod cdr;
 pub mod convert;
 pub mod dds;
+pub mod dds_world;
 pub mod error;
 pub mod msg;
 pub mod node_core;

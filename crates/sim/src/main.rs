@@ -116,6 +116,22 @@ enum Cmd {
         #[arg(required = true)]
         scenarios: Vec<PathBuf>,
     },
+    /// Be the ROS 2 world of a separate `trust-node` (docs/ros2.md): publish the vehicle's
+    /// odometry, the goal and the true obstacles over DDS, fly the trajectory the node
+    /// publishes in real time, and write the run log (out/run.jsonl) as `run` does.
+    DdsWorld {
+        /// The scenario file (the node should be started with the same one).
+        scenario: PathBuf,
+        /// Trial seed, as for `run`.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// ROS domain id (the node's --domain-id).
+        #[arg(long, default_value_t = 0)]
+        domain_id: u16,
+        /// Output directory.
+        #[arg(long, default_value = "out/dds-world")]
+        out: PathBuf,
+    },
     /// Run a comparative study (the paper's E4 by default): every planner on the same trials;
     /// writes runs.csv, summary.json, report.md, plots and every run log.
     Ablate {
@@ -589,6 +605,55 @@ fn run_cli() -> Result<ExitCode> {
             } else {
                 ExitCode::FAILURE
             })
+        }
+        Cmd::DdsWorld {
+            scenario,
+            seed,
+            domain_id,
+            out,
+        } => {
+            let mut s = Scenario::parse_file(&scenario)?;
+            if let Some(seed) = seed {
+                s = s.with_seed(seed);
+            }
+            let problems = trust_flight::scenario::check(&s);
+            if !problems.is_empty() {
+                return Err(WorldError::Invalid {
+                    path: s.origin(),
+                    problems,
+                }
+                .into());
+            }
+            let world = World::build(&s)?;
+            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+            let log_path = out.join("run.jsonl");
+            eprintln!(
+                "dds-world: `{}` (seed {}) on ROS domain {domain_id}, waiting for trust-node...",
+                s.name, s.seed
+            );
+            let o = trust_ros2::dds_world::fly(
+                &world,
+                domain_id,
+                &log_path,
+                &trust_ros2::dds_world::DdsWorldOptions::default(),
+            )?;
+            out!(
+                "trust-node over DDS: {}{} at t = {:.2} s; path {:.1} m; min clearance static {}, \
+                 moving {}; max speed {:.2} m/s; {} cycles; wrote {}",
+                o.status.as_str(),
+                o.with
+                    .as_ref()
+                    .map(|w| format!(" with {w}"))
+                    .unwrap_or_default(),
+                o.t,
+                o.path_length_m,
+                clearance_text(o.min_clearance_static_m),
+                clearance_text(o.min_clearance_dynamic_m),
+                o.max_speed,
+                o.cycle_count,
+                log_path.display()
+            );
+            Ok(ExitCode::SUCCESS)
         }
         Cmd::Audit { logs, cycles } => {
             let mut bad = 0;

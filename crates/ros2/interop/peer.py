@@ -1,0 +1,550 @@
+#!/usr/bin/env python3
+"""An independent DDS peer for `trust-node`: Eclipse Cyclone DDS (Python binding, pinned in
+`requirements.txt`), which shares no code with ros2-client/RustDDS.
+
+The ROS 2 message types are declared here as Cyclone IDL structs, written from the ROS 2 `.msg`
+definitions (common_interfaces as in Humble and Jazzy, px4_msgs of PX4 v1.15, and our
+`crates/ros2/msg/trust_msgs`), not from the Rust structs. ROS 2 on DDS: the topic `/odom` is the
+DDS topic `rt/odom`, the type `nav_msgs/msg/Odometry` the DDS type
+`nav_msgs::msg::dds_::Odometry_`, payloads XCDR1 little-endian.
+
+The peer publishes odometry, a goal and two moving obstacles with known values, receives every
+topic the node publishes and checks each message field by field (frames, stamps, finite
+numbers, the plan from the vehicle to the goal, the obstacles' forecasts). A field whose layout
+differs on the two sides either fails to decode here or decodes to values that fail a check.
+
+    peer.py --domain N [--px4] [--timeout S]
+
+Exit status 0 when every check passed, 1 on a failed check or a timeout (the reason on stderr).
+Run it restricted to loopback: CYCLONEDDS_URI (see `crates/ros2/tests/cyclone_interop.rs`).
+"""
+
+import argparse
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+
+from cyclonedds.core import Policy, Qos
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.idl import IdlStruct
+from cyclonedds.idl import types as t
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+
+
+def dds(pkg, name):
+    """The DDS type name of the ROS 2 message `pkg/msg/name`."""
+    return f"{pkg}::msg::dds_::{name}_"
+
+
+# --- builtin_interfaces, std_msgs ---------------------------------------------------------------
+
+
+@dataclass
+class Time(IdlStruct, typename=dds("builtin_interfaces", "Time")):
+    sec: t.int32 = 0
+    nanosec: t.uint32 = 0
+
+
+@dataclass
+class Duration(IdlStruct, typename=dds("builtin_interfaces", "Duration")):
+    sec: t.int32 = 0
+    nanosec: t.uint32 = 0
+
+
+@dataclass
+class Header(IdlStruct, typename=dds("std_msgs", "Header")):
+    stamp: Time = field(default_factory=Time)
+    frame_id: str = ""
+
+
+@dataclass
+class ColorRGBA(IdlStruct, typename=dds("std_msgs", "ColorRGBA")):
+    r: t.float32 = 0.0
+    g: t.float32 = 0.0
+    b: t.float32 = 0.0
+    a: t.float32 = 0.0
+
+
+# --- geometry_msgs ------------------------------------------------------------------------------
+
+
+@dataclass
+class Point(IdlStruct, typename=dds("geometry_msgs", "Point")):
+    x: t.float64 = 0.0
+    y: t.float64 = 0.0
+    z: t.float64 = 0.0
+
+
+@dataclass
+class Vector3(IdlStruct, typename=dds("geometry_msgs", "Vector3")):
+    x: t.float64 = 0.0
+    y: t.float64 = 0.0
+    z: t.float64 = 0.0
+
+
+@dataclass
+class Quaternion(IdlStruct, typename=dds("geometry_msgs", "Quaternion")):
+    x: t.float64 = 0.0
+    y: t.float64 = 0.0
+    z: t.float64 = 0.0
+    w: t.float64 = 1.0
+
+
+@dataclass
+class Pose(IdlStruct, typename=dds("geometry_msgs", "Pose")):
+    position: Point = field(default_factory=Point)
+    orientation: Quaternion = field(default_factory=Quaternion)
+
+
+@dataclass
+class PoseStamped(IdlStruct, typename=dds("geometry_msgs", "PoseStamped")):
+    header: Header = field(default_factory=Header)
+    pose: Pose = field(default_factory=Pose)
+
+
+@dataclass
+class PoseWithCovariance(IdlStruct, typename=dds("geometry_msgs", "PoseWithCovariance")):
+    pose: Pose = field(default_factory=Pose)
+    covariance: t.array[t.float64, 36] = field(default_factory=lambda: [0.0] * 36)
+
+
+@dataclass
+class Twist(IdlStruct, typename=dds("geometry_msgs", "Twist")):
+    linear: Vector3 = field(default_factory=Vector3)
+    angular: Vector3 = field(default_factory=Vector3)
+
+
+@dataclass
+class TwistWithCovariance(IdlStruct, typename=dds("geometry_msgs", "TwistWithCovariance")):
+    twist: Twist = field(default_factory=Twist)
+    covariance: t.array[t.float64, 36] = field(default_factory=lambda: [0.0] * 36)
+
+
+@dataclass
+class Transform(IdlStruct, typename=dds("geometry_msgs", "Transform")):
+    translation: Vector3 = field(default_factory=Vector3)
+    rotation: Quaternion = field(default_factory=Quaternion)
+
+
+# --- nav_msgs, trajectory_msgs ------------------------------------------------------------------
+
+
+@dataclass
+class Odometry(IdlStruct, typename=dds("nav_msgs", "Odometry")):
+    header: Header = field(default_factory=Header)
+    child_frame_id: str = ""
+    pose: PoseWithCovariance = field(default_factory=PoseWithCovariance)
+    twist: TwistWithCovariance = field(default_factory=TwistWithCovariance)
+
+
+@dataclass
+class Path(IdlStruct, typename=dds("nav_msgs", "Path")):
+    header: Header = field(default_factory=Header)
+    poses: t.sequence[PoseStamped] = field(default_factory=list)
+
+
+@dataclass
+class MultiDOFJointTrajectoryPoint(
+    IdlStruct, typename=dds("trajectory_msgs", "MultiDOFJointTrajectoryPoint")
+):
+    transforms: t.sequence[Transform] = field(default_factory=list)
+    velocities: t.sequence[Twist] = field(default_factory=list)
+    accelerations: t.sequence[Twist] = field(default_factory=list)
+    time_from_start: Duration = field(default_factory=Duration)
+
+
+@dataclass
+class MultiDOFJointTrajectory(IdlStruct, typename=dds("trajectory_msgs", "MultiDOFJointTrajectory")):
+    header: Header = field(default_factory=Header)
+    joint_names: t.sequence[str] = field(default_factory=list)
+    points: t.sequence[MultiDOFJointTrajectoryPoint] = field(default_factory=list)
+
+
+# --- sensor_msgs, visualization_msgs (Humble/Jazzy Marker, with textures and meshes) -----------
+
+
+@dataclass
+class CompressedImage(IdlStruct, typename=dds("sensor_msgs", "CompressedImage")):
+    header: Header = field(default_factory=Header)
+    format: str = ""
+    data: t.sequence[t.uint8] = field(default_factory=list)
+
+
+@dataclass
+class UVCoordinate(IdlStruct, typename=dds("visualization_msgs", "UVCoordinate")):
+    u: t.float32 = 0.0
+    v: t.float32 = 0.0
+
+
+@dataclass
+class MeshFile(IdlStruct, typename=dds("visualization_msgs", "MeshFile")):
+    filename: str = ""
+    data: t.sequence[t.uint8] = field(default_factory=list)
+
+
+@dataclass
+class Marker(IdlStruct, typename=dds("visualization_msgs", "Marker")):
+    header: Header = field(default_factory=Header)
+    ns: str = ""
+    id: t.int32 = 0
+    type: t.int32 = 0
+    action: t.int32 = 0
+    pose: Pose = field(default_factory=Pose)
+    scale: Vector3 = field(default_factory=Vector3)
+    color: ColorRGBA = field(default_factory=ColorRGBA)
+    lifetime: Duration = field(default_factory=Duration)
+    frame_locked: bool = False
+    points: t.sequence[Point] = field(default_factory=list)
+    colors: t.sequence[ColorRGBA] = field(default_factory=list)
+    texture_resource: str = ""
+    texture: CompressedImage = field(default_factory=CompressedImage)
+    uv_coordinates: t.sequence[UVCoordinate] = field(default_factory=list)
+    text: str = ""
+    mesh_resource: str = ""
+    mesh_file: MeshFile = field(default_factory=MeshFile)
+    mesh_use_embedded_materials: bool = False
+
+
+MARKER_SPHERE, MARKER_CYLINDER, MARKER_LINE_STRIP = 2, 3, 4
+MARKER_ADD, MARKER_DELETEALL = 0, 3
+
+
+@dataclass
+class MarkerArray(IdlStruct, typename=dds("visualization_msgs", "MarkerArray")):
+    markers: t.sequence[Marker] = field(default_factory=list)
+
+
+# --- trust_msgs (crates/ros2/msg/trust_msgs/msg) ------------------------------------------------
+
+SHAPE_SPHERE, SHAPE_CYLINDER = 0, 1
+
+
+@dataclass
+class MovingObstacle(IdlStruct, typename=dds("trust_msgs", "MovingObstacle")):
+    id: t.uint32 = 0
+    shape: t.uint8 = 0
+    size: Vector3 = field(default_factory=Vector3)
+    position: Point = field(default_factory=Point)
+    velocity: Vector3 = field(default_factory=Vector3)
+    covariance: t.array[t.float64, 36] = field(default_factory=lambda: [0.0] * 36)
+
+
+@dataclass
+class MovingObstacleArray(IdlStruct, typename=dds("trust_msgs", "MovingObstacleArray")):
+    header: Header = field(default_factory=Header)
+    obstacles: t.sequence[MovingObstacle] = field(default_factory=list)
+
+
+@dataclass
+class PlannerEvent(IdlStruct, typename=dds("trust_msgs", "PlannerEvent")):
+    header: Header = field(default_factory=Header)
+    cycle_count: t.uint64 = 0
+    cycle_time_ms: t.float64 = 0.0
+    has_plan: bool = False
+    fallback: bool = False
+    events: t.sequence[str] = field(default_factory=list)
+
+
+# --- px4_msgs (PX4 v1.15) -----------------------------------------------------------------------
+
+
+@dataclass
+class TrajectorySetpoint(IdlStruct, typename=dds("px4_msgs", "TrajectorySetpoint")):
+    timestamp: t.uint64 = 0
+    position: t.array[t.float32, 3] = field(default_factory=lambda: [0.0] * 3)
+    velocity: t.array[t.float32, 3] = field(default_factory=lambda: [0.0] * 3)
+    acceleration: t.array[t.float32, 3] = field(default_factory=lambda: [0.0] * 3)
+    jerk: t.array[t.float32, 3] = field(default_factory=lambda: [0.0] * 3)
+    yaw: t.float32 = 0.0
+    yawspeed: t.float32 = 0.0
+
+
+# --- the scene the peer sends (inside scenarios/quickstart.toml's 40 x 20 x 10 m world) ---------
+
+WORLD, BODY = "map", "base_link"
+START = (2.0, 10.0, 3.0)
+GOAL = (8.0, 10.0, 3.0)
+# (id, shape, size, position): off the way from START to GOAL.
+OBSTACLES = [
+    (7, SHAPE_SPHERE, (1.0, 1.0, 1.0), (30.0, 4.0, 6.0)),
+    (9, SHAPE_CYLINDER, (0.8, 0.8, 3.0), (34.0, 16.0, 3.0)),
+]
+
+
+class CheckFailed(Exception):
+    pass
+
+
+def check(cond, what):
+    if not cond:
+        raise CheckFailed(what)
+
+
+def now_stamp():
+    ns = time.time_ns()
+    return Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+
+
+def seconds(stamp):
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+def check_stamp(stamp, what):
+    check(0 <= stamp.nanosec < 1_000_000_000, f"{what}.nanosec = {stamp.nanosec}: not in [0, 1e9)")
+    age = time.time() - seconds(stamp)
+    check(-5.0 < age < 30.0, f"{what} = {seconds(stamp):.3f}: {age:.3f} s from the peer's clock")
+
+
+def check_header(h, what):
+    check(h.frame_id == WORLD, f"{what}.header.frame_id = {h.frame_id!r}, expected {WORLD!r}")
+    check_stamp(h.stamp, f"{what}.header.stamp")
+
+
+def finite(values, what):
+    values = list(values)
+    check(all(isinstance(v, float) and math.isfinite(v) for v in values), f"{what} not finite: {values}")
+
+
+def xyz(v):
+    return (v.x, v.y, v.z)
+
+
+def dist(a, b):
+    return math.dist(a, b)
+
+
+def check_identity(q, what):
+    finite((q.x, q.y, q.z, q.w), what)
+    check(abs(q.x) + abs(q.y) + abs(q.z) < 1e-9 and abs(q.w - 1.0) < 1e-9, f"{what} = {q}: not the identity")
+
+
+def check_point(p, what, seen):
+    """A MultiDOFJointTrajectoryPoint of one joint; returns its position."""
+    check(
+        len(p.transforms) == len(p.velocities) == len(p.accelerations) == 1,
+        f"{what}: {len(p.transforms)}/{len(p.velocities)}/{len(p.accelerations)} transforms/velocities/"
+        "accelerations, expected one each",
+    )
+    tr = p.transforms[0]
+    finite(xyz(tr.translation), f"{what}.translation")
+    check_identity(tr.rotation, f"{what}.rotation")
+    for name, tw, limit in (("velocity", p.velocities[0], 10.5), ("acceleration", p.accelerations[0], 40.0)):
+        finite(xyz(tw.linear) + xyz(tw.angular), f"{what}.{name}")
+        check(math.hypot(*xyz(tw.linear)) <= limit, f"{what}.{name} = {xyz(tw.linear)}: above {limit}")
+        check(xyz(tw.angular) == (0.0, 0.0, 0.0), f"{what}.{name}.angular = {xyz(tw.angular)}, expected 0")
+    check(0 <= p.time_from_start.nanosec < 1_000_000_000, f"{what}.time_from_start.nanosec out of range")
+    check(0 <= seconds(p.time_from_start) < 120.0, f"{what}.time_from_start = {seconds(p.time_from_start)}")
+    x = xyz(tr.translation)
+    check(all(lo - 1.0 <= c <= hi + 1.0 for c, lo, hi in zip(x, (0, 0, 0), (40, 20, 10))),
+          f"{what}.translation = {x}: outside the world")
+    return x
+
+
+def check_trajectory(m):
+    check_header(m.header, "trajectory")
+    check(list(m.joint_names) == [BODY], f"trajectory.joint_names = {m.joint_names}, expected [{BODY!r}]")
+    check(len(m.points) >= 2, f"trajectory: {len(m.points)} points")
+    last_t = -1.0
+    for k, p in enumerate(m.points):
+        check_point(p, f"trajectory.points[{k}]", None)
+        tk = seconds(p.time_from_start)
+        check(tk > last_t, f"trajectory.points[{k}].time_from_start = {tk} not after {last_t}")
+        last_t = tk
+    first = xyz(m.points[0].transforms[0].translation)
+    last = xyz(m.points[-1].transforms[0].translation)
+    check(dist(first, START) < 1.0, f"trajectory starts at {first}, the vehicle is at {START}")
+    check(dist(last, GOAL) < 1.0, f"trajectory ends at {last}, the goal is {GOAL}")
+    return f"{len(m.points)} points from {fmt(first)} to {fmt(last)} in {last_t:.2f} s"
+
+
+def check_path(m):
+    check_header(m.header, "path")
+    check(len(m.poses) >= 2, f"path: {len(m.poses)} poses")
+    for k, ps in enumerate(m.poses):
+        check_header(ps.header, f"path.poses[{k}]")
+        finite(xyz(ps.pose.position), f"path.poses[{k}].position")
+        check_identity(ps.pose.orientation, f"path.poses[{k}].orientation")
+    first, last = xyz(m.poses[0].pose.position), xyz(m.poses[-1].pose.position)
+    check(dist(first, START) < 1.0, f"path starts at {first}, the vehicle is at {START}")
+    check(dist(last, GOAL) < 1.0, f"path ends at {last}, the goal is {GOAL}")
+    return f"{len(m.poses)} poses from {fmt(first)} to {fmt(last)}"
+
+
+def check_setpoint(m):
+    check_header(m.header, "setpoint")
+    check(list(m.joint_names) == [BODY], f"setpoint.joint_names = {m.joint_names}")
+    check(len(m.points) == 1, f"setpoint: {len(m.points)} points, expected 1")
+    x = check_point(m.points[0], "setpoint.points[0]", None)
+    check(seconds(m.points[0].time_from_start) == 0.0, "setpoint.time_from_start is not 0")
+    check(dist(x, START) < 1.0, f"setpoint at {x}: the vehicle (held at {START}) is not there")
+    return f"at {fmt(x)}"
+
+
+def check_px4_setpoint(m):
+    # NED: north (ROS y), east (ROS x), down (-z).
+    check(m.timestamp > 0 and abs(m.timestamp * 1e-6 - time.time()) < 30.0,
+          f"px4 setpoint.timestamp = {m.timestamp} µs: not the ROS time")
+    for name in ("position", "velocity", "acceleration", "jerk"):
+        v = [float(c) for c in getattr(m, name)]
+        check(len(v) == 3, f"px4 setpoint.{name} has {len(v)} elements")
+        if name != "jerk":
+            finite(v, f"px4 setpoint.{name}")
+    ned = [float(c) for c in m.position]
+    expected = (START[1], START[0], -START[2])
+    check(dist(ned, expected) < 1.0, f"px4 setpoint.position = {ned}, expected near NED {expected}")
+    # The node holds ROS yaw 0 (facing east, ENU), which is PX4 yaw π/2 (from north, clockwise).
+    check(abs(float(m.yaw) - math.pi / 2) < 1e-3, f"px4 setpoint.yaw = {m.yaw}, expected π/2 (east)")
+    check(math.isfinite(m.yawspeed), f"px4 setpoint.yawspeed = {m.yawspeed}")
+    return f"NED {fmt(ned)}"
+
+
+def check_markers(m, state):
+    check(len(m.markers) >= 1, "markers: empty array")
+    first = m.markers[0]
+    check(first.action == MARKER_DELETEALL, f"markers[0].action = {first.action}, expected DELETEALL")
+    forecasts = {}
+    branches = 0
+    for k, mk in enumerate(m.markers):
+        what = f"markers[{k}]"
+        check_header(mk.header, what)
+        check(mk.texture_resource == "" and mk.text == "" and mk.mesh_resource == "" and
+              len(mk.texture.data) == 0 and len(mk.uv_coordinates) == 0 and len(mk.mesh_file.data) == 0
+              and not mk.mesh_use_embedded_materials and not mk.frame_locked,
+              f"{what}: texture/mesh fields not empty")
+        for c in ("r", "g", "b", "a"):
+            v = getattr(mk.color, c)
+            check(0.0 <= v <= 1.0, f"{what}.color.{c} = {v}")
+        if k == 0:
+            continue
+        check(mk.action == MARKER_ADD, f"{what}.action = {mk.action}, expected ADD")
+        check_identity(mk.pose.orientation, f"{what}.pose.orientation")
+        if mk.ns == "branches":
+            check(mk.type == MARKER_LINE_STRIP, f"{what}.type = {mk.type}, expected LINE_STRIP")
+            check(len(mk.points) >= 2, f"{what}: {len(mk.points)} points")
+            for p in mk.points:
+                finite(xyz(p), f"{what}.points")
+            check(abs(mk.scale.x - 0.05) < 1e-9, f"{what}.scale.x = {mk.scale.x}, expected 0.05")
+            branches += 1
+        elif mk.ns == "forecasts":
+            c = xyz(mk.pose.position)
+            finite(c + xyz(mk.scale), what)
+            forecasts[(mk.type, round(c[0]), round(c[1]), round(c[2]))] = mk
+        else:
+            raise CheckFailed(f"{what}.ns = {mk.ns!r}: expected 'branches' or 'forecasts'")
+    # Every obstacle sent is drawn where it was sent, of at least its size.
+    found = []
+    for oid, shape, size, pos in OBSTACLES:
+        kind = MARKER_SPHERE if shape == SHAPE_SPHERE else MARKER_CYLINDER
+        mk = next((v for (ty, *_), v in forecasts.items()
+                   if ty == kind and dist(xyz(v.pose.position), pos) < 0.5), None)
+        if mk is None:
+            continue
+        check(mk.scale.x >= size[0] - 1e-6 and abs(mk.scale.x - mk.scale.y) < 1e-9,
+              f"forecast of obstacle {oid}: scale {xyz(mk.scale)}, size sent {size}")
+        if shape == SHAPE_CYLINDER:
+            check(mk.scale.z >= size[2] - 1e-6, f"forecast of obstacle {oid}: height {mk.scale.z} < {size[2]}")
+        found.append(oid)
+    if branches >= 1 and len(found) == len(OBSTACLES):
+        state["markers_complete"] = True
+    return f"{branches} branches, forecasts of obstacles {found}"
+
+
+def check_event(m):
+    check_header(m.header, "events")
+    check(m.cycle_count >= 1, f"events.cycle_count = {m.cycle_count}")
+    check(math.isfinite(m.cycle_time_ms) and 0.0 <= m.cycle_time_ms < 60_000.0,
+          f"events.cycle_time_ms = {m.cycle_time_ms}")
+    check(isinstance(m.has_plan, bool) and isinstance(m.fallback, bool), "events: flags are not bools")
+    for e in m.events:
+        check(e.startswith("{") and e.endswith("}"), f"events.events: {e!r} is not a JSON object")
+    return f"cycle {m.cycle_count}, {m.cycle_time_ms:.1f} ms, has_plan {m.has_plan}, {len(m.events)} events"
+
+
+def fmt(v):
+    return "(" + ", ".join(f"{c:.2f}" for c in v) + ")"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--domain", type=int, required=True)
+    ap.add_argument("--px4", action="store_true", help="the node runs with --px4")
+    ap.add_argument("--timeout", type=float, default=40.0)
+    args = ap.parse_args()
+
+    dp = DomainParticipant(args.domain)
+    best_effort = Qos(Policy.Reliability.BestEffort, Policy.Durability.Volatile, Policy.History.KeepLast(10))
+    reliable = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.Volatile,
+                   Policy.History.KeepLast(10))
+
+    def writer(name, ty, qos):
+        return DataWriter(dp, Topic(dp, "rt/" + name, ty), qos=qos)
+
+    def reader(name, ty, qos):
+        return DataReader(dp, Topic(dp, "rt/" + name, ty), qos=qos)
+
+    odom_w = writer("odom", Odometry, best_effort)
+    goal_w = writer("goal", PoseStamped, reliable)  # as RViz's "2D Goal Pose"
+    obst_w = writer("obstacles", MovingObstacleArray, best_effort)
+
+    checks = {
+        "trajectory": (reader("trajectory", MultiDOFJointTrajectory, reliable), check_trajectory),
+        "path": (reader("path", Path, reliable), check_path),
+        "markers": (reader("markers", MarkerArray, reliable), None),
+        "events": (reader("events", PlannerEvent, reliable), check_event),
+    }
+    if args.px4:
+        checks["fmu/in/trajectory_setpoint"] = (
+            reader("fmu/in/trajectory_setpoint", TrajectorySetpoint, best_effort), check_px4_setpoint)
+    else:
+        checks["setpoint"] = (reader("setpoint", MultiDOFJointTrajectory, best_effort), check_setpoint)
+
+    state = {"markers_complete": False}
+    passed = {}
+    deadline = time.monotonic() + args.timeout
+    next_publish = time.monotonic()
+    while time.monotonic() < deadline:
+        if time.monotonic() >= next_publish:
+            stamp = now_stamp()
+            odom = Odometry(header=Header(stamp=stamp, frame_id=WORLD), child_frame_id=BODY)
+            odom.pose.pose.position = Point(*START)
+            # A yaw of 90°: the (zero) body-frame twist stays zero in the world.
+            odom.pose.pose.orientation = Quaternion(0.0, 0.0, math.sqrt(0.5), math.sqrt(0.5))
+            odom.pose.covariance = [0.01 if i % 7 == 0 else 0.0 for i in range(36)]
+            odom_w.write(odom)
+            goal_w.write(PoseStamped(header=Header(stamp=stamp, frame_id=WORLD),
+                                     pose=Pose(position=Point(*GOAL))))
+            obst_w.write(MovingObstacleArray(
+                header=Header(stamp=stamp, frame_id=WORLD),
+                obstacles=[MovingObstacle(id=i, shape=s, size=Vector3(*size), position=Point(*p),
+                                          covariance=[0.04 if k % 7 == 0 else 0.0 for k in range(36)])
+                           for i, s, size, p in OBSTACLES]))
+            next_publish += 0.1
+        for name, (rd, fn) in checks.items():
+            for sample in rd.take(N=50):
+                try:
+                    summary = check_markers(sample, state) if name == "markers" else fn(sample)
+                except CheckFailed as e:
+                    print(f"peer: FAILED {name}: {e}", file=sys.stderr)
+                    return 1
+                if name not in passed:
+                    print(f"peer: {name} ok: {summary}", file=sys.stderr)
+                passed[name] = summary
+        if len(passed) == len(checks) and state["markers_complete"]:
+            print(f"peer: markers complete: {passed['markers']}", file=sys.stderr)
+            print("peer: every check passed", file=sys.stderr)
+            return 0
+        time.sleep(0.01)
+    missing = [n for n in checks if n not in passed]
+    if not state["markers_complete"]:
+        missing.append("markers with a branch and both obstacles' forecasts")
+    print(f"peer: FAILED: nothing (valid) within {args.timeout} s from {missing}; received {sorted(passed)}",
+          file=sys.stderr)
+    return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

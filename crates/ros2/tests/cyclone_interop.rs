@@ -1,0 +1,150 @@
+//! `trust-node` against an independent DDS implementation: Eclipse Cyclone DDS through its
+//! Python binding (`interop/peer.py`, types written from the ROS 2 `.msg` files), over loopback
+//! on a ROS domain of the test's own. The peer publishes odometry, a goal and obstacles and
+//! checks every message type the node publishes field by field; a field laid out differently
+//! on the two sides fails here, where the loopback test (ros2-client on both ends) cannot see it.
+//!
+//! The Python interpreter is `$TRUST_CYCLONE_PYTHON` (else `python3`). Without the `cyclonedds`
+//! module the tests are skipped, unless `TRUST_REQUIRE_CYCLONE` is set (CI: `.ci/run` installs
+//! the pinned wheel of `interop/requirements.txt` into `target/cyclone-venv`).
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant};
+
+/// Cyclone DDS restricted to the loopback interface (multicast forced on `lo`, which Linux
+/// does not flag as multicast-capable, and unicast discovery of 127.0.0.1 as well).
+const CYCLONE_LOOPBACK: &str = "<CycloneDDS><Domain Id=\"any\"><General><Interfaces>\
+    <NetworkInterface name=\"lo\" multicast=\"true\"/></Interfaces>\
+    <AllowMulticast>true</AllowMulticast></General><Discovery>\
+    <ParticipantIndex>auto</ParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers>\
+    </Discovery></Domain></CycloneDDS>";
+
+/// How long the peer waits for every message type (a debug build on a loaded machine).
+const PEER_TIMEOUT_S: u64 = 60;
+
+fn crate_dir() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The interpreter with the `cyclonedds` module, or `None` when the tests may be skipped.
+fn cyclone_python() -> Option<PathBuf> {
+    let python = std::env::var_os("TRUST_CYCLONE_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("python3"));
+    let found = Command::new(&python)
+        .args(["-c", "import cyclonedds.idl"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if found {
+        return Some(python);
+    }
+    let why = format!(
+        "{} cannot import cyclonedds (pip install -r crates/ros2/interop/requirements.txt, \
+         then TRUST_CYCLONE_PYTHON=<that python>)",
+        python.display()
+    );
+    assert!(
+        std::env::var_os("TRUST_REQUIRE_CYCLONE").is_none(),
+        "TRUST_REQUIRE_CYCLONE is set but {why}"
+    );
+    eprintln!("SKIPPED: {why}");
+    None
+}
+
+/// A domain id in 21..=220 of this process and test (`k` < 2): parallel test processes, and
+/// the two tests of this one, do not meet.
+fn domain_id(k: u32) -> u16 {
+    ((std::process::id() % 100) * 2 + 21 + k) as u16
+}
+
+/// Waits for `child` at most `limit`, killing it after that (`None`).
+fn wait_at_most(child: &mut Child, limit: Duration) -> Option<ExitStatus> {
+    let deadline = Instant::now() + limit;
+    while Instant::now() < deadline {
+        if let Ok(Some(status)) = child.try_wait() {
+            return Some(status);
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    None
+}
+
+fn stderr_of(child: &mut Child) -> String {
+    let mut s = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = e.read_to_string(&mut s);
+    }
+    s
+}
+
+/// Runs `trust-node` (with `node_args`) and the Cyclone peer (with `peer_args`) on a domain of
+/// their own and fails with both logs unless the peer's checks pass.
+fn node_against_cyclone_peer(k: u32, node_args: &[&str], peer_args: &[&str]) {
+    let Some(python) = cyclone_python() else {
+        return;
+    };
+    let domain = domain_id(k).to_string();
+    let scenario = crate_dir().join("../../scenarios/quickstart.toml");
+    let mut node = Command::new(env!("CARGO_BIN_EXE_trust-node"))
+        .arg(&scenario)
+        .args(["--domain-id", &domain, "--until-stdin-closes"])
+        .args(node_args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start trust-node");
+    let started = Instant::now();
+    let mut peer = Command::new(&python)
+        .arg(crate_dir().join("interop/peer.py"))
+        .args([
+            "--domain",
+            &domain,
+            "--timeout",
+            &PEER_TIMEOUT_S.to_string(),
+        ])
+        .args(peer_args)
+        .env("CYCLONEDDS_URI", CYCLONE_LOOPBACK)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start the Cyclone DDS peer");
+    // The peer's stderr is read after it exits: its output is a few lines.
+    let peer_status = wait_at_most(&mut peer, Duration::from_secs(PEER_TIMEOUT_S + 20));
+    let peer_log = stderr_of(&mut peer);
+    drop(node.stdin.take()); // --until-stdin-closes: the node stops and prints its counters
+    let node_status = wait_at_most(&mut node, Duration::from_secs(10));
+    let node_log = stderr_of(&mut node);
+    eprintln!(
+        "domain {domain}, {:.1} s\n--- peer ---\n{peer_log}--- trust-node ---\n{node_log}",
+        started.elapsed().as_secs_f64()
+    );
+    assert!(
+        peer_status.is_some_and(|s| s.success()),
+        "the Cyclone DDS peer failed ({peer_status:?}); its log and the node's are above"
+    );
+    assert!(
+        node_status.is_some_and(|s| s.success()),
+        "trust-node did not stop cleanly when its stdin closed ({node_status:?})"
+    );
+    assert!(
+        node_log.contains(" 0 rejected"),
+        "the node rejected messages of the peer: {node_log}"
+    );
+}
+
+#[test]
+fn every_message_type_round_trips_with_cyclone_dds() {
+    node_against_cyclone_peer(0, &[], &[]);
+}
+
+#[test]
+fn px4_setpoints_decode_in_cyclone_dds() {
+    node_against_cyclone_peer(1, &["--px4"], &["--px4"]);
+}
