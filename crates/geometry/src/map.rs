@@ -835,7 +835,7 @@ mod tests {
             }
         }
 
-        /// The BVH cast equals the nearest hit over all shapes        /// The BVH cast equals the nearest hit over all shapes, and the point it reports lies on
+        /// The BVH cast equals the nearest hit over all shapes, and the point it reports lies on
         /// the surface.
         #[test]
         fn cast_ray_matches_brute_force(seed in 0u64..4, o in point_strategy(), az in 0.0f64..6.0, el in -1.5f64..1.5) {
