@@ -815,6 +815,26 @@ mod tests {
     proptest! {
         #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
 
+        /// The closed-form cylinder cast agrees with parry's GJK cast.
+        #[test]
+        fn closed_form_ray_cylinder_agrees_with_parry(
+            o in point_strategy(), az in 0.0f64..6.0, el in -1.5f64..1.5, r in 0.1f64..2.0, h in 0.1f64..3.0,
+        ) {
+            let c = Cylinder::new(v(10.0, 10.0, 5.0), r, h).unwrap();
+            let d = v(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+            let ours = crate::parry_conv::ray_cylinder_hit(&c, &o, &d, 30.0);
+            let gjk = crate::parry_conv::parry_ray_cylinder_hit(&c, &o, &d, 30.0);
+            match (ours, gjk) {
+                (Some(a), Some(b)) => prop_assert!((a - b).abs() < 1e-6, "{a} vs {b}"),
+                (None, None) => {}
+                // Grazing rays: both answers are within rounding of the surface.
+                (a, b) => {
+                    let t = a.or(b).unwrap();
+                    prop_assert!(Shape::from(c).signed_distance(&(o + d * t)).abs() < 1e-6, "{a:?} vs {b:?}");
+                }
+            }
+        }
+
         /// The BVH cast equals the nearest hit over all shapes, and the point it reports lies on
         /// the surface.
         #[test]

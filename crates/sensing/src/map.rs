@@ -7,7 +7,7 @@ use trust_geometry::{Aabb, Esdf, StaticMap, Vec3};
 use crate::distance::{DistanceField, KeyBox};
 use crate::error::{SensingError, check_count, check_range};
 use crate::occupancy::{LogOddsParams, VoxelState};
-use crate::ring::Ring;
+use crate::ring::{Ring, walk};
 use crate::scan::{ReturnKind, Scan};
 use crate::traversal::{VoxelKey, VoxelTraversal, voxel_key};
 
@@ -384,33 +384,28 @@ impl LocalMap {
             let Some((a, b)) = window.clip_segment(&o, &end) else {
                 continue;
             };
+            let (voxels, touched) = (&mut self.voxels, &mut self.touched);
             if self.params.stop_at_visited {
-                for k in VoxelTraversal::unchecked(&b, &a, res) {
-                    if !self.ring.contains(&k) {
-                        continue;
-                    }
-                    let slot = self.ring.slot(&k);
-                    let v = &mut self.voxels[slot];
+                walk(&self.ring, &b, &a, |slot, k| {
+                    let v = &mut voxels[slot];
                     if v.mark == miss {
-                        break;
+                        return false;
                     }
                     if v.mark != hit {
                         v.mark = miss;
-                        self.touched.push((slot, k));
+                        touched.push((slot, k));
                     }
-                }
+                    true
+                });
             } else {
-                for k in VoxelTraversal::unchecked(&a, &b, res) {
-                    if !self.ring.contains(&k) {
-                        continue;
-                    }
-                    let slot = self.ring.slot(&k);
-                    let v = &mut self.voxels[slot];
+                walk(&self.ring, &a, &b, |slot, k| {
+                    let v = &mut voxels[slot];
                     if v.mark != hit && v.mark != miss {
                         v.mark = miss;
-                        self.touched.push((slot, k));
+                        touched.push((slot, k));
                     }
-                }
+                    true
+                });
             }
         }
         let lo = self.params.log_odds;

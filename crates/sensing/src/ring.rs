@@ -2,7 +2,7 @@
 
 use trust_geometry::{Aabb, Vec3};
 
-use crate::traversal::VoxelKey;
+use crate::traversal::{VoxelKey, VoxelTraversal};
 
 /// A window of `dims` voxels whose low corner is the voxel `low`, stored in a fixed buffer: the
 /// voxel `k` lives in slot `(k mod dims)` per axis, so moving the window re-labels slots instead
@@ -72,5 +72,46 @@ impl Ring {
             (k[1] as f64 + 0.5) * self.res,
             (k[2] as f64 + 0.5) * self.res,
         )
+    }
+}
+
+/// Walks the voxels of the segment `[a, b]` (3-D DDA) that lie in the window, calling
+/// `visit(slot, key)` until it returns false; the slot is kept incrementally (no division per
+/// voxel).
+pub(crate) fn walk(
+    ring: &Ring,
+    a: &Vec3,
+    b: &Vec3,
+    mut visit: impl FnMut(usize, VoxelKey) -> bool,
+) {
+    let mut tr = VoxelTraversal::unchecked(a, b, ring.res);
+    let d = ring.dims;
+    let (lo, hi) = (ring.low, ring.high());
+    let mut key = tr.key();
+    let mut s = [
+        ring.axis_slot(0, key[0]),
+        ring.axis_slot(1, key[1]),
+        ring.axis_slot(2, key[2]),
+    ];
+    loop {
+        let inside = (0..3).all(|i| key[i] >= lo[i] && key[i] <= hi[i]);
+        if inside && !visit(s[0] + d[0] * (s[1] + d[1] * s[2]), key) {
+            return;
+        }
+        let Some((axis, step)) = tr.step() else {
+            return;
+        };
+        key[axis] += step;
+        s[axis] = if step > 0 {
+            if s[axis] + 1 == d[axis] {
+                0
+            } else {
+                s[axis] + 1
+            }
+        } else if s[axis] == 0 {
+            d[axis] - 1
+        } else {
+            s[axis] - 1
+        };
     }
 }

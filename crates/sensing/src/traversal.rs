@@ -111,14 +111,14 @@ impl VoxelTraversal {
     }
 }
 
-impl Iterator for VoxelTraversal {
-    type Item = VoxelKey;
+impl VoxelTraversal {
+    /// The current voxel (the first one before any step).
+    pub(crate) fn key(&self) -> VoxelKey {
+        self.key
+    }
 
-    fn next(&mut self) -> Option<VoxelKey> {
-        if !self.started {
-            self.started = true;
-            return Some(self.key);
-        }
+    /// Moves to the next voxel; returns the axis stepped and the step (±1), `None` at the end.
+    pub(crate) fn step(&mut self) -> Option<(usize, i64)> {
         // The axis whose next face comes first, among those with steps left.
         let mut axis = usize::MAX;
         let mut best = f64::INFINITY;
@@ -134,7 +134,19 @@ impl Iterator for VoxelTraversal {
         self.key[axis] += self.step[axis];
         self.t_max[axis] += self.t_delta[axis];
         self.remaining[axis] -= 1;
-        Some(self.key)
+        Some((axis, self.step[axis]))
+    }
+}
+
+impl Iterator for VoxelTraversal {
+    type Item = VoxelKey;
+
+    fn next(&mut self) -> Option<VoxelKey> {
+        if !self.started {
+            self.started = true;
+            return Some(self.key);
+        }
+        self.step().map(|_| self.key)
     }
 
     fn size_hint(&self) -> (usize, Option<usize>) {
