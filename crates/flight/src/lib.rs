@@ -729,8 +729,9 @@ fn cycle_record(
         })
         // A slice of a search still under way.
         || report.timing.route_ms > 0.0;
-    // A worker job was merged: its wall time is positive (a job always takes some).
+    // A worker job was merged, a route slice taken back: its wall time is positive.
     let merged = report.timing.worker_ms > 0.0;
+    let route_away = report.timing.route_worker_ms > 0.0;
     CycleRecord {
         t: report.t,
         wall_ms: time(report.timing.wall_ms),
@@ -760,7 +761,8 @@ fn cycle_record(
         charged_ms: None,
         overrun_ticks: None,
         worker_ms: merged.then(|| time(report.timing.worker_ms)),
-        waited_ms: merged.then(|| time(report.timing.waited_ms)),
+        waited_ms: (merged || route_away).then(|| time(report.timing.waited_ms)),
+        route_worker_ms: route_away.then(|| time(report.timing.route_worker_ms)),
     }
 }
 

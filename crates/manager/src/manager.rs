@@ -22,9 +22,9 @@ use crate::report::{
 use crate::safety::{
     SafetyVerdict, assess_trajectory, check_trajectory, forecasts_near, window_bounds,
 };
-use trust_route::{GlobalRoute, RoutePoint, RouteProgress, RouteSearch, UnreachableCause};
+use trust_route::{GlobalRoute, RoutePoint, RouteProgress, UnreachableCause};
 
-use crate::routing::{RouteReason, Router, rerouted, route_failed};
+use crate::routing::{RouteReason, Router, SearchSlot, rerouted, route_failed};
 
 mod worker;
 use worker::{Job, JobInput, JobOutput};
@@ -231,8 +231,9 @@ pub struct Manager<F, B, H> {
     /// Guide paths of the last exploration still to be solved
     /// ([`ManagerParams::cold_solves_per_cycle`]).
     deferred_guides: Vec<GuidePath>,
-    /// The route search under way, and why it started.
-    route_search: Option<(RouteReason, RouteSearch)>,
+    /// The route search under way, why it started, and where it is (here, or away for a slice
+    /// between cycles).
+    route_search: Option<(RouteReason, SearchSlot)>,
     /// The static map the scenes are built on, shared with the worker
     /// ([`Manager::share_map`]).
     shared_map: Option<Arc<StaticMap>>,
@@ -520,6 +521,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         let fallback = self.commit(main, &kept, &mut cycle, scene, &mut spans);
         self.branches = kept;
         let worker_started = self.start_job(now, &cycle, scene);
+        let route_away = self.send_route_away(scene);
         Ok(StepReport {
             t: now,
             replan_start: cycle.start,
@@ -535,7 +537,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             timing: spans.finish(),
             fallback,
             goal_unreachable: self.unreachable.clone(),
-            worker_started,
+            worker_started: worker_started || route_away,
         })
     }
 
@@ -679,6 +681,24 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         };
         let goal = *goal;
         let new_goal = self.routed_goal.is_none_or(|g| (g - goal).norm() > 1e-9);
+        // A search sent away for a slice between cycles comes back first (the cycle waits for
+        // it, so a seed is one flight); an answer it found is taken below, in place of a slice.
+        let mut away_answer = None;
+        if let Some((reason, slot)) = self.route_search.take() {
+            let waiting = Instant::now();
+            // A slice that panicked loses the search, as a job that panicked is dropped: the
+            // next stall or re-check starts another.
+            if let Some(back) = slot.take_back() {
+                if let Some(elapsed) = back.elapsed {
+                    spans.timing.waited_ms += ms(waiting.elapsed());
+                    spans.timing.route_worker_ms += ms(elapsed);
+                }
+                if !matches!(back.progress, RouteProgress::Pending) {
+                    away_answer = Some(back.progress);
+                }
+                self.route_search = Some((reason, SearchSlot::Here(back.search)));
+            }
+        }
         let searching = self.route_search.is_some();
         // While the stall lasts the route is planned again every horizon (a route that failed,
         // or one that leads into a dead end, is not kept for the rest of the flight); a verdict
@@ -703,8 +723,11 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             }
             self.routed_goal = Some(goal);
             self.routed_at = measured.t;
+            away_answer = None;
             match router.start(scene.map, &measured.p, &goal) {
-                Ok(search) => self.route_search = Some((reason, search)),
+                Ok(search) => {
+                    self.route_search = Some((reason, SearchSlot::Here(Box::new(search))))
+                }
                 Err(e) => {
                     self.route_search = None;
                     cycle.events.push(route_failed(reason, &e));
@@ -712,16 +735,23 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                 }
             }
         }
-        let Some((reason, search)) = self.route_search.as_mut() else {
+        let off_cycle = self.route_off_cycle(scene);
+        let Some((reason, SearchSlot::Here(search))) = self.route_search.as_mut() else {
             return;
         };
         let reason = *reason;
-        let progress = spans.time(Span::Route, || {
-            search.advance(scene.map, router.work_per_cycle())
-        });
-        let answer = match progress {
-            RouteProgress::Pending => return,
-            answer => answer,
+        let answer = match away_answer {
+            Some(answer) => answer,
+            // With a map the threads can read, every slice is done between cycles (this one
+            // is sent away as the cycle ends); else the cycle does a slice itself.
+            None if !off_cycle => {
+                let work = router.work_per_cycle();
+                match spans.time(Span::Route, || search.advance(scene.map, work)) {
+                    RouteProgress::Pending => return,
+                    answer => answer,
+                }
+            }
+            None => return,
         };
         self.route_search = None;
         let new_route = match answer {
@@ -903,6 +933,46 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         (out.explored, resolved)
     }
 
+    /// The static map shared with the threads that work between cycles, if `scene` is built on
+    /// it ([`Manager::share_map`]).
+    fn shared_map_for(&self, scene: &Scene<'_>) -> Option<Arc<StaticMap>> {
+        self.shared_map
+            .clone()
+            .filter(|m| std::ptr::eq(Arc::as_ptr(m), scene.map))
+    }
+
+    /// Whether a route search under way goes on between cycles ([`crate::routing`]): with
+    /// [`ManagerParams::background`] and the scene built on the shared map.
+    fn route_off_cycle(&self, scene: &Scene<'_>) -> bool {
+        self.params.background && self.shared_map_for(scene).is_some()
+    }
+
+    /// As a cycle ends, sends the route search under way away for a slice of
+    /// [`Router::work_off_cycle`] units between cycles ([`Manager::route_off_cycle`]); the next
+    /// cycle takes it back. Returns whether it did.
+    fn send_route_away(&mut self, scene: &Scene<'_>) -> bool {
+        let (Some(router), Some(map)) = (&self.router, self.shared_map_for(scene)) else {
+            return false;
+        };
+        if !self.params.background {
+            return false;
+        }
+        let work = router.work_off_cycle();
+        match self.route_search.take() {
+            Some((reason, SearchSlot::Here(search))) => match SearchSlot::away(search, map, work) {
+                Some(slot) => {
+                    self.route_search = Some((reason, slot));
+                    true
+                }
+                None => false,
+            },
+            other => {
+                self.route_search = other;
+                false
+            }
+        }
+    }
+
     /// Starts the worker on the next cycle's sub-branch re-solves and exploration
     /// ([`ManagerParams::background`]), from the next cycle's replan start as the committed plan
     /// predicts it one period (the last cycle interval) ahead; whether it started one.
@@ -918,10 +988,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         if !self.params.background || !self.params.history || self.main.is_none() {
             return false;
         }
-        let shared = self
-            .shared_map
-            .clone()
-            .filter(|m| std::ptr::eq(Arc::as_ptr(m), scene.map));
+        let shared = self.shared_map_for(scene);
         let period = Some(period).filter(|p| p.is_finite() && *p > 0.0);
         let (Some(map), Some(period), Some(plan)) = (shared, period, self.committed.as_ref())
         else {

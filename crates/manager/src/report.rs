@@ -398,6 +398,11 @@ pub struct CycleTiming {
     /// times are in `frontend_ms`, `backend_ms` and `checker_ms`.
     #[serde(default)]
     pub worker_ms: f64,
+    /// Wall time of the route-search slice taken back this cycle (done between the previous
+    /// cycle and this one on a thread of its own, off the critical path; [`crate::routing`]);
+    /// 0 when none. The slices a cycle does itself are in `route_ms`.
+    #[serde(default)]
+    pub route_worker_ms: f64,
 }
 
 impl CycleTiming {

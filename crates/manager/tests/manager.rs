@@ -1412,11 +1412,9 @@ fn with_a_route_a_wide_wall_ahead_is_flown_around_to_the_goal() {
     assert!(e.to_string().contains("route.radius_m"), "{e}");
 }
 
-/// Issue 31: a goal sealed inside a closed box. The route search proves it in a few cycles, the
-/// manager reports the verdict with its cause, plans toward the reachable point nearest the goal
-/// (outside the box) and keeps re-checking; the vehicle never enters the box's walls.
-#[test]
-fn a_sealed_goal_is_reported_unreachable_and_a_stop_is_held_outside() {
+/// A 40 × 20 × 10 m world with a closed box of 0.4 m walls around (24..28, 8..12, 2..5): a goal
+/// at its centre is sealed off.
+fn sealed_box_map() -> StaticMap {
     let bounds = Aabb::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(40.0, 20.0, 10.0)).unwrap();
     let (lo, hi, t) = (Vec3::new(24.0, 8.0, 2.0), Vec3::new(28.0, 12.0, 5.0), 0.4);
     let slab = |a: Vec3, b: Vec3| Shape::AaBox(AaBox::new(a, b).unwrap());
@@ -1440,7 +1438,65 @@ fn a_sealed_goal_is_reported_unreachable_and_a_stop_is_held_outside() {
         slab(Vec3::new(lo.x, lo.y - t, lo.z), Vec3::new(hi.x, lo.y, hi.z)),
         slab(Vec3::new(lo.x, hi.y, lo.z), Vec3::new(hi.x, hi.y + t, hi.z)),
     ];
-    let map = StaticMap::from_shapes(bounds, walls).unwrap();
+    StaticMap::from_shapes(bounds, walls).unwrap()
+}
+
+/// Issue 31: with the map shared with the manager's threads, the route search goes on between
+/// cycles on a thread of its own: no cycle does route work itself, the verdict is the one the
+/// in-cycle slices reach (one cycle later at most: the first slice is done after the cycle that
+/// starts the search, and every slice between cycles does more work), and two flights of
+/// the same seed are the same flight (each cycle waits for the slice).
+#[test]
+fn with_a_shared_map_the_route_search_runs_between_cycles() {
+    let map = std::sync::Arc::new(sealed_box_map());
+    let (start, goal) = (Vec3::new(3.0, 10.0, 3.5), Vec3::new(26.0, 10.0, 3.5));
+    let run = |share: bool| {
+        let mut m = planner(ManagerParams::trust());
+        m.set_router(Some(
+            trust_manager::Router::new(trust_route::RouteParams::default(), 0.3).unwrap(),
+        ));
+        if share {
+            m.share_map(std::sync::Arc::clone(&map));
+        }
+        fly(&mut m, &map, goal, State::at_rest(0.0, start), 30, |_| {
+            Vec::new()
+        })
+    };
+    let verdict = |reports: &[StepReport]| {
+        let i = reports
+            .iter()
+            .position(|r| r.goal_unreachable().is_some())
+            .expect("a verdict");
+        (i, reports[i].goal_unreachable().unwrap().clone())
+    };
+    let here = run(false);
+    let away = run(true);
+    let (i_here, u_here) = verdict(&here);
+    let (i_away, u_away) = verdict(&away);
+    assert_eq!(u_here.cause, u_away.cause);
+    assert_eq!(u_here.held_at, u_away.held_at);
+    assert!(i_away <= i_here + 1, "{i_away} cycles away, {i_here} here");
+    assert!(here[..=i_here].iter().all(|r| r.timing.route_ms > 0.0));
+    assert!(away.iter().all(|r| r.timing.route_ms == 0.0));
+    assert!(
+        away[1..=i_away]
+            .iter()
+            .all(|r| r.timing.route_worker_ms > 0.0)
+    );
+    assert!(away[..i_away].iter().all(|r| r.worker_started));
+    let again = run(true);
+    assert_eq!(verdict(&again).0, i_away);
+    for (a, b) in away.iter().zip(&again) {
+        assert_eq!(a.replan_start.p, b.replan_start.p, "t = {}", a.t);
+    }
+}
+
+/// Issue 31: a goal sealed inside a closed box. The route search proves it in a few cycles, the
+/// manager reports the verdict with its cause, plans toward the reachable point nearest the goal
+/// (outside the box) and keeps re-checking; the vehicle never enters the box's walls.
+#[test]
+fn a_sealed_goal_is_reported_unreachable_and_a_stop_is_held_outside() {
+    let map = sealed_box_map();
     let (start, goal) = (Vec3::new(3.0, 10.0, 3.5), Vec3::new(26.0, 10.0, 3.5));
     let mut m = planner(ManagerParams::trust());
     m.set_router(Some(

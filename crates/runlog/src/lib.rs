@@ -276,6 +276,12 @@ pub struct CycleRecord {
     /// (ms). The real-time clock charges `wall_ms − waited_ms` plus the job's lateness.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub waited_ms: Option<f64>,
+    /// Added (issue 31), only in cycles that took back a route search sent away for a slice
+    /// between cycles (on a thread of its own, off the critical path): the slice's wall time
+    /// (ms; not part of `wall_ms`, its wait is in `waited_ms`). The real-time clock charges the
+    /// later of the job's and the slice's lateness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub route_worker_ms: Option<f64>,
 }
 
 /// One kept branch's trajectory, sampled (added, issue 20).
@@ -844,6 +850,7 @@ mod tests {
             overrun_ticks: None,
             worker_ms: None,
             waited_ms: None,
+            route_worker_ms: None,
         }
     }
 

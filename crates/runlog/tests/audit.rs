@@ -95,6 +95,7 @@ fn cycle(t: f64) -> CycleRecord {
         overrun_ticks: None,
         worker_ms: None,
         waited_ms: None,
+        route_worker_ms: None,
     }
 }
 
