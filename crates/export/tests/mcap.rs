@@ -294,28 +294,15 @@ fn without_branches_there_is_no_branch_channel_and_a_log_file_exports() {
                 main: Some(1),
                 branches: 1,
                 events: vec![],
-                frontend_ms: 0.0,
-                backend_ms: 0.0,
-                checker_ms: 0.0,
                 solve_count: 1,
                 effective_t: t,
                 branch_j: vec![1.0],
-                fallback_collision_free: None,
-                fallback_shortfall_m: None,
-                fallback_along: None,
                 dropped: Default::default(),
-                route: None,
-                route_ms: None,
                 branch_samples: Some(vec![BranchSamples {
                     id: 1,
                     samples: vec![[t, 1.0, 1.0, 1.0], [t + 1.0, 2.0, 1.5, 1.0]],
                 }]),
-                forecasts: None,
-                charged_ms: None,
-                overrun_ticks: None,
-                worker_ms: None,
-                waited_ms: None,
-                route_worker_ms: None,
+                ..CycleRecord::default()
             }
         })
         .collect();

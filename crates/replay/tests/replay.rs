@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use trust_replay::{GifParams, ReplayError, ReplayParams, browser, write_replay};
 use trust_runlog::{
-    Bounds, BranchSamples, CycleRecord, Dropped, ForecastRecord, ForecastShape, Header, LimitsInfo,
+    Bounds, BranchSamples, CycleRecord, ForecastRecord, ForecastShape, Header, LimitsInfo,
     LogWriter, ObstacleInfo, ObstacleKind, Outcome, Record, SCHEMA, StateRecord, StaticShape,
     Status, VehicleInfo,
 };
@@ -115,18 +115,10 @@ fn write_log(path: &Path, t_end: f64, with_branches: bool) {
                 main: if k == 50 { None } else { Some(1) },
                 branches: 2,
                 events,
-                frontend_ms: 0.0,
-                backend_ms: 0.0,
-                checker_ms: 0.0,
                 solve_count: 2,
                 effective_t: t + 0.02,
                 branch_j: vec![1.0, 2.0],
                 fallback_collision_free: (k == 50).then_some(true),
-                fallback_shortfall_m: None,
-                fallback_along: None,
-                dropped: Dropped::default(),
-                route: None,
-                route_ms: None,
                 branch_samples: with_branches.then(|| {
                     vec![
                         BranchSamples {
@@ -165,11 +157,7 @@ fn write_log(path: &Path, t_end: f64, with_branches: bool) {
                         },
                     ]
                 }),
-                charged_ms: None,
-                overrun_ticks: None,
-                worker_ms: None,
-                waited_ms: None,
-                route_worker_ms: None,
+                ..CycleRecord::default()
             }))
             .unwrap();
         }

@@ -63,7 +63,21 @@ fn e4_shapes(seed: u64, wall: bool) -> Result<Vec<Shape>, GeometryError> {
 /// # Errors
 /// None for a positive `half` above 0.3 m; the box constructor's error is passed on.
 pub fn closed_box(centre: Vec3, half: f64) -> Result<Vec<Shape>, GeometryError> {
-    let t = 0.3;
+    box_with_hole(centre, half, 0.3, 0.0)
+}
+
+/// The walls (`t` thick) of a box of outer half-size `half` around `centre`, with a square hole
+/// of side `hole` in the middle of its +x wall (none when `hole` is 0): the +x wall is then four
+/// pieces around the hole.
+///
+/// # Errors
+/// None for `half > t > 0` and `hole < 2 (half - t)`; the box constructor's error is passed on.
+pub fn box_with_hole(
+    centre: Vec3,
+    half: f64,
+    t: f64,
+    hole: f64,
+) -> Result<Vec<Shape>, GeometryError> {
     let (lo, hi) = (centre - Vec3::repeat(half), centre + Vec3::repeat(half));
     let mut out = Vec::new();
     for a in 0..3 {
@@ -73,6 +87,20 @@ pub fn closed_box(centre: Vec3, half: f64) -> Result<Vec<Shape>, GeometryError> 
                 min[a] = hi[a] - t;
             } else {
                 max[a] = lo[a] + t;
+            }
+            if a == 0 && far && hole > 0.0 {
+                let (y0, y1) = (centre.y - hole / 2.0, centre.y + hole / 2.0);
+                let (z0, z1) = (centre.z - hole / 2.0, centre.z + hole / 2.0);
+                for (ylo, yhi, zlo, zhi) in [
+                    (min.y, y0, min.z, max.z),
+                    (y1, max.y, min.z, max.z),
+                    (y0, y1, min.z, z0),
+                    (y0, y1, z1, max.z),
+                ] {
+                    let (p, q) = (Vec3::new(min.x, ylo, zlo), Vec3::new(max.x, yhi, zhi));
+                    out.push(AaBox::new(p, q)?.into());
+                }
+                continue;
             }
             out.push(AaBox::new(min, max)?.into());
         }

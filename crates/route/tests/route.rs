@@ -6,7 +6,7 @@ use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use trust_geometry::{AaBox, Aabb, Cylinder, Shape, StaticMap, Vec3};
-use trust_route::scenes::crazyflie_room;
+use trust_route::scenes::{box_with_hole, crazyflie_room, sealed_goal_room};
 use trust_route::{
     Endpoint, GlobalRoute, RouteError, RouteParams, RoutePlanner, RouteProgress, Unreachable,
     UnreachableCause,
@@ -599,35 +599,9 @@ fn unreachable(p: &RouteProgress) -> &Unreachable {
     }
 }
 
-/// A closed box of 0.3 m walls around `centre` (outer half-size `half`).
-fn closed_box(centre: Vec3, half: f64) -> Vec<Shape> {
-    let t = 0.3;
-    let (lo, hi) = (centre - Vec3::repeat(half), centre + Vec3::repeat(half));
-    let mut out = Vec::new();
-    for a in 0..3 {
-        for side in [false, true] {
-            let (mut min, mut max) = (lo, hi);
-            if side {
-                min[a] = hi[a] - t;
-            } else {
-                max[a] = lo[a] + t;
-            }
-            out.push(AaBox::new(min, max).unwrap().into());
-        }
-    }
-    out
-}
-
-/// A 60 × 20 × 10 m room, the goal sealed in a closed 4 m box 35 m from the start.
-fn sealed_room() -> (StaticMap, Vec3, Vec3) {
-    let goal = Vec3::new(40.0, 10.0, 5.0);
-    let map = StaticMap::from_shapes(bounds([60.0, 20.0, 10.0]), closed_box(goal, 2.0)).unwrap();
-    (map, Vec3::new(5.0, 10.0, 5.0), goal)
-}
-
 #[test]
 fn a_sealed_goal_gets_its_verdict_in_a_few_thousand_units() {
-    let (map, s, g) = sealed_room();
+    let (map, s, g) = sealed_goal_room().unwrap();
     let (p, work) = run_sliced(&map, s, g, 0.3, usize::MAX);
     let u = unreachable(&p);
     assert_eq!(u.cause, UnreachableCause::SealedOff, "{}", u.cause);
@@ -657,7 +631,7 @@ fn a_sealed_goal_gets_its_verdict_in_a_few_thousand_units() {
 
 #[test]
 fn the_answer_does_not_depend_on_how_the_work_is_sliced() {
-    let (sealed, s1, g1) = sealed_room();
+    let (sealed, s1, g1) = sealed_goal_room().unwrap();
     let wall = wide_wall();
     let (s2, g2) = (Vec3::new(2.0, 30.0, 5.0), Vec3::new(100.0, 30.0, 5.0));
     let (slot, s3, g3) = slot_world(SlotAxis::Y, 0.58, 2.0);
@@ -962,40 +936,6 @@ proptest! {
     }
 }
 
-/// A box around `centre` (outer half-size `half`, walls `t` thick) with a square hole of side
-/// `hole` in its +x wall (none when `hole` is 0).
-fn box_with_hole(centre: Vec3, half: f64, t: f64, hole: f64) -> Vec<Shape> {
-    let (lo, hi) = (centre - Vec3::repeat(half), centre + Vec3::repeat(half));
-    let mut out: Vec<Shape> = Vec::new();
-    for a in 0..3 {
-        for side in [false, true] {
-            let (mut min, mut max) = (lo, hi);
-            if side {
-                min[a] = hi[a] - t;
-            } else {
-                max[a] = lo[a] + t;
-            }
-            if a == 0 && side && hole > 0.0 {
-                // The +x wall in four pieces around the hole.
-                let (y0, y1) = (centre.y - hole / 2.0, centre.y + hole / 2.0);
-                let (z0, z1) = (centre.z - hole / 2.0, centre.z + hole / 2.0);
-                for (ylo, yhi, zlo, zhi) in [
-                    (min.y, y0, min.z, max.z),
-                    (y1, max.y, min.z, max.z),
-                    (y0, y1, min.z, z0),
-                    (y0, y1, z1, max.z),
-                ] {
-                    let (p, q) = (Vec3::new(min.x, ylo, zlo), Vec3::new(max.x, yhi, zhi));
-                    out.push(AaBox::new(p, q).unwrap().into());
-                }
-                continue;
-            }
-            out.push(AaBox::new(min, max).unwrap().into());
-        }
-    }
-    out
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(
         std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(8)
@@ -1015,7 +955,7 @@ proptest! {
         side in any::<bool>(),
     ) {
         let centre = Vec3::new(7.0, 3.0, 3.0);
-        let map = StaticMap::from_shapes(bounds([10.0, 6.0, 6.0]), box_with_hole(centre, half, t, hole)).unwrap();
+        let map = StaticMap::from_shapes(bounds([10.0, 6.0, 6.0]), box_with_hole(centre, half, t, hole).unwrap()).unwrap();
         let outside = Vec3::new(1.5, 3.0, 3.0);
         let (s, g) = if side { (outside, centre) } else { (centre, outside) };
         let answer = planner().plan(&map, &s, &g, r);

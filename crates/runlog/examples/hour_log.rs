@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use trust_runlog::audit::{AuditOptions, audit_file};
 use trust_runlog::{
-    Bounds, BranchSamples, CycleRecord, Dropped, ForecastRecord, ForecastShape, Header, LimitsInfo,
+    Bounds, BranchSamples, CycleRecord, ForecastRecord, ForecastShape, Header, LimitsInfo,
     LogWriter, ObstacleInfo, ObstacleKind, Outcome, Record, SCHEMA, StateRecord, Status,
     VehicleInfo,
 };
@@ -120,12 +120,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 solve_count: 2,
                 effective_t: t + 0.1,
                 branch_j: vec![1.0, 2.0],
-                fallback_collision_free: None,
-                fallback_shortfall_m: None,
-                fallback_along: None,
-                dropped: Dropped::default(),
-                route: None,
-                route_ms: None,
                 branch_samples: Some(vec![branch(1, 0.0), branch(2, 0.01 * TAU)]),
                 forecasts: Some(
                     (0..k)
@@ -142,11 +136,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         })
                         .collect(),
                 ),
-                charged_ms: None,
-                overrun_ticks: None,
-                worker_ms: None,
-                waited_ms: None,
-                route_worker_ms: None,
+                ..CycleRecord::default()
             }))?;
         }
     }

@@ -199,8 +199,9 @@ pub struct StateRecord {
     pub obstacles: Vec<[f64; 3]>,
 }
 
-/// One planning cycle.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// One planning cycle. `Default` is an empty cycle at `t = 0` (every added field absent), for
+/// building records with `..CycleRecord::default()`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct CycleRecord {
     /// Time of the cycle (s).
     pub t: f64,
@@ -838,19 +839,7 @@ mod tests {
             solve_count: 2,
             effective_t: t + 0.1,
             branch_j: vec![1.0, 2.0],
-            fallback_collision_free: None,
-            fallback_shortfall_m: None,
-            fallback_along: None,
-            dropped: Dropped::default(),
-            route: None,
-            route_ms: None,
-            branch_samples: None,
-            forecasts: None,
-            charged_ms: None,
-            overrun_ticks: None,
-            worker_ms: None,
-            waited_ms: None,
-            route_worker_ms: None,
+            ..CycleRecord::default()
         }
     }
 

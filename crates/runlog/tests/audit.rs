@@ -6,8 +6,8 @@ use std::time::Instant;
 
 use trust_runlog::audit::{AuditOptions, audit, audit_file};
 use trust_runlog::{
-    Bounds, CycleRecord, Dropped, Header, LimitsInfo, LogError, LogWriter, ObstacleInfo,
-    ObstacleKind, Outcome, Record, RunLog, SCHEMA, StateRecord, Status, VehicleInfo,
+    Bounds, CycleRecord, Header, LimitsInfo, LogError, LogWriter, ObstacleInfo, ObstacleKind,
+    Outcome, Record, RunLog, SCHEMA, StateRecord, Status, VehicleInfo,
 };
 
 /// A fresh folder for one test.
@@ -82,20 +82,7 @@ fn cycle(t: f64) -> CycleRecord {
         checker_ms: 0.0,
         solve_count: 0,
         effective_t: t,
-        branch_j: Vec::new(),
-        fallback_collision_free: None,
-        fallback_shortfall_m: None,
-        fallback_along: None,
-        dropped: Dropped::default(),
-        route: None,
-        route_ms: None,
-        branch_samples: None,
-        forecasts: None,
-        charged_ms: None,
-        overrun_ticks: None,
-        worker_ms: None,
-        waited_ms: None,
-        route_worker_ms: None,
+        ..CycleRecord::default()
     }
 }
 
