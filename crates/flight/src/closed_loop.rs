@@ -68,17 +68,18 @@ impl Clock {
 /// not charged (a flight in real time would not have waited for a job done by then) but the
 /// worker's lateness is: the job started at `worker_since` and ran `worker_ms` (scaled by
 /// `cpu_scale`, on a core of its own), so its results were ready no earlier than that. A route
-/// slice done between cycles (`route_worker_ms`) started at the same time on a thread of its
-/// own: the later of the two counts.
+/// slice done between cycles is not waited for: the manager takes its answer only once it is
+/// due ([`trust_manager::ManagerParams::real_time_scale`]).
 pub fn charged_for(clock: Clock, timing: &CycleTiming, worker_since: Option<f64>, t: f64) -> f64 {
     match clock {
         Clock::Fixed { .. } => clock.charged_s(timing.wall_ms),
         Clock::RealTime { cpu_scale } => {
             let own = clock.charged_s(timing.wall_ms - timing.waited_ms);
-            let away_ms = timing.worker_ms.max(timing.route_worker_ms);
-            let late = worker_since.filter(|_| away_ms > 0.0).map_or(0.0, |since| {
-                (since + away_ms * 1e-3 * cpu_scale - t).max(0.0)
-            });
+            let late = worker_since
+                .filter(|_| timing.worker_ms > 0.0)
+                .map_or(0.0, |since| {
+                    (since + timing.worker_ms * 1e-3 * cpu_scale - t).max(0.0)
+                });
             own + late
         }
     }

@@ -599,6 +599,7 @@ pub fn real_time_planner(planner: &ResolvedPlanner, cpu_scale: f64) -> ResolvedP
     let mut p = planner.clone();
     p.reproducible = false;
     p.manager.enforce_budget = true;
+    p.manager.real_time_scale = Some(cpu_scale);
     p.manager.cycle_budget_ms /= cpu_scale;
     match &mut p.frontend {
         FrontendSpec::DevPrm(x) => x.budget_ms /= cpu_scale,

@@ -24,7 +24,7 @@ use crate::safety::{
 };
 use trust_route::{GlobalRoute, RoutePoint, RouteProgress, UnreachableCause};
 
-use crate::routing::{RouteReason, Router, SearchSlot, rerouted, route_failed};
+use crate::routing::{RouteReason, Router, SearchSlot, TakenBack, rerouted, route_failed};
 
 mod worker;
 use worker::{Job, JobInput, JobOutput};
@@ -521,7 +521,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         let fallback = self.commit(main, &kept, &mut cycle, scene, &mut spans);
         self.branches = kept;
         let worker_started = self.start_job(now, &cycle, scene);
-        let route_away = self.send_route_away(scene);
+        let route_away = self.send_route_away(now, &spans, scene);
         Ok(StepReport {
             t: now,
             replan_start: cycle.start,
@@ -686,17 +686,26 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         let mut away_answer = None;
         if let Some((reason, slot)) = self.route_search.take() {
             let waiting = Instant::now();
-            // A slice that panicked loses the search, as a job that panicked is dropped: the
-            // next stall or re-check starts another.
-            if let Some(back) = slot.take_back() {
-                if let Some(elapsed) = back.elapsed {
-                    spans.timing.waited_ms += ms(waiting.elapsed());
-                    spans.timing.route_worker_ms += ms(elapsed);
+            let joined = matches!(slot, SearchSlot::Away { .. });
+            let back = slot.take_back(measured.t, self.params.real_time_scale);
+            if joined {
+                spans.timing.waited_ms += ms(waiting.elapsed());
+            }
+            match back {
+                TakenBack::Here(search) => {
+                    self.route_search = Some((reason, SearchSlot::Here(search)));
                 }
-                if !matches!(back.progress, RouteProgress::Pending) {
-                    away_answer = Some(back.progress);
+                TakenBack::Sliced(slice) => {
+                    spans.timing.route_worker_ms += ms(slice.elapsed);
+                    if !matches!(slice.progress, RouteProgress::Pending) {
+                        away_answer = Some(slice.progress);
+                    }
+                    self.route_search = Some((reason, SearchSlot::Here(slice.search)));
                 }
-                self.route_search = Some((reason, SearchSlot::Here(back.search)));
+                TakenBack::NotYet(slot) => self.route_search = Some((reason, slot)),
+                // A slice that panicked loses the search, as a job that panicked is dropped:
+                // the next stall or re-check starts another.
+                TakenBack::Lost => {}
             }
         }
         let searching = self.route_search.is_some();
@@ -950,7 +959,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     /// As a cycle ends, sends the route search under way away for a slice of
     /// [`Router::work_off_cycle`] units between cycles ([`Manager::route_off_cycle`]); the next
     /// cycle takes it back. Returns whether it did.
-    fn send_route_away(&mut self, scene: &Scene<'_>) -> bool {
+    fn send_route_away(&mut self, now: f64, spans: &Spans, scene: &Scene<'_>) -> bool {
         let (Some(router), Some(map)) = (&self.router, self.shared_map_for(scene)) else {
             return false;
         };
@@ -958,14 +967,22 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             return false;
         }
         let work = router.work_off_cycle();
+        // The slice starts as this cycle ends: on the flight's clock, its charged time later.
+        let sent_at = now
+            + self
+                .params
+                .real_time_scale
+                .map_or(0.0, |x| spans.started.elapsed().as_secs_f64() * x);
         match self.route_search.take() {
-            Some((reason, SearchSlot::Here(search))) => match SearchSlot::away(search, map, work) {
-                Some(slot) => {
-                    self.route_search = Some((reason, slot));
-                    true
+            Some((reason, SearchSlot::Here(search))) => {
+                match SearchSlot::away(search, map, work, sent_at) {
+                    Some(slot) => {
+                        self.route_search = Some((reason, slot));
+                        true
+                    }
+                    None => false,
                 }
-                None => false,
-            },
+            }
             other => {
                 self.route_search = other;
                 false

@@ -149,6 +149,13 @@ pub struct ManagerParams {
     /// starts from the committed trajectory at `now + latency` so consecutive plans join
     /// continuously. `None`: the cycle budget.
     pub latency_s: Option<f64>,
+    /// How the cycles take back the route search's slices between cycles ([`crate::routing`]).
+    /// `None` (default): each cycle waits for the slice, so a seed is one flight. `Some(x)`: the
+    /// flight runs in real time on a computer `x` times slower than this one (the simulator's
+    /// real-time mode): a slice's answer takes effect only at the first cycle by which its
+    /// measured time × `x` has passed since it was sent away, on the flight's clock (`now`), as
+    /// on a vehicle whose planning cycle never blocks on the route's thread.
+    pub real_time_scale: Option<f64>,
     /// When the measured state has drifted this far from the committed trajectory, the replan
     /// starts from the measured state instead ([`ReanchorParams`]).
     pub reanchor: ReanchorParams,
@@ -212,6 +219,7 @@ impl ManagerParams {
             cycle_budget_ms: 50.0,
             enforce_budget: true,
             latency_s: None,
+            real_time_scale: None,
             reanchor: ReanchorParams::default(),
             hysteresis: 0.75,
             goal_reached_m: 0.05,
@@ -341,6 +349,9 @@ impl ManagerParams {
         check_non_negative("manager.goal_reached_m", self.goal_reached_m)?;
         self.progress.validate()?;
         check_positive("manager.cycle_budget_ms", self.cycle_budget_ms)?;
+        if let Some(x) = self.real_time_scale {
+            check_positive("manager.real_time_scale", x)?;
+        }
         if let Some(l) = self.latency_s {
             check_non_negative("manager.latency_s", l)?;
         }

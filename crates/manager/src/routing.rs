@@ -175,32 +175,49 @@ impl RouteReason {
     }
 }
 
-/// Where a search under way is: with the manager, or on a thread doing a slice of it between
-/// two cycles.
+/// Where a search under way is: with the manager, on a thread doing a slice of it between two
+/// cycles, or back from a slice whose answer is not due yet
+/// ([`crate::ManagerParams::real_time_scale`]).
 pub(crate) enum SearchSlot {
     /// With the manager, between slices (boxed: a search is large, a handle small).
     Here(Box<RouteSearch>),
-    /// On its thread; the next cycle takes it back ([`SearchSlot::take_back`]).
-    Away(JoinHandle<Slice>),
+    /// On its thread since the flight time `sent_at` (s).
+    Away {
+        handle: JoinHandle<Slice>,
+        sent_at: f64,
+    },
+    /// Back from its thread, its answer due at the flight time `due` (s).
+    Done { slice: Slice, due: f64 },
 }
 
-/// A search taken back ([`SearchSlot::take_back`]): with the progress and wall time of the
-/// slice done away (`Pending` and `None` for a search that was here).
+/// A slice done between cycles: the search, its progress and the slice's wall time.
 pub(crate) struct Slice {
     pub(crate) search: Box<RouteSearch>,
     pub(crate) progress: RouteProgress,
-    /// The slice's wall time; `None` for a search that was here.
-    pub(crate) elapsed: Option<Duration>,
+    pub(crate) elapsed: Duration,
+}
+
+/// What [`SearchSlot::take_back`] found.
+pub(crate) enum TakenBack {
+    /// The search was here.
+    Here(Box<RouteSearch>),
+    /// A slice done away, its answer due by now.
+    Sliced(Slice),
+    /// A slice whose answer is not due yet: the slot to keep.
+    NotYet(SearchSlot),
+    /// The slice panicked: the search is lost (the next stall or re-check starts another).
+    Lost,
 }
 
 impl SearchSlot {
-    /// Sends `search` to a thread of its own for `work` units on `map`; `None` if the thread
-    /// could not be started (the search is then lost: the next stall or re-check starts
-    /// another).
+    /// Sends `search` to a thread of its own for `work` units on `map` at the flight time
+    /// `sent_at`; `None` if the thread could not be started (the search is then lost: the next
+    /// stall or re-check starts another).
     pub(crate) fn away(
         mut search: Box<RouteSearch>,
         map: Arc<StaticMap>,
         work: usize,
+        sent_at: f64,
     ) -> Option<Self> {
         std::thread::Builder::new()
             .name("trust-manager-route".into())
@@ -210,23 +227,37 @@ impl SearchSlot {
                 Slice {
                     search,
                     progress,
-                    elapsed: Some(started.elapsed()),
+                    elapsed: started.elapsed(),
                 }
             })
             .ok()
-            .map(SearchSlot::Away)
+            .map(|handle| SearchSlot::Away { handle, sent_at })
     }
 
-    /// The search back (waiting for a slice done away); `None` if the slice panicked (the
-    /// search is then lost, as for a thread that could not start).
-    pub(crate) fn take_back(self) -> Option<Slice> {
-        match self {
-            SearchSlot::Here(search) => Some(Slice {
-                search,
-                progress: RouteProgress::Pending,
-                elapsed: None,
-            }),
-            SearchSlot::Away(handle) => handle.join().ok(),
+    /// Takes the search back at the flight time `now`, waiting for a slice done away. With a
+    /// real-time scale `x` ([`crate::ManagerParams::real_time_scale`]) a slice's answer is due
+    /// `x` times its wall time after it was sent away; without one it is due at once.
+    pub(crate) fn take_back(self, now: f64, real_time_scale: Option<f64>) -> TakenBack {
+        let slice = match self {
+            SearchSlot::Here(search) => return TakenBack::Here(search),
+            SearchSlot::Done { slice, due } => return Self::when_due(slice, due, now),
+            SearchSlot::Away { handle, sent_at } => match handle.join() {
+                Ok(slice) => (slice, sent_at),
+                Err(_) => return TakenBack::Lost,
+            },
+        };
+        let (slice, sent_at) = slice;
+        let due = real_time_scale.map_or(f64::NEG_INFINITY, |x| {
+            sent_at + slice.elapsed.as_secs_f64() * x
+        });
+        Self::when_due(slice, due, now)
+    }
+
+    fn when_due(slice: Slice, due: f64, now: f64) -> TakenBack {
+        if due <= now {
+            TakenBack::Sliced(slice)
+        } else {
+            TakenBack::NotYet(SearchSlot::Done { slice, due })
         }
     }
 }

@@ -1489,6 +1489,34 @@ fn with_a_shared_map_the_route_search_runs_between_cycles() {
     for (a, b) in away.iter().zip(&again) {
         assert_eq!(a.replan_start.p, b.replan_start.p, "t = {}", a.t);
     }
+
+    // In real time on a computer a million times slower, a slice's answer is not due within
+    // the flight: the cycles go on without it (and never wait for another slice).
+    let mut m = planner(ManagerParams {
+        real_time_scale: Some(1e6),
+        ..ManagerParams::trust()
+    });
+    m.set_router(Some(
+        trust_manager::Router::new(trust_route::RouteParams::default(), 0.3).unwrap(),
+    ));
+    m.share_map(std::sync::Arc::clone(&map));
+    let slow = fly(&mut m, &map, goal, State::at_rest(0.0, start), 30, |_| {
+        Vec::new()
+    });
+    assert!(slow.iter().all(|r| r.goal_unreachable().is_none()));
+    assert_eq!(
+        slow.iter().filter(|r| r.timing.route_worker_ms > 0.0).count(),
+        0,
+        "no slice taken back"
+    );
+    let e = ManagerParams {
+        real_time_scale: Some(0.0),
+        ..ManagerParams::trust()
+    }
+    .validate()
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("manager.real_time_scale"), "{e}");
 }
 
 /// Issue 31: a goal sealed inside a closed box. The route search proves it in a few cycles, the

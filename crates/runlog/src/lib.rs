@@ -279,8 +279,8 @@ pub struct CycleRecord {
     pub waited_ms: Option<f64>,
     /// Added (issue 31), only in cycles that took back a route search sent away for a slice
     /// between cycles (on a thread of its own, off the critical path): the slice's wall time
-    /// (ms; not part of `wall_ms`, its wait is in `waited_ms`). The real-time clock charges the
-    /// later of the job's and the slice's lateness.
+    /// (ms; not part of `wall_ms`, its wait is in `waited_ms`). In real time a slice is not
+    /// charged: its answer is taken once its time × `cpu_scale` has passed since it was sent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub route_worker_ms: Option<f64>,
 }
