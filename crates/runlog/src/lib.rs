@@ -278,6 +278,46 @@ pub struct CycleRecord {
     pub waited_ms: Option<f64>,
 }
 
+impl CycleRecord {
+    /// A cycle with only the fields of format version 1 (`t`, `wall_ms`, `main`, `branches`,
+    /// `events`): every added field is zero, empty or absent, and `effective_t` is `t`. For
+    /// logs written from outside the planner (a ROS node's events) and for readers that skip
+    /// the added fields.
+    pub fn bare(
+        t: f64,
+        wall_ms: f64,
+        main: Option<u64>,
+        branches: usize,
+        events: Vec<String>,
+    ) -> CycleRecord {
+        CycleRecord {
+            t,
+            wall_ms,
+            main,
+            branches,
+            events,
+            frontend_ms: 0.0,
+            backend_ms: 0.0,
+            checker_ms: 0.0,
+            solve_count: 0,
+            effective_t: t,
+            branch_j: Vec::new(),
+            fallback_collision_free: None,
+            fallback_shortfall_m: None,
+            fallback_along: None,
+            dropped: Dropped::default(),
+            route: None,
+            route_ms: None,
+            branch_samples: None,
+            forecasts: None,
+            charged_ms: None,
+            overrun_ticks: None,
+            worker_ms: None,
+            waited_ms: None,
+        }
+    }
+}
+
 /// One kept branch's trajectory, sampled (added, issue 20).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -48,29 +48,8 @@ fn parse_record(line: &str, light_cycles: bool) -> Result<Record, serde_json::Er
         if light_cycles {
             let c: LightCycle = serde_json::from_str(line)?;
             return Ok(Record::Cycle(crate::CycleRecord {
-                t: c.t,
-                wall_ms: c.wall_ms,
-                main: c.main,
-                branches: c.branches,
-                events: c.events,
-                frontend_ms: 0.0,
-                backend_ms: 0.0,
-                checker_ms: 0.0,
-                solve_count: 0,
                 effective_t: 0.0,
-                branch_j: Vec::new(),
-                fallback_collision_free: None,
-                fallback_shortfall_m: None,
-                fallback_along: None,
-                dropped: crate::Dropped::default(),
-                route: None,
-                route_ms: None,
-                branch_samples: None,
-                forecasts: None,
-                charged_ms: None,
-                overrun_ticks: None,
-                worker_ms: None,
-                waited_ms: None,
+                ..crate::CycleRecord::bare(c.t, c.wall_ms, c.main, c.branches, c.events)
             }));
         }
         return serde_json::from_str(line).map(Record::Cycle);
