@@ -127,7 +127,10 @@ fn main() {
     let deadline = Instant::now() + Duration::from_secs(30);
     let mut plan = None;
     while plan.is_none() {
-        assert!(Instant::now() < deadline, "no trajectory on domain {domain}");
+        assert!(
+            Instant::now() < deadline,
+            "no trajectory on domain {domain}"
+        );
         let _ = goal_pub.publish(goal.clone());
         let _ = odom_pub.publish(odom_at(START, Vec3::zeros()));
         std::thread::sleep(Duration::from_millis(100));
@@ -188,8 +191,14 @@ fn main() {
     println!("odom_to_published: {cycles} cycles, quickstart, DDS loopback, poll 0.1 ms");
     for (name, x) in [
         ("planning cycle (manager step)", &mut planning),
-        ("node: odom received -> trajectory published, beyond the cycle", &mut beyond),
-        ("wire: odom written -> trajectory read, beyond the cycle", &mut wire),
+        (
+            "node: odom received -> trajectory published, beyond the cycle",
+            &mut beyond,
+        ),
+        (
+            "wire: odom written -> trajectory read, beyond the cycle",
+            &mut wire,
+        ),
     ] {
         let (median, p99, max) = stats(x);
         println!("  {name}: median {median:.3} ms, p99 {p99:.3} ms, max {max:.3} ms");

@@ -36,10 +36,7 @@ fn fly_over_dds(scenario: &Path, seed: u64, domain: u16) -> Outcome {
         .spawn()
         .expect("start trust-node");
     let world = world(scenario, seed);
-    let dir = std::env::temp_dir().join(format!(
-        "trust-dds-world-{}-{domain}",
-        std::process::id()
-    ));
+    let dir = std::env::temp_dir().join(format!("trust-dds-world-{}-{domain}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let log = dir.join("run.jsonl");
     let outcome = fly(&world, domain, &log, &DdsWorldOptions::default());

@@ -861,29 +861,13 @@ mod tests {
 
     fn cycle(t: f64) -> CycleRecord {
         CycleRecord {
-            t,
-            wall_ms: 1.5,
-            main: Some(3),
-            branches: 2,
-            events: vec!["switched".into()],
             frontend_ms: 0.5,
             backend_ms: 0.75,
             checker_ms: 0.25,
             solve_count: 2,
             effective_t: t + 0.1,
             branch_j: vec![1.0, 2.0],
-            fallback_collision_free: None,
-            fallback_shortfall_m: None,
-            fallback_along: None,
-            dropped: Dropped::default(),
-            route: None,
-            route_ms: None,
-            branch_samples: None,
-            forecasts: None,
-            charged_ms: None,
-            overrun_ticks: None,
-            worker_ms: None,
-            waited_ms: None,
+            ..CycleRecord::bare(t, 1.5, Some(3), 2, vec!["switched".into()])
         }
     }
 
