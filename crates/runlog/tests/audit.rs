@@ -6,8 +6,8 @@ use std::time::Instant;
 
 use trust_runlog::audit::{AuditOptions, audit, audit_file};
 use trust_runlog::{
-    Bounds, CycleRecord, Dropped, Header, LimitsInfo, LogError, LogWriter, ObstacleInfo,
-    ObstacleKind, Outcome, Record, RunLog, SCHEMA, StateRecord, Status, VehicleInfo,
+    Bounds, CycleRecord, Header, LimitsInfo, LogError, LogWriter, ObstacleInfo, ObstacleKind,
+    Outcome, Record, RunLog, SCHEMA, StateRecord, Status, VehicleInfo,
 };
 
 /// A fresh folder for one test.
