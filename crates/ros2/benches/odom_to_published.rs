@@ -6,9 +6,10 @@
 //! `trajectory`. The node (the `DdsNode` of `trust-node`, driven by odometry instead of its
 //! 10 Hz timer, polling every 0.1 ms) runs a cycle as soon as an odometry arrives. Per cycle:
 //!
-//! * `node`: from the odometry handed to the core to the trajectory written to DDS, less the
-//!   manager's step (`events.cycle_time_ms`): validation, forecasts, sampling the plan into
-//!   messages, CDR encoding and the writes of `trajectory`, `path`, `markers`, `events`;
+//! * `node`: from the poll that takes the odometry from DDS to the trajectory written, less
+//!   the manager's step (`events.cycle_time_ms`): decoding and validation, forecasts, sampling
+//!   the plan into messages, CDR encoding and the writes of `trajectory`, `path`, `markers`,
+//!   `events`;
 //! * `wire`: from the world's `odom` write to its `trajectory` read, less the same step: the
 //!   above plus both DDS transfers and both polls.
 //!
@@ -58,8 +59,9 @@ fn node_thread(domain: u16, stop: Arc<AtomicBool>, out: mpsc::Sender<NodeSample>
     let mut warn = |what: &str, e: &trust_ros2::Ros2Error| eprintln!("node ({what}): {e}");
     let mut odom_count = 0;
     while !stop.load(Ordering::Relaxed) {
-        node.receive(&mut core, &mut warn);
+        // The poll that finds the odometry counts: taking it from DDS, decoding, validating.
         let received = Instant::now();
+        node.receive(&mut core, &mut warn);
         if core.counters().odom_count > odom_count {
             odom_count = core.counters().odom_count;
             match node.cycle(&mut core, system_time()) {
