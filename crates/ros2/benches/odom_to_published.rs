@@ -182,7 +182,7 @@ fn main() {
         beyond.push(s.beyond_ms);
         planning.push(s.planning_ms);
         // Goal re-sent now and then (the node keeps the latest).
-        if wire.len() % 50 == 0 {
+        if wire.len().is_multiple_of(50) {
             let _ = goal_pub.publish(goal.clone());
         }
         std::thread::sleep(Duration::from_millis(20));
