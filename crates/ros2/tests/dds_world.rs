@@ -67,8 +67,11 @@ fn a_suite_room_with_people_flown_over_dds_arrives_as_trust_sim_run_does() {
     let seed = 0;
     let over_dds = fly_over_dds(&scenario, seed, domain(1));
     // `trust-sim run` of the same file and seed, in this process.
-    let world = world(&scenario, seed);
-    let planner = trust_flight::scenario::resolve_planner(world.scenario());
+    let s = trust_flight::scenario::load_checked(&scenario)
+        .expect("scenario")
+        .with_seed(seed);
+    let world = World::build(&s).expect("world");
+    let planner = trust_flight::scenario::resolve_planner(&s);
     let in_process = trust_flight::fly(&world, &planner, &Default::default(), |_| {})
         .expect("trust-sim run's flight")
         .summary
