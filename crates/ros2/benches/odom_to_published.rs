@@ -81,9 +81,11 @@ fn node_thread(domain: u16, stop: Arc<AtomicBool>, out: mpsc::Sender<NodeSample>
 }
 
 fn odom_at(p: Vec3, v: Vec3) -> Odometry {
-    let mut m = Odometry::default();
-    m.header = system_time().into_header("map");
-    m.child_frame_id = "map".into();
+    let mut m = Odometry {
+        header: system_time().into_header("map"),
+        child_frame_id: "map".into(),
+        ..Odometry::default()
+    };
     m.pose.pose.position = p.into();
     m.twist.twist.linear = v.into();
     m
