@@ -249,19 +249,34 @@ pub fn header(world: &World, planner_label: &str, points_file: Option<String>) -
     }
 }
 
-/// The logged figures of a flight, accumulated state by state (the contract's definitions).
+/// The logged figures of a flight, accumulated state by state (the contract's definitions):
+/// what the `outcome` record reports about the states. [`fly`] and the ROS 2 world
+/// (`trust_ros2::dds_world`) keep one.
 #[derive(Debug, Clone)]
-struct Tally {
-    min_static: f64,
-    min_dynamic: f64,
-    max_speed: f64,
-    max_accel: f64,
-    path_length: f64,
+pub struct Tally {
+    /// Least static clearance so far (m; infinite before the first state or without static
+    /// obstacles).
+    pub min_static: f64,
+    /// Least clearance to a moving obstacle so far (m; infinite likewise).
+    pub min_dynamic: f64,
+    /// Greatest speed so far (m/s).
+    pub max_speed: f64,
+    /// Greatest acceleration norm so far (m/s²).
+    pub max_accel: f64,
+    /// Length of the polyline through the states (m).
+    pub path_length: f64,
     last_p: Option<Vec3>,
 }
 
+impl Default for Tally {
+    fn default() -> Self {
+        Tally::new()
+    }
+}
+
 impl Tally {
-    fn new() -> Self {
+    /// No state yet.
+    pub fn new() -> Self {
         Tally {
             min_static: f64::INFINITY,
             min_dynamic: f64::INFINITY,
@@ -272,7 +287,8 @@ impl Tally {
         }
     }
 
-    fn add(&mut self, p: &Vec3, v: &Vec3, a: &Vec3, static_c: f64, dynamic_c: f64) {
+    /// Adds the state `p`, `v`, `a` with its static and moving clearances (m).
+    pub fn add(&mut self, p: &Vec3, v: &Vec3, a: &Vec3, static_c: f64, dynamic_c: f64) {
         self.min_static = self.min_static.min(static_c);
         self.min_dynamic = self.min_dynamic.min(dynamic_c);
         self.max_speed = self.max_speed.max(v.norm());
@@ -281,6 +297,16 @@ impl Tally {
             self.path_length += (p - q).norm();
         }
         self.last_p = Some(*p);
+    }
+
+    /// The outcome's static clearance: [`NO_OBSTACLE_CLEARANCE_M`] when none was met.
+    pub fn min_clearance_static_m(&self) -> f64 {
+        finite_or_stand_in(self.min_static)
+    }
+
+    /// The outcome's moving clearance: [`NO_OBSTACLE_CLEARANCE_M`] when none was met.
+    pub fn min_clearance_dynamic_m(&self) -> f64 {
+        finite_or_stand_in(self.min_dynamic)
     }
 }
 
@@ -484,8 +510,8 @@ pub fn fly(
         t,
         flight_time_s: t,
         path_length_m: tally.path_length,
-        min_clearance_static_m: finite_or_stand_in(tally.min_static),
-        min_clearance_dynamic_m: finite_or_stand_in(tally.min_dynamic),
+        min_clearance_static_m: tally.min_clearance_static_m(),
+        min_clearance_dynamic_m: tally.min_clearance_dynamic_m(),
         max_speed: tally.max_speed,
         max_accel: tally.max_accel,
         with,

@@ -1505,7 +1505,9 @@ fn with_a_shared_map_the_route_search_runs_between_cycles() {
     });
     assert!(slow.iter().all(|r| r.goal_unreachable().is_none()));
     assert_eq!(
-        slow.iter().filter(|r| r.timing.route_worker_ms > 0.0).count(),
+        slow.iter()
+            .filter(|r| r.timing.route_worker_ms > 0.0)
+            .count(),
         0,
         "no slice taken back"
     );

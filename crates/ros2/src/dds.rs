@@ -278,14 +278,17 @@ impl DdsNode {
         });
     }
 
-    /// Runs one cycle of `core` at `now` and publishes its messages.
+    /// Runs one cycle of `core` at `now` and publishes its messages (the trajectory first);
+    /// returns the planning cycle's own wall time (ms, the manager's step, as in `events`), or
+    /// `None` when no cycle ran (no odometry or goal yet).
     ///
     /// # Errors
     /// The cycle's error (nothing published), or [`Ros2Error::Dds`] if a write fails.
-    pub fn cycle(&mut self, core: &mut NodeCore, now: Time) -> Result<(), Ros2Error> {
+    pub fn cycle(&mut self, core: &mut NodeCore, now: Time) -> Result<Option<f64>, Ros2Error> {
         let Some(out) = core.cycle(now)? else {
-            return Ok(());
+            return Ok(None);
         };
+        let planning_ms = out.event.cycle_time_ms;
         if let Some(t) = out.trajectory {
             self.trajectory
                 .publish(t)
@@ -302,7 +305,7 @@ impl DdsNode {
         self.events
             .publish(out.event)
             .map_err(|e| Ros2Error::dds("publish events", e))?;
-        Ok(())
+        Ok(Some(planning_ms))
     }
 
     /// Publishes the setpoint of `core` at `now` (nothing without a plan).

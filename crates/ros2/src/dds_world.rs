@@ -13,8 +13,8 @@ use std::path::Path;
 use std::time::{Duration as StdDuration, Instant};
 
 use trust_core::Vec3;
-use trust_flight::Clearances;
-use trust_runlog::{CycleRecord, Dropped, LogWriter, Outcome, Record, StateRecord, Status};
+use trust_flight::{Clearances, Tally};
+use trust_runlog::{CycleRecord, LogWriter, Outcome, Record, StateRecord, Status};
 use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle};
 use trust_world::World;
 use trust_world::scenario::VehicleModel;
@@ -120,8 +120,10 @@ pub fn obstacle_message(
     })
 }
 
-/// The reference of `traj` at ROS time `now` (s): linear between its samples, its last sample
-/// held (at rest) after its end, its first before its start.
+/// The reference of `traj` at ROS time `now` (s): linear between its samples, with the jerk
+/// of the accelerations' slope (the controller's body-rate feed-forward: without it the
+/// quadrotor lags and overshoots the planned speed), its last sample held (at rest) after its
+/// end, its first before its start.
 pub fn reference_at(traj: &MultiDOFJointTrajectory, now: f64) -> Option<Reference> {
     let t0 = traj.header.stamp.as_seconds();
     let sample = |k: usize| {
@@ -140,23 +142,28 @@ pub fn reference_at(traj: &MultiDOFJointTrajectory, now: f64) -> Option<Referenc
     let k = traj
         .points
         .partition_point(|p| t0 + p.time_from_start.as_seconds() <= now);
-    let (p, v, a) = if k == 0 {
+    let (p, v, a, j) = if k == 0 {
         let (_, p, v, a) = sample(0)?;
-        (p, v, a)
+        (p, v, a, Vec3::zeros())
     } else if k == n {
         let (_, p, _, _) = sample(n - 1)?;
-        (p, Vec3::zeros(), Vec3::zeros())
+        (p, Vec3::zeros(), Vec3::zeros(), Vec3::zeros())
     } else {
         let (ta, pa, va, aa) = sample(k - 1)?;
         let (tb, pb, vb, ab) = sample(k)?;
-        let s = if tb > ta { (now - ta) / (tb - ta) } else { 0.0 };
-        (pa.lerp(&pb, s), va.lerp(&vb, s), aa.lerp(&ab, s))
+        let h = tb - ta;
+        let (s, j) = if h > 0.0 {
+            ((now - ta) / h, (ab - aa) / h)
+        } else {
+            (0.0, Vec3::zeros())
+        };
+        (pa.lerp(&pb, s), va.lerp(&vb, s), aa.lerp(&ab, s), j)
     };
     Some(Reference {
         p,
         v,
         a,
-        j: Vec3::zeros(),
+        j,
         yaw: 0.0,
     })
 }
@@ -287,8 +294,9 @@ pub fn fly(
         }
     };
     {
-        let c = Clearances::at(world, &traffic, radius, &vehicle.state().p);
-        tally.add(vehicle.state(), &c);
+        let s = vehicle.state();
+        let c = Clearances::at(world, &traffic, radius, &s.p);
+        tally.add(&s.p, &s.v, &s.a, c.static_m, c.dynamic_m);
         log.write(&Record::State(state_record(
             0.0,
             &*vehicle,
@@ -341,7 +349,7 @@ pub fn fly(
         let t = step as f64 * dt;
         let s = vehicle.state();
         let c = Clearances::at(world, &traffic, radius, &s.p);
-        tally.add(s, &c);
+        tally.add(&s.p, &s.v, &s.a, c.static_m, c.dynamic_m);
         log.write(&Record::State(state_record(
             t,
             &*vehicle,
@@ -369,8 +377,8 @@ pub fn fly(
         t,
         flight_time_s: t,
         path_length_m: tally.path_length,
-        min_clearance_static_m: tally.min_static.min(1e9),
-        min_clearance_dynamic_m: tally.min_dynamic.min(1e9),
+        min_clearance_static_m: tally.min_clearance_static_m(),
+        min_clearance_dynamic_m: tally.min_clearance_dynamic_m(),
         max_speed: tally.max_speed,
         max_accel: tally.max_accel,
         with,
@@ -386,73 +394,12 @@ pub fn fly(
 
 /// A `cycle` record at flight time `t` from the node's event.
 fn cycle_record(t: f64, e: &PlannerEvent) -> CycleRecord {
-    CycleRecord {
-        t,
-        wall_ms: if e.cycle_time_ms.is_finite() {
-            e.cycle_time_ms.max(0.0)
-        } else {
-            0.0
-        },
-        main: None,
-        branches: 0,
-        events: e.events.clone(),
-        frontend_ms: 0.0,
-        backend_ms: 0.0,
-        checker_ms: 0.0,
-        solve_count: 0,
-        effective_t: t,
-        branch_j: Vec::new(),
-        fallback_collision_free: None,
-        fallback_shortfall_m: None,
-        fallback_along: None,
-        dropped: Dropped::default(),
-        route: None,
-        route_ms: None,
-        branch_samples: None,
-        forecasts: None,
-        charged_ms: None,
-        overrun_ticks: None,
-        worker_ms: None,
-        waited_ms: None,
-        route_worker_ms: None,
-    }
-}
-
-/// The outcome's figures over the logged states (as the contract defines them).
-#[derive(Debug)]
-struct Tally {
-    last: Option<Vec3>,
-    path_length: f64,
-    min_static: f64,
-    min_dynamic: f64,
-    max_speed: f64,
-    max_accel: f64,
-}
-
-impl Default for Tally {
-    fn default() -> Self {
-        Tally {
-            last: None,
-            path_length: 0.0,
-            min_static: f64::INFINITY,
-            min_dynamic: f64::INFINITY,
-            max_speed: 0.0,
-            max_accel: 0.0,
-        }
-    }
-}
-
-impl Tally {
-    fn add(&mut self, s: &trust_vehicle::VehicleState, c: &Clearances) {
-        if let Some(last) = self.last {
-            self.path_length += (s.p - last).norm();
-        }
-        self.last = Some(s.p);
-        self.min_static = self.min_static.min(c.static_m);
-        self.min_dynamic = self.min_dynamic.min(c.dynamic_m);
-        self.max_speed = self.max_speed.max(s.v.norm());
-        self.max_accel = self.max_accel.max(s.a.norm());
-    }
+    let wall_ms = if e.cycle_time_ms.is_finite() {
+        e.cycle_time_ms.max(0.0)
+    } else {
+        0.0
+    };
+    CycleRecord::bare(t, wall_ms, None, 0, e.events.clone())
 }
 
 #[cfg(test)]
@@ -508,5 +455,24 @@ mod tests {
         assert_relative_eq!(after.p.x, 1.0, epsilon = 1e-9);
         assert_relative_eq!(after.v.norm(), 0.0, epsilon = 1e-12);
         assert!(reference_at(&MultiDOFJointTrajectory::default(), 0.0).is_none());
+    }
+
+    #[test]
+    fn the_reference_carries_the_jerk_of_the_sampled_accelerations() {
+        let mut traj = MultiDOFJointTrajectory {
+            header: Time {
+                sec: 100,
+                nanosec: 0,
+            }
+            .into_header("map"),
+            joint_names: vec!["base_link".into()],
+            points: vec![point(0.0, 0.0, 0.0), point(0.5, 0.0, 0.0)],
+        };
+        traj.points[1].accelerations[0].linear.x = 2.0;
+        let r = reference_at(&traj, 100.25).expect("a reference");
+        assert_relative_eq!(r.a.x, 1.0, epsilon = 1e-9);
+        assert_relative_eq!(r.j.x, 4.0, epsilon = 1e-9);
+        let after = reference_at(&traj, 101.0).expect("a reference");
+        assert_relative_eq!(after.j.norm(), 0.0, epsilon = 1e-12);
     }
 }

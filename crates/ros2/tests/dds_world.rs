@@ -1,29 +1,42 @@
 //! The simulator as the ROS 2 world (`trust_ros2::dds_world::fly`, what `trust-sim dds-world`
 //! runs) against `trust-node` in a process of its own, over loopback on a domain of their own:
-//! `scenarios/quickstart.toml` flies to the goal and the run log passes the audit.
+//! `scenarios/quickstart.toml` and a suite room with walking people fly to the goal, and their
+//! run logs pass the audit; the room's outcome has the class of `trust-sim run`'s (same file,
+//! same seed).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use trust_ros2::dds_world::{DdsWorldOptions, fly};
-use trust_runlog::Status;
 use trust_runlog::audit::{AuditOptions, audit_file};
+use trust_runlog::{Outcome, Status};
 use trust_world::World;
 
-#[test]
-fn quickstart_flown_by_trust_node_over_dds_arrives_and_its_log_passes_the_audit() {
-    let domain = (std::process::id() % 100) as u16 * 2 + 22;
-    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/quickstart.toml");
+fn scenario_path(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenarios")
+        .join(relative)
+}
+
+fn world(scenario: &Path, seed: u64) -> World {
+    let s = trust_world::load_checked::<trust_planner::PlannerSpec>(scenario)
+        .expect("scenario")
+        .with_seed(seed);
+    World::build(&s).expect("world")
+}
+
+/// Flies `scenario` (trial `seed`) with `trust-node` on domain `domain`; checks the log's audit
+/// and returns the outcome.
+fn fly_over_dds(scenario: &Path, seed: u64, domain: u16) -> Outcome {
     let mut node = Command::new(env!("CARGO_BIN_EXE_trust-node"))
-        .arg(&scenario)
+        .arg(scenario)
         .args(["--domain-id", &domain.to_string(), "--until-stdin-closes"])
         .stdin(Stdio::piped())
         .stdout(Stdio::null())
         .spawn()
         .expect("start trust-node");
-    let s = trust_world::load_checked::<trust_planner::PlannerSpec>(&scenario).expect("quickstart");
-    let world = World::build(&s).expect("world");
-    let dir = std::env::temp_dir().join(format!("trust-dds-world-{}", std::process::id()));
+    let world = world(scenario, seed);
+    let dir = std::env::temp_dir().join(format!("trust-dds-world-{}-{domain}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let log = dir.join("run.jsonl");
     let outcome = fly(&world, domain, &log, &DdsWorldOptions::default());
@@ -32,7 +45,40 @@ fn quickstart_flown_by_trust_node_over_dds_arrives_and_its_log_passes_the_audit(
     let outcome = outcome.expect("the flight over DDS");
     let audit = audit_file(&log, AuditOptions { cycles: true }).expect("read the log");
     assert!(audit.passed(), "audit findings: {:?}", audit.findings);
-    assert_eq!(outcome.status, Status::Arrived, "{outcome:?}");
     assert!(outcome.cycle_count > 0, "{outcome:?}");
     let _ = std::fs::remove_dir_all(&dir);
+    outcome
+}
+
+/// A domain id of this test process's own (`offset` tells the tests apart).
+fn domain(offset: u16) -> u16 {
+    (std::process::id() % 50) as u16 * 4 + 22 + offset
+}
+
+#[test]
+fn quickstart_flown_by_trust_node_over_dds_arrives_and_its_log_passes_the_audit() {
+    let outcome = fly_over_dds(&scenario_path("quickstart.toml"), 0, domain(0));
+    assert_eq!(outcome.status, Status::Arrived, "{outcome:?}");
+}
+
+#[test]
+fn a_suite_room_with_people_flown_over_dds_arrives_as_trust_sim_run_does() {
+    let scenario = scenario_path("suite/room_people.toml");
+    let seed = 0;
+    let over_dds = fly_over_dds(&scenario, seed, domain(1));
+    // `trust-sim run` of the same file and seed, in this process.
+    let s = trust_flight::scenario::load_checked(&scenario)
+        .expect("scenario")
+        .with_seed(seed);
+    let world = World::build(&s).expect("world");
+    let planner = trust_flight::scenario::resolve_planner(&s);
+    let in_process = trust_flight::fly(&world, &planner, &Default::default(), |_| {})
+        .expect("trust-sim run's flight")
+        .summary
+        .outcome;
+    assert_eq!(in_process.status, Status::Arrived, "{in_process:?}");
+    assert_eq!(
+        over_dds.status, in_process.status,
+        "over DDS: {over_dds:?}\ntrust-sim run: {in_process:?}"
+    );
 }

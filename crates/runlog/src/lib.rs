@@ -285,6 +285,30 @@ pub struct CycleRecord {
     pub route_worker_ms: Option<f64>,
 }
 
+impl CycleRecord {
+    /// A cycle with only the fields of format version 1 (`t`, `wall_ms`, `main`, `branches`,
+    /// `events`): every added field is zero, empty or absent, and `effective_t` is `t`. For
+    /// logs written from outside the planner (a ROS node's events) and for readers that skip
+    /// the added fields.
+    pub fn bare(
+        t: f64,
+        wall_ms: f64,
+        main: Option<u64>,
+        branches: usize,
+        events: Vec<String>,
+    ) -> CycleRecord {
+        CycleRecord {
+            t,
+            wall_ms,
+            main,
+            branches,
+            events,
+            effective_t: t,
+            ..CycleRecord::default()
+        }
+    }
+}
+
 /// One kept branch's trajectory, sampled (added, issue 20).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -828,18 +852,13 @@ mod tests {
 
     fn cycle(t: f64) -> CycleRecord {
         CycleRecord {
-            t,
-            wall_ms: 1.5,
-            main: Some(3),
-            branches: 2,
-            events: vec!["switched".into()],
             frontend_ms: 0.5,
             backend_ms: 0.75,
             checker_ms: 0.25,
             solve_count: 2,
             effective_t: t + 0.1,
             branch_j: vec![1.0, 2.0],
-            ..CycleRecord::default()
+            ..CycleRecord::bare(t, 1.5, Some(3), 2, vec!["switched".into()])
         }
     }
 

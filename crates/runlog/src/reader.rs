@@ -48,12 +48,8 @@ fn parse_record(line: &str, light_cycles: bool) -> Result<Record, serde_json::Er
         if light_cycles {
             let c: LightCycle = serde_json::from_str(line)?;
             return Ok(Record::Cycle(crate::CycleRecord {
-                t: c.t,
-                wall_ms: c.wall_ms,
-                main: c.main,
-                branches: c.branches,
-                events: c.events,
-                ..crate::CycleRecord::default()
+                effective_t: 0.0,
+                ..crate::CycleRecord::bare(c.t, c.wall_ms, c.main, c.branches, c.events)
             }));
         }
         return serde_json::from_str(line).map(Record::Cycle);

@@ -71,19 +71,7 @@ fn states(n: usize) -> Vec<StateRecord> {
 }
 
 fn cycle(t: f64) -> CycleRecord {
-    CycleRecord {
-        t,
-        wall_ms: 1.0,
-        main: Some(1),
-        branches: 1,
-        events: Vec::new(),
-        frontend_ms: 0.0,
-        backend_ms: 0.0,
-        checker_ms: 0.0,
-        solve_count: 0,
-        effective_t: t,
-        ..CycleRecord::default()
-    }
+    CycleRecord::bare(t, 1.0, Some(1), 1, Vec::new())
 }
 
 /// A log whose outcome is what its states say (the audit's recomputation of an untampered copy).
