@@ -672,12 +672,16 @@ mod tests {
                 let mut b = p;
                 a[i] += h;
                 b[i] -= h;
-                let (fa, ga) = map.distance_and_gradient(&a);
-                let (fb, gb) = map.distance_and_gradient(&b);
+                let (_, ga) = map.distance_and_gradient(&a);
+                let (_, gb) = map.distance_and_gradient(&b);
                 if (ga - g).norm() > 1e-4 || (gb - g).norm() > 1e-4 {
                     continue; // a kink lies between the samples
                 }
-                let fd = (fa - fb) / (2.0 * h);
+                let fd = trust_numdiff::central_difference(
+                    |s| map.distance_and_gradient(&(p + Vec3::ith(i, s))).0,
+                    0.0,
+                    h,
+                );
                 prop_assert!((fd - g[i]).abs() < 1e-5, "axis {i}: {} vs {fd}", g[i]);
             }
         }

@@ -537,15 +537,11 @@ mod tests {
 
     /// Central finite-difference gradient of `f` at `p`.
     fn fd_gradient(f: impl Fn(&Vec3) -> f64, p: &Vec3) -> Vec3 {
-        let mut g = Vec3::zeros();
-        for i in 0..3 {
-            let mut a = *p;
-            let mut b = *p;
-            a[i] += H;
-            b[i] -= H;
-            g[i] = (f(&a) - f(&b)) / (2.0 * H);
-        }
-        g
+        Vec3::from(trust_numdiff::gradient_array(
+            |q| f(&Vec3::from(q)),
+            (*p).into(),
+            H,
+        ))
     }
 
     fn assert_close(a: &Vec3, b: &Vec3, tol: f64) -> Result<(), TestCaseError> {

@@ -31,23 +31,12 @@ pub fn rosenbrock_start(dimension: usize) -> Vec<f64> {
         .collect()
 }
 
-/// Central finite difference of a scalar function: `(f(x + h) − f(x − h)) / (2h)`.
-///
-/// The one-variable companion of [`central_difference_gradient`], for checking a hand-written
-/// derivative in a test.
-pub fn central_difference<F>(mut f: F, x: f64, h: f64) -> f64
-where
-    F: FnMut(f64) -> f64,
-{
-    let ahead = f(x + h);
-    let behind = f(x - h);
-    (ahead - behind) / (2.0 * h)
-}
-
 /// Central finite-difference gradient of the cost part of a fused cost-and-gradient function:
 /// `grad[i] = (f(x + h·eᵢ) − f(x − h·eᵢ)) / (2h)`.
 ///
-/// Allocates two scratch vectors; meant for tests, not for inner loops.
+/// [`trust_numdiff::gradient`] (the workspace's one finite-difference home, where the step-size
+/// rationale is) applied to the fused form. Allocates two scratch vectors; meant for tests, not for
+/// inner loops.
 ///
 /// # Panics
 /// If `grad.len() != x.len()`.
@@ -55,17 +44,8 @@ pub fn central_difference_gradient<F>(mut f: F, x: &[f64], h: f64, grad: &mut [f
 where
     F: FnMut(&[f64], &mut [f64]) -> f64,
 {
-    assert_eq!(grad.len(), x.len(), "gradient length must equal x length");
-    let mut probe = x.to_vec();
     let mut scratch = vec![0.0; x.len()];
-    for i in 0..x.len() {
-        probe[i] = x[i] + h;
-        let ahead = f(&probe, &mut scratch);
-        probe[i] = x[i] - h;
-        let behind = f(&probe, &mut scratch);
-        probe[i] = x[i];
-        grad[i] = (ahead - behind) / (2.0 * h);
-    }
+    trust_numdiff::gradient(|probe| f(probe, &mut scratch), x, h, grad);
 }
 
 #[cfg(test)]

@@ -103,7 +103,7 @@ fn check_fd(
     h: f64,
     f: impl Fn(f64) -> f64,
 ) -> Result<(), TestCaseError> {
-    let fd = trust_lbfgs::test_functions::central_difference(&f, 0.0, h);
+    let fd = trust_numdiff::central_difference(&f, 0.0, h);
     let noise = 100.0 * f64::EPSILON * f(0.0).abs() / h;
     let tol = 1e-5 * analytic.abs().max(floor) + noise;
     prop_assert!(

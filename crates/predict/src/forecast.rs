@@ -417,13 +417,10 @@ mod tests {
 
     /// Central differences of the signed distance in p and t.
     fn finite_differences(f: &Forecast, p: &Vec3, t: f64) -> (Vec3, f64) {
-        let mut g = Vec3::zeros();
-        for i in 0..3 {
-            let mut e = Vec3::zeros();
-            e[i] = H;
-            g[i] = (f.signed_distance(&(p + e), t) - f.signed_distance(&(p - e), t)) / (2.0 * H);
-        }
-        let gt = (f.signed_distance(p, t + H) - f.signed_distance(p, t - H)) / (2.0 * H);
+        let g =
+            trust_numdiff::gradient_array(|q| f.signed_distance(&Vec3::from(q), t), (*p).into(), H);
+        let gt = trust_numdiff::central_difference(|s| f.signed_distance(p, s), t, H);
+        let g = Vec3::from(g);
         (g, gt)
     }
 

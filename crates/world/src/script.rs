@@ -641,7 +641,7 @@ mod tests {
             for t in [0.3, 1.7, 2.9, 3.5, 5.2] {
                 let (_, v) = path.evaluate(t);
                 let h = 1e-6;
-                let fd = (path.evaluate(t + h).0 - path.evaluate(t - h).0) / (2.0 * h);
+                let fd = trust_numdiff::central_difference(|s| path.evaluate(s).0, t, h);
                 assert!((v - fd).norm() < 1e-6, "{end:?} t = {t}: {v} vs {fd}");
             }
         }
@@ -720,7 +720,7 @@ mod tests {
             assert!((p - q).norm() < 1e-12 && (v - w).norm() < 1e-12);
             assert!((p - r).norm() < 1e-9 && (v - u).norm() < 1e-9);
             let h = 1e-6;
-            let fd = (f.evaluate(t + h).0 - f.evaluate(t - h).0) / (2.0 * h);
+            let fd = trust_numdiff::central_difference(|s| f.evaluate(s).0, t, h);
             assert!((v - fd).norm() < 1e-6);
         }
         // A circle of radius 2 keeps its radius and speed 2·ω.

@@ -60,7 +60,7 @@ mod tests {
         #[test]
         fn derivative_matches_finite_differences(tau in -50.0..50.0f64) {
             let h = 1e-6;
-            let fd = trust_lbfgs::test_functions::central_difference(|x| positive_time(x).0, tau, h);
+            let fd = trust_numdiff::central_difference(|x| positive_time(x).0, tau, h);
             let (t, d) = positive_time(tau);
             prop_assert!(t > 0.0 && d > 0.0);
             prop_assert!((fd - d).abs() <= 1e-6 * (1.0 + d), "{fd} vs {d}");

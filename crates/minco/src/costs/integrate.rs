@@ -682,19 +682,21 @@ mod tests {
             let h = 1e-6;
             for row in 0..coeffs.len() {
                 for axis in 0..3 {
-                    let (mut hi, mut lo) = (coeffs.clone(), coeffs.clone());
-                    hi[row][axis] += h;
-                    lo[row][axis] -= h;
-                    let fd = (integral(&hi, &durations, 0.4).0 - integral(&lo, &durations, 0.4).0) / (2.0 * h);
+                    let fd = trust_numdiff::central_difference(|s| {
+                        let mut probe = coeffs.clone();
+                        probe[row][axis] += s;
+                        integral(&probe, &durations, 0.4).0
+                    }, 0.0, h);
                     prop_assert!((fd - gc[row][axis]).abs() <= 1e-6 * (1.0 + fd.abs()),
                         "c[{row}][{axis}]: fd {fd} vs {}", gc[row][axis]);
                 }
             }
             for i in 0..2 {
-                let (mut hi, mut lo) = (durations, durations);
-                hi[i] += h;
-                lo[i] -= h;
-                let fd = (integral(&coeffs, &hi, 0.4).0 - integral(&coeffs, &lo, 0.4).0) / (2.0 * h);
+                let fd = trust_numdiff::central_difference(|s| {
+                    let mut probe = durations;
+                    probe[i] += s;
+                    integral(&coeffs, &probe, 0.4).0
+                }, 0.0, h);
                 prop_assert!((fd - gt[i]).abs() <= 1e-5 * (1.0 + fd.abs()), "T[{i}]: fd {fd} vs {}", gt[i]);
             }
         }

@@ -89,7 +89,7 @@ mod tests {
         #[test]
         fn slope_matches_finite_differences(x in -0.05..0.2f64, mu in 1e-3..0.1f64) {
             let h = 1e-7;
-            let fd = trust_lbfgs::test_functions::central_difference(|y| smoothed_l1(y, mu).0, x, h);
+            let fd = trust_numdiff::central_difference(|y| smoothed_l1(y, mu).0, x, h);
             let (_, slope) = smoothed_l1(x, mu);
             prop_assert!((fd - slope).abs() < 1e-5, "x {x} mu {mu}: fd {fd} vs {slope}");
         }

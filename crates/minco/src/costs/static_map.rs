@@ -257,12 +257,11 @@ mod tests {
         assert!(value > 0.0, "within 0.3 m of the wall");
         let h = 1e-6;
         for d in 0..3 {
-            let (mut hi, mut lo) = (p, p);
-            hi[d] += h;
-            lo[d] -= h;
-            let fd = (term.sample(&state(hi), &mut { SampleGrad::ZERO })
-                - term.sample(&state(lo), &mut { SampleGrad::ZERO }))
-                / (2.0 * h);
+            let fd = trust_numdiff::central_difference(
+                |s| term.sample(&state(p + Vec3::ith(d, s)), &mut { SampleGrad::ZERO }),
+                0.0,
+                h,
+            );
             assert_relative_eq!(g.p[d], fd, epsilon = 1e-6, max_relative = 1e-6);
         }
     }
@@ -345,12 +344,11 @@ mod tests {
         assert!(g.p.y > 0.0 && g.p.z < 0.0 && g.p.x == 0.0, "{:?}", g.p);
         for k in 0..3 {
             let h = 1e-6;
-            let (mut a, mut b) = (p, p);
-            a[k] += h;
-            b[k] -= h;
-            let fd = (term.sample(&state(a), &mut { SampleGrad::ZERO })
-                - term.sample(&state(b), &mut { SampleGrad::ZERO }))
-                / (2.0 * h);
+            let fd = trust_numdiff::central_difference(
+                |s| term.sample(&state(p + Vec3::ith(k, s)), &mut { SampleGrad::ZERO }),
+                0.0,
+                h,
+            );
             assert_relative_eq!(fd, g.p[k], epsilon = 1e-5, max_relative = 1e-5);
         }
         let mut g = SampleGrad::ZERO;

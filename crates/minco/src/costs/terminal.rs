@@ -252,14 +252,17 @@ mod tests {
             let (_, gp, gv) = cost.eval_objective(&p, &v);
             let h = 1e-6;
             for k in 0..3 {
-                let mut e = Vec3::zeros();
-                e[k] = h;
-                let fd_p = (cost.eval_objective(&(p + e), &v).0
-                    - cost.eval_objective(&(p - e), &v).0)
-                    / (2.0 * h);
-                let fd_v = (cost.eval_objective(&p, &(v + e)).0
-                    - cost.eval_objective(&p, &(v - e)).0)
-                    / (2.0 * h);
+                let e = |s: f64| Vec3::ith(k, s);
+                let fd_p = trust_numdiff::central_difference(
+                    |s| cost.eval_objective(&(p + e(s)), &v).0,
+                    0.0,
+                    h,
+                );
+                let fd_v = trust_numdiff::central_difference(
+                    |s| cost.eval_objective(&p, &(v + e(s))).0,
+                    0.0,
+                    h,
+                );
                 assert_relative_eq!(gp[k], fd_p, epsilon = 1e-6);
                 assert_relative_eq!(gv[k], fd_v, epsilon = 1e-6);
             }

@@ -438,7 +438,7 @@ proptest! {
             let (up, down) = (pdc.signed_distance(&(p + e)), pdc.signed_distance(&(p - e)));
             // Skip kinks (where the one-sided slopes disagree).
             prop_assume!(((up - d) - (d - down)).abs() < 1e-9);
-            let fd = (up - down) / (2.0 * h);
+            let fd = trust_numdiff::central_difference(|s| pdc.signed_distance(&(p + Vec3::ith(i, s))), 0.0, h);
             prop_assert!((fd - g[i]).abs() < 1e-5, "axis {i}: fd {fd} vs {}", g[i]);
         }
     }
@@ -617,14 +617,11 @@ proptest! {
         let (d, g) = round_cone_sdf(&a, &b, ra, rb, &p);
         prop_assume!(d > 0.05);
         prop_assert!((g.norm() - 1.0).abs() < 1e-9);
-        let h = 1e-6;
-        let mut fd = Vec3::zeros();
-        for i in 0..3 {
-            let mut e = Vec3::zeros();
-            e[i] = h;
-            fd[i] = (round_cone_sdf(&a, &b, ra, rb, &(p + e)).0
-                - round_cone_sdf(&a, &b, ra, rb, &(p - e)).0) / (2.0 * h);
-        }
+        let fd = Vec3::from(trust_numdiff::gradient_array(
+            |q| round_cone_sdf(&a, &b, ra, rb, &Vec3::from(q)).0,
+            p.into(),
+            1e-6,
+        ));
         prop_assert!((fd - g).norm() < 1e-4, "{fd:?} vs {g:?}");
     }
 }
