@@ -676,38 +676,14 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         scene: &Scene<'_>,
         spans: &mut Spans,
     ) {
+        // A search sent away for a slice between cycles comes back first; an answer it found
+        // is taken below, in place of a slice.
+        let mut away_answer = self.take_route_back(measured.t, spans);
         let Some(router) = &self.router else {
             return;
         };
         let goal = *goal;
         let new_goal = self.routed_goal.is_none_or(|g| (g - goal).norm() > 1e-9);
-        // A search sent away for a slice between cycles comes back first (the cycle waits for
-        // it, so a seed is one flight); an answer it found is taken below, in place of a slice.
-        let mut away_answer = None;
-        if let Some((reason, slot)) = self.route_search.take() {
-            let waiting = Instant::now();
-            let joined = matches!(slot, SearchSlot::Away { .. });
-            let back = slot.take_back(measured.t, self.params.real_time_scale);
-            if joined {
-                spans.timing.waited_ms += ms(waiting.elapsed());
-            }
-            match back {
-                TakenBack::Here(search) => {
-                    self.route_search = Some((reason, SearchSlot::Here(search)));
-                }
-                TakenBack::Sliced(slice) => {
-                    spans.timing.route_worker_ms += ms(slice.elapsed);
-                    if !matches!(slice.progress, RouteProgress::Pending) {
-                        away_answer = Some(slice.progress);
-                    }
-                    self.route_search = Some((reason, SearchSlot::Here(slice.search)));
-                }
-                TakenBack::NotYet(slot) => self.route_search = Some((reason, slot)),
-                // A slice that panicked loses the search, as a job that panicked is dropped:
-                // the next stall or re-check starts another.
-                TakenBack::Lost => {}
-            }
-        }
         let searching = self.route_search.is_some();
         // While the stall lasts the route is planned again every horizon (a route that failed,
         // or one that leads into a dead end, is not kept for the rest of the flight); a verdict
@@ -763,6 +739,52 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             None => return,
         };
         self.route_search = None;
+        self.apply_route_answer(cycle, measured, &goal, reason, answer);
+    }
+
+    /// Takes back the route search sent away for a slice between cycles (waiting for it, so a
+    /// seed is one flight; in real time taking its answer only once due,
+    /// [`ManagerParams::real_time_scale`]); returns the slice's answer, if it found one.
+    fn take_route_back(&mut self, now: f64, spans: &mut Spans) -> Option<RouteProgress> {
+        let (reason, slot) = self.route_search.take()?;
+        let waiting = Instant::now();
+        let joined = matches!(slot, SearchSlot::Away { .. });
+        let back = slot.take_back(now, self.params.real_time_scale);
+        if joined {
+            spans.timing.waited_ms += ms(waiting.elapsed());
+        }
+        match back {
+            TakenBack::Here(search) => {
+                self.route_search = Some((reason, SearchSlot::Here(search)));
+                None
+            }
+            TakenBack::Sliced(slice) => {
+                spans.timing.route_worker_ms += ms(slice.elapsed);
+                self.route_search = Some((reason, SearchSlot::Here(slice.search)));
+                Some(slice.progress).filter(|p| !matches!(p, RouteProgress::Pending))
+            }
+            TakenBack::NotYet(slot) => {
+                self.route_search = Some((reason, slot));
+                None
+            }
+            // A slice that panicked loses the search, as a job that panicked is dropped: the
+            // next stall or re-check starts another.
+            TakenBack::Lost => None,
+        }
+    }
+
+    /// A route search's answer: a new route (the progress monitor is carried over to its arc
+    /// length), a verdict that the goal cannot be reached (the route then leads to the reachable
+    /// point nearest it), or a failure (the previous route stays).
+    fn apply_route_answer(
+        &mut self,
+        cycle: &mut Cycle,
+        measured: &State,
+        goal: &Vec3,
+        reason: RouteReason,
+        answer: RouteProgress,
+    ) {
+        let goal = *goal;
         let new_route = match answer {
             RouteProgress::Found(route) => {
                 self.unreachable = None;
