@@ -702,6 +702,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         } else {
             None
         };
+        let started_now = reason.is_some();
         if let Some(reason) = reason {
             if new_goal {
                 self.unreachable = None;
@@ -727,9 +728,11 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         let reason = *reason;
         let answer = match away_answer {
             Some(answer) => answer,
-            // With a map the threads can read, every slice is done between cycles (this one
-            // is sent away as the cycle ends); else the cycle does a slice itself.
-            None if !off_cycle => {
+            // The cycle that starts a search does its first slice (most routes are found
+            // there, before the vehicle has waited a cycle); with a map the threads can read,
+            // the later slices are done between cycles (sent away as the cycle ends), else
+            // each cycle does a slice itself.
+            None if started_now || !off_cycle => {
                 let work = router.work_per_cycle();
                 match spans.time(Span::Route, || search.advance(scene.map, work)) {
                     RouteProgress::Pending => return,
