@@ -9,12 +9,15 @@
 //!
 //! * a search ([`trust_route::RouteSearch`]) starts on the first cycle toward a goal (and
 //!   whenever the goal moves), on a stall, and on a re-check;
-//! * the search is done in slices, off the cycle's critical path: as a cycle ends the manager
-//!   hands the search to a thread of its own for [`Router::work_off_cycle`] units, and the
-//!   next cycle takes it back (it waits for it, so a seed is one flight; the answer never
-//!   depends on the slicing). Without a shared map ([`crate::Manager::share_map`]) or with
-//!   [`crate::ManagerParams::background`] off, each cycle does [`Router::work_per_cycle`] units
-//!   itself. Meanwhile the vehicle flies the previous route, or toward the goal without one;
+//! * the cycle that starts a search does its first slice, at most [`Router::work_per_cycle`]
+//!   units (most routes are found there); a search that needs more goes on off the cycle's
+//!   critical path: as a cycle ends the manager hands it to a thread of its own for
+//!   [`Router::work_off_cycle`] units, and the next cycle takes it back (it waits for it, so a
+//!   seed is one flight; the answer never depends on the slicing; in real time it takes the
+//!   answer only once due, [`crate::ManagerParams::real_time_scale`]). Without a shared map
+//!   ([`crate::Manager::share_map`]) or with [`crate::ManagerParams::background`] off, each
+//!   cycle does [`Router::work_per_cycle`] units itself. Meanwhile the vehicle flies the previous
+//!   route, or toward the goal without one;
 //! * its answer is reported as [`crate::Event::Rerouted`] (why, length, vertices),
 //!   [`crate::Event::GoalUnreachable`] (the cause; the manager then plans toward the reachable
 //!   point nearest the goal and holds a stop there, [`crate::StepReport::goal_unreachable`]) or
