@@ -23,13 +23,12 @@ use std::time::{Duration, Instant};
 
 use ros2_client::{Context, ContextOptions, NodeName, NodeOptions};
 use trust_core::Vec3;
-use trust_ros2::dds::{self, DdsNode, DdsOptions, plan_qos, system_time, topics};
+use trust_ros2::dds::{self, plan_qos, system_time, topics};
 use trust_ros2::dds_world::reference_at;
-use trust_ros2::msg::builtin_interfaces::Time;
-use trust_ros2::msg::geometry_msgs::{Point, PoseStamped};
+use trust_ros2::msg::geometry_msgs::PoseStamped;
 use trust_ros2::msg::nav_msgs::Odometry;
 use trust_ros2::msg::trajectory_msgs::MultiDOFJointTrajectory;
-use trust_ros2::{NodeCore, NodeParams, NodeSetup};
+use trust_ros2::test_support::{goal, odometry, quickstart_dds_node};
 
 const POLL: Duration = Duration::from_micros(100);
 const START: Vec3 = Vec3::new(2.0, 10.0, 3.0);
@@ -46,16 +45,7 @@ struct NodeSample {
 }
 
 fn node_thread(domain: u16, stop: Arc<AtomicBool>, out: mpsc::Sender<NodeSample>) {
-    let scenario =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/quickstart.toml");
-    let setup = NodeSetup::from_scenario(&scenario).expect("quickstart");
-    let origin = Time {
-        sec: system_time().sec,
-        nanosec: 0,
-    };
-    let mut core = NodeCore::new(setup, NodeParams::default(), origin).expect("core");
-    let ctx = context(domain);
-    let mut node = DdsNode::new(&ctx, &DdsOptions::default()).expect("node");
+    let (mut core, mut node) = quickstart_dds_node(domain).expect("quickstart node");
     let mut warn = |what: &str, e: &trust_ros2::Ros2Error| eprintln!("node ({what}): {e}");
     let mut odom_count = 0;
     while !stop.load(Ordering::Relaxed) {
@@ -80,15 +70,9 @@ fn node_thread(domain: u16, stop: Arc<AtomicBool>, out: mpsc::Sender<NodeSample>
     }
 }
 
+/// The vehicle's odometry now, its twist in the world frame.
 fn odom_at(p: Vec3, v: Vec3) -> Odometry {
-    let mut m = Odometry {
-        header: system_time().into_header("map"),
-        child_frame_id: "map".into(),
-        ..Odometry::default()
-    };
-    m.pose.pose.position = p.into();
-    m.twist.twist.linear = v.into();
-    m
+    odometry(system_time(), "map", p, v)
 }
 
 /// Median, p99 and max of `x` (sorted in place).
@@ -123,9 +107,7 @@ fn main() {
     let traj_sub =
         dds::subscription::<MultiDOFJointTrajectory>(&mut world, topics::TRAJECTORY, plan_qos())
             .expect("trajectory reader");
-    let mut goal = PoseStamped::default();
-    goal.header.frame_id = "map".into();
-    goal.pose.position = Point::from(GOAL);
+    let goal = goal(system_time(), GOAL);
 
     // Discovery: until the first trajectory comes back.
     let deadline = Instant::now() + Duration::from_secs(30);

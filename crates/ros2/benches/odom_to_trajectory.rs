@@ -6,40 +6,29 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use trust_core::Vec3;
 use trust_ros2::cdr;
 use trust_ros2::convert::trajectory_message;
+use trust_ros2::heading::Heading;
 use trust_ros2::msg::builtin_interfaces::Time;
-use trust_ros2::msg::geometry_msgs::{Point, PoseStamped};
 use trust_ros2::msg::nav_msgs::Odometry;
-use trust_ros2::{NodeCore, NodeParams, NodeSetup};
+use trust_ros2::test_support::{goal, odometry, quickstart_core};
 
 fn bench(c: &mut Criterion) {
     let origin = Time {
         sec: 1_700_000_000,
         nanosec: 0,
     };
-    let scenario =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/quickstart.toml");
-    let setup = NodeSetup::from_scenario(&scenario).expect("quickstart");
-    let mut core = NodeCore::new(setup, NodeParams::default(), origin).expect("core");
-    let mut odom = Odometry::default();
-    odom.header.stamp = origin;
-    odom.header.frame_id = "map".into();
-    odom.child_frame_id = "base_link".into();
-    odom.pose.pose.position = Point {
-        x: 2.0,
-        y: 10.0,
-        z: 3.0,
-    };
-    let mut goal = PoseStamped::default();
-    goal.header.frame_id = "map".into();
-    goal.pose.position = Point {
-        x: 38.0,
-        y: 10.0,
-        z: 3.0,
-    };
+    let mut core = quickstart_core(origin).expect("core");
+    let odom = odometry(
+        origin,
+        "base_link",
+        Vec3::new(2.0, 10.0, 3.0),
+        Vec3::zeros(),
+    );
     core.on_odometry(&odom).expect("odometry");
-    core.on_goal(&goal).expect("goal");
+    core.on_goal(&goal(origin, Vec3::new(38.0, 10.0, 3.0)))
+        .expect("goal");
     core.cycle(origin).expect("cycle").expect("ran");
     let payload = cdr::encode(&odom).expect("encode");
     let samples = core
@@ -55,13 +44,14 @@ fn bench(c: &mut Criterion) {
                 core.on_odometry(&msg).expect("odometry");
                 let params = core.params();
                 let plan = core.manager().plan().expect("plan");
+                let mut heading = Heading::new(params.yaw).expect("yaw policy");
                 let traj = trajectory_message(
                     plan,
                     0.0,
                     params.trajectory_dt_s,
                     core.clock(),
-                    &params.world_frame,
-                    &params.body_frame,
+                    (&params.world_frame, &params.body_frame),
+                    &mut heading,
                 )
                 .expect("trajectory");
                 black_box(cdr::encode(&traj).expect("encode"))

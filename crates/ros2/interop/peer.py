@@ -3,17 +3,26 @@
 `requirements.txt`), which shares no code with ros2-client/RustDDS.
 
 The ROS 2 message types are declared here as Cyclone IDL structs, written from the ROS 2 `.msg`
-definitions (common_interfaces as in Humble and Jazzy, px4_msgs of PX4 v1.15, and our
-`crates/ros2/msg/trust_msgs`), not from the Rust structs. ROS 2 on DDS: the topic `/odom` is the
-DDS topic `rt/odom`, the type `nav_msgs/msg/Odometry` the DDS type
-`nav_msgs::msg::dds_::Odometry_`, payloads XCDR1 little-endian.
+definitions (common_interfaces, geometry2's tf2_msgs and rcl_interfaces' rosgraph_msgs as in
+Humble and Jazzy, px4_msgs of PX4 v1.15, and our `crates/ros2/msg/trust_msgs`), not from the
+Rust structs. ROS 2 on DDS: the topic `/odom` is the DDS topic `rt/odom`, the type
+`nav_msgs/msg/Odometry` the DDS type `nav_msgs::msg::dds_::Odometry_`, payloads XCDR1
+little-endian.
 
 The peer publishes odometry, a goal and two moving obstacles with known values, receives every
 topic the node publishes and checks each message field by field (frames, stamps, finite
-numbers, the plan from the vehicle to the goal, the obstacles' forecasts). A field whose layout
-differs on the two sides either fails to decode here or decodes to values that fail a check.
+numbers, the plan from the vehicle to the goal, the yaw policy, the obstacles' forecasts, /tf).
+A field whose layout differs on the two sides either fails to decode here or decodes to values
+that fail a check.
 
-    peer.py --domain N [--px4] [--timeout S]
+    peer.py --domain N [--px4] [--sim-time START] [--timeout S]
+    peer.py --domain N --observe-world START [--timeout S]
+
+With `--sim-time START` the peer is also the node's clock (the node runs with
+`--use-sim-time`): it publishes `/clock` from START s on and stamps its messages with it; every
+stamp the node publishes must follow that clock. With `--observe-world START` it publishes
+nothing and checks a `trust-sim dds-world` flight whose clock starts at START s: `/clock`, the
+world's odometry, and the node's `/tf` and `trajectory` on the world's clock.
 
 Exit status 0 when every check passed, 1 on a failed check or a timeout (the reason on stderr).
 Run it restricted to loopback: CYCLONEDDS_URI (see `crates/ros2/tests/cyclone_interop.rs`).
@@ -128,6 +137,26 @@ class TwistWithCovariance(IdlStruct, typename=dds("geometry_msgs", "TwistWithCov
 class Transform(IdlStruct, typename=dds("geometry_msgs", "Transform")):
     translation: Vector3 = field(default_factory=Vector3)
     rotation: Quaternion = field(default_factory=Quaternion)
+
+
+@dataclass
+class TransformStamped(IdlStruct, typename=dds("geometry_msgs", "TransformStamped")):
+    header: Header = field(default_factory=Header)
+    child_frame_id: str = ""
+    transform: Transform = field(default_factory=Transform)
+
+
+# --- tf2_msgs, rosgraph_msgs --------------------------------------------------------------------
+
+
+@dataclass
+class TFMessage(IdlStruct, typename=dds("tf2_msgs", "TFMessage")):
+    transforms: t.sequence[TransformStamped] = field(default_factory=list)
+
+
+@dataclass
+class Clock(IdlStruct, typename=dds("rosgraph_msgs", "Clock")):
+    clock: Time = field(default_factory=Time)
 
 
 # --- nav_msgs, trajectory_msgs ------------------------------------------------------------------
@@ -268,6 +297,13 @@ class TrajectorySetpoint(IdlStruct, typename=dds("px4_msgs", "TrajectorySetpoint
 WORLD, BODY = "map", "base_link"
 START = (2.0, 10.0, 3.0)
 GOAL = (8.0, 10.0, 3.0)
+# The vehicle's heading the peer sends (90°: facing north, ENU) and the way to the goal (east).
+ODOM_YAW = math.pi / 2
+ODOM_Q = (0.0, 0.0, math.sqrt(0.5), math.sqrt(0.5))
+TRAVEL_YAW = math.atan2(GOAL[1] - START[1], GOAL[0] - START[0])
+# The node's default yaw policy (docs/ros2.md, "Yaw"): face the horizontal velocity above this
+# horizontal speed, hold the last yaw below it.
+YAW_MIN_SPEED = 0.3
 # (id, shape, size, position): off the way from START to GOAL.
 OBSTACLES = [
     (7, SHAPE_SPHERE, (1.0, 1.0, 1.0), (30.0, 4.0, 6.0)),
@@ -284,9 +320,30 @@ def check(cond, what):
         raise CheckFailed(what)
 
 
-def now_stamp():
-    ns = time.time_ns()
+class PeerClock:
+    """The ROS time the node should follow: the system clock, or with --sim-time the peer's own
+    simulated clock (START s when the peer starts, then with the monotonic clock)."""
+
+    def __init__(self, sim_start=None):
+        self.sim_start = sim_start
+        self.t0 = time.monotonic()
+
+    def now(self):
+        if self.sim_start is None:
+            return time.time()
+        return self.sim_start + (time.monotonic() - self.t0)
+
+
+CLOCK = PeerClock()
+
+
+def to_stamp(s):
+    ns = round(s * 1e9)
     return Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+
+
+def now_stamp():
+    return to_stamp(CLOCK.now())
 
 
 def seconds(stamp):
@@ -295,7 +352,7 @@ def seconds(stamp):
 
 def check_stamp(stamp, what):
     check(0 <= stamp.nanosec < 1_000_000_000, f"{what}.nanosec = {stamp.nanosec}: not in [0, 1e9)")
-    age = time.time() - seconds(stamp)
+    age = CLOCK.now() - seconds(stamp)
     check(-5.0 < age < 30.0, f"{what} = {seconds(stamp):.3f}: {age:.3f} s from the peer's clock")
 
 
@@ -322,8 +379,53 @@ def check_identity(q, what):
     check(abs(q.x) + abs(q.y) + abs(q.z) < 1e-9 and abs(q.w - 1.0) < 1e-9, f"{what} = {q}: not the identity")
 
 
-def check_point(p, what, seen):
-    """A MultiDOFJointTrajectoryPoint of one joint; returns its position."""
+def wrap(a):
+    """`a` wrapped to (-pi, pi]."""
+    r = math.fmod(a, 2 * math.pi)
+    if r <= -math.pi:
+        r += 2 * math.pi
+    elif r > math.pi:
+        r -= 2 * math.pi
+    return r
+
+
+def yaw_of(q, what):
+    """The yaw of a rotation about +z only (x = y = 0, unit norm)."""
+    finite((q.x, q.y, q.z, q.w), what)
+    check(q.x == 0.0 and q.y == 0.0, f"{what} = {q}: not a rotation about z alone")
+    check(abs(q.z * q.z + q.w * q.w - 1.0) < 1e-12, f"{what} = {q}: not a unit quaternion")
+    return 2.0 * math.atan2(q.z, q.w)
+
+
+def check_held_yaw(yaw, what):
+    """A yaw held while slow: the vehicle's own heading (the odometry's) or the way it went."""
+    check(min(abs(wrap(yaw - ODOM_YAW)), abs(wrap(yaw - TRAVEL_YAW))) < 0.2,
+          f"{what} = {yaw:.4f} rad: slow, so the held yaw: the odometry's {ODOM_YAW:.4f} or the travel "
+          f"heading {TRAVEL_YAW:.4f}")
+
+
+def check_yaw(yaw, rate, v, a, what, held):
+    """The yaw policy in the world frame (ENU) at velocity v and acceleration a: facing the
+    velocity with the rate of its heading when faster than YAW_MIN_SPEED, else the held yaw
+    (`held`, the previous sample's, or one of check_held_yaw's when None) and rate 0."""
+    speed2 = v[0] ** 2 + v[1] ** 2
+    if math.sqrt(speed2) > YAW_MIN_SPEED:
+        heading = math.atan2(v[1], v[0])
+        check(abs(wrap(yaw - heading)) < 1e-6, f"{what}: yaw {yaw:.6f} rad, the velocity {v} heads {heading:.6f}")
+        expected = (v[0] * a[1] - v[1] * a[0]) / speed2
+        check(abs(rate - expected) <= 1e-6 * max(1.0, abs(expected)),
+              f"{what}: yaw rate {rate} rad/s, the heading turns at {expected} rad/s")
+    else:
+        check(rate == 0.0, f"{what}: yaw rate {rate} rad/s while slow ({math.sqrt(speed2):.3f} m/s)")
+        if held is None:
+            check_held_yaw(yaw, what)
+        else:
+            check(abs(wrap(yaw - held)) < 1e-12, f"{what}: yaw {yaw} rad while slow, the last was {held}")
+
+
+def check_point(p, what, held):
+    """A MultiDOFJointTrajectoryPoint of one joint (`held`: the previous point's yaw, or None);
+    returns its position and yaw."""
     check(
         len(p.transforms) == len(p.velocities) == len(p.accelerations) == 1,
         f"{what}: {len(p.transforms)}/{len(p.velocities)}/{len(p.accelerations)} transforms/velocities/"
@@ -331,29 +433,47 @@ def check_point(p, what, seen):
     )
     tr = p.transforms[0]
     finite(xyz(tr.translation), f"{what}.translation")
-    check_identity(tr.rotation, f"{what}.rotation")
+    yaw = yaw_of(tr.rotation, f"{what}.rotation")
     for name, tw, limit in (("velocity", p.velocities[0], 10.5), ("acceleration", p.accelerations[0], 40.0)):
         finite(xyz(tw.linear) + xyz(tw.angular), f"{what}.{name}")
         check(math.hypot(*xyz(tw.linear)) <= limit, f"{what}.{name} = {xyz(tw.linear)}: above {limit}")
-        check(xyz(tw.angular) == (0.0, 0.0, 0.0), f"{what}.{name}.angular = {xyz(tw.angular)}, expected 0")
+    vel, acc = p.velocities[0], p.accelerations[0]
+    check((vel.angular.x, vel.angular.y) == (0.0, 0.0), f"{what}.velocity.angular = {xyz(vel.angular)}: not about z")
+    check(xyz(acc.angular) == (0.0, 0.0, 0.0), f"{what}.acceleration.angular = {xyz(acc.angular)}, expected 0")
+    check_yaw(yaw, vel.angular.z, xyz(vel.linear), xyz(acc.linear), f"{what} yaw", held)
     check(0 <= p.time_from_start.nanosec < 1_000_000_000, f"{what}.time_from_start.nanosec out of range")
     check(0 <= seconds(p.time_from_start) < 120.0, f"{what}.time_from_start = {seconds(p.time_from_start)}")
     x = xyz(tr.translation)
     check(all(lo - 1.0 <= c <= hi + 1.0 for c, lo, hi in zip(x, (0, 0, 0), (40, 20, 10))),
           f"{what}.translation = {x}: outside the world")
-    return x
+    return x, yaw
 
 
-def check_trajectory(m):
+def match_path_yaws(state, stamp, kind, yaws):
+    """The path and the trajectory of one cycle (same stamp) carry the same yaws."""
+    key = (stamp.sec, stamp.nanosec)
+    state[kind][key] = yaws
+    other = state["path_yaws" if kind == "trajectory_yaws" else "trajectory_yaws"].get(key)
+    if other is not None:
+        check(len(other) == len(yaws) and all(abs(wrap(a - b)) < 1e-9 for a, b in zip(other, yaws)),
+              f"path and trajectory of the cycle at {seconds(stamp):.3f}: yaws differ")
+        state["yaws_matched"] = True
+
+
+def check_trajectory(m, state):
     check_header(m.header, "trajectory")
     check(list(m.joint_names) == [BODY], f"trajectory.joint_names = {m.joint_names}, expected [{BODY!r}]")
     check(len(m.points) >= 2, f"trajectory: {len(m.points)} points")
     last_t = -1.0
+    held = None
+    yaws = []
     for k, p in enumerate(m.points):
-        check_point(p, f"trajectory.points[{k}]", None)
+        _, held = check_point(p, f"trajectory.points[{k}]", held)
+        yaws.append(held)
         tk = seconds(p.time_from_start)
         check(tk > last_t, f"trajectory.points[{k}].time_from_start = {tk} not after {last_t}")
         last_t = tk
+    match_path_yaws(state, m.header.stamp, "trajectory_yaws", yaws)
     first = xyz(m.points[0].transforms[0].translation)
     last = xyz(m.points[-1].transforms[0].translation)
     check(dist(first, START) < 1.0, f"trajectory starts at {first}, the vehicle is at {START}")
@@ -361,32 +481,34 @@ def check_trajectory(m):
     return f"{len(m.points)} points from {fmt(first)} to {fmt(last)} in {last_t:.2f} s"
 
 
-def check_path(m):
+def check_path(m, state):
     check_header(m.header, "path")
     check(len(m.poses) >= 2, f"path: {len(m.poses)} poses")
+    yaws = []
     for k, ps in enumerate(m.poses):
         check_header(ps.header, f"path.poses[{k}]")
         finite(xyz(ps.pose.position), f"path.poses[{k}].position")
-        check_identity(ps.pose.orientation, f"path.poses[{k}].orientation")
+        yaws.append(yaw_of(ps.pose.orientation, f"path.poses[{k}].orientation"))
+    match_path_yaws(state, m.header.stamp, "path_yaws", yaws)
     first, last = xyz(m.poses[0].pose.position), xyz(m.poses[-1].pose.position)
     check(dist(first, START) < 1.0, f"path starts at {first}, the vehicle is at {START}")
     check(dist(last, GOAL) < 1.0, f"path ends at {last}, the goal is {GOAL}")
     return f"{len(m.poses)} poses from {fmt(first)} to {fmt(last)}"
 
 
-def check_setpoint(m):
+def check_setpoint(m, state):
     check_header(m.header, "setpoint")
     check(list(m.joint_names) == [BODY], f"setpoint.joint_names = {m.joint_names}")
     check(len(m.points) == 1, f"setpoint: {len(m.points)} points, expected 1")
-    x = check_point(m.points[0], "setpoint.points[0]", None)
+    x, _ = check_point(m.points[0], "setpoint.points[0]", None)
     check(seconds(m.points[0].time_from_start) == 0.0, "setpoint.time_from_start is not 0")
     check(dist(x, START) < 1.0, f"setpoint at {x}: the vehicle (held at {START}) is not there")
     return f"at {fmt(x)}"
 
 
-def check_px4_setpoint(m):
+def check_px4_setpoint(m, state):
     # NED: north (ROS y), east (ROS x), down (-z).
-    check(m.timestamp > 0 and abs(m.timestamp * 1e-6 - time.time()) < 30.0,
+    check(m.timestamp > 0 and abs(m.timestamp * 1e-6 - CLOCK.now()) < 30.0,
           f"px4 setpoint.timestamp = {m.timestamp} µs: not the ROS time")
     for name in ("position", "velocity", "acceleration", "jerk"):
         v = [float(c) for c in getattr(m, name)]
@@ -396,10 +518,46 @@ def check_px4_setpoint(m):
     ned = [float(c) for c in m.position]
     expected = (START[1], START[0], -START[2])
     check(dist(ned, expected) < 1.0, f"px4 setpoint.position = {ned}, expected near NED {expected}")
-    # The node holds ROS yaw 0 (facing east, ENU), which is PX4 yaw π/2 (from north, clockwise).
-    check(abs(float(m.yaw) - math.pi / 2) < 1e-3, f"px4 setpoint.yaw = {m.yaw}, expected π/2 (east)")
-    check(math.isfinite(m.yawspeed), f"px4 setpoint.yawspeed = {m.yawspeed}")
-    return f"NED {fmt(ned)}"
+    # PX4's yaw is from north, clockwise seen from above: the heading of the horizontal NED
+    # velocity (north, east) is atan2(east, north), turning at (v_n a_e - v_e a_n) / |v|^2 about
+    # down. Slow, the held yaw: the odometry's (ENU 90°, north: NED 0) or the travel heading.
+    yaw, rate = float(m.yaw), float(m.yawspeed)
+    finite((yaw, rate), "px4 setpoint.yaw/yawspeed")
+    check(-math.pi <= yaw <= math.pi, f"px4 setpoint.yaw = {yaw}: outside [-π, π]")
+    (vn, ve, _), (an, ae, _) = m.velocity, m.acceleration
+    speed2 = vn * vn + ve * ve
+    if math.sqrt(speed2) > YAW_MIN_SPEED * 1.001:
+        heading = math.atan2(ve, vn)
+        check(abs(wrap(yaw - heading)) < 1e-4, f"px4 setpoint.yaw = {yaw}: the NED velocity heads {heading}")
+        expected = (vn * ae - ve * an) / speed2
+        check(abs(rate - expected) <= 1e-3 * max(1.0, abs(expected)),
+              f"px4 setpoint.yawspeed = {rate}: the NED heading turns at {expected}")
+        kind = "facing the velocity"
+    elif math.sqrt(speed2) < YAW_MIN_SPEED * 0.999:
+        check(rate == 0.0, f"px4 setpoint.yawspeed = {rate} while slow")
+        odom_ned, travel_ned = wrap(math.pi / 2 - ODOM_YAW), wrap(math.pi / 2 - TRAVEL_YAW)
+        check(min(abs(wrap(yaw - odom_ned)), abs(wrap(yaw - travel_ned))) < 0.2,
+              f"px4 setpoint.yaw = {yaw} while slow: expected the held {odom_ned} or {travel_ned}")
+        kind = "held"
+    else:
+        kind = "at the threshold (float32)"
+    state["px4_yaws"][kind] = state["px4_yaws"].get(kind, 0) + 1
+    return f"NED {fmt(ned)}, yaw {yaw:.3f} ({kind})"
+
+
+def check_tf(m, state):
+    check(len(m.transforms) == 1, f"tf: {len(m.transforms)} transforms, expected 1")
+    tr = m.transforms[0]
+    check_header(tr.header, "tf.transforms[0]")
+    check(tr.child_frame_id == BODY, f"tf.child_frame_id = {tr.child_frame_id!r}, expected {BODY!r}")
+    key = (tr.header.stamp.sec, tr.header.stamp.nanosec)
+    check(key in state["odom_stamps"], f"tf stamp {seconds(tr.header.stamp):.9f}: not one of the odometry's")
+    x = xyz(tr.transform.translation)
+    check(x == START, f"tf.translation = {x}, the odometry's position is {START}")
+    q = tr.transform.rotation
+    check(max(abs(a - b) for a, b in zip((q.x, q.y, q.z, q.w), ODOM_Q)) < 1e-12,
+          f"tf.rotation = {q}: the odometry's orientation is {ODOM_Q}")
+    return f"{WORLD} -> {BODY} at {fmt(x)}, stamped as an odometry sent"
 
 
 def check_markers(m, state):
@@ -453,7 +611,7 @@ def check_markers(m, state):
     return f"{branches} branches, forecasts of obstacles {found}"
 
 
-def check_event(m):
+def check_event(m, state):
     check_header(m.header, "events")
     check(m.cycle_count >= 1, f"events.cycle_count = {m.cycle_count}")
     check(math.isfinite(m.cycle_time_ms) and 0.0 <= m.cycle_time_ms < 60_000.0,
@@ -472,8 +630,14 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--domain", type=int, required=True)
     ap.add_argument("--px4", action="store_true", help="the node runs with --px4")
+    ap.add_argument("--sim-time", type=float, metavar="START",
+                    help="publish /clock from START s (the node runs with --use-sim-time)")
+    ap.add_argument("--observe-world", type=float, metavar="START",
+                    help="only observe a trust-sim dds-world flight whose clock starts at START s")
     ap.add_argument("--timeout", type=float, default=40.0)
     args = ap.parse_args()
+    global CLOCK
+    CLOCK = PeerClock(args.sim_time)
 
     dp = DomainParticipant(args.domain)
     best_effort = Qos(Policy.Reliability.BestEffort, Policy.Durability.Volatile, Policy.History.KeepLast(10))
@@ -486,6 +650,10 @@ def main():
     def reader(name, ty, qos):
         return DataReader(dp, Topic(dp, "rt/" + name, ty), qos=qos)
 
+    if args.observe_world is not None:
+        return observe_world(args, reader, best_effort, reliable)
+
+    clock_w = writer("clock", Clock, reliable) if args.sim_time is not None else None
     odom_w = writer("odom", Odometry, best_effort)
     goal_w = writer("goal", PoseStamped, reliable)  # as RViz's "2D Goal Pose"
     obst_w = writer("obstacles", MovingObstacleArray, best_effort)
@@ -493,8 +661,9 @@ def main():
     checks = {
         "trajectory": (reader("trajectory", MultiDOFJointTrajectory, reliable), check_trajectory),
         "path": (reader("path", Path, reliable), check_path),
-        "markers": (reader("markers", MarkerArray, reliable), None),
+        "markers": (reader("markers", MarkerArray, reliable), check_markers),
         "events": (reader("events", PlannerEvent, reliable), check_event),
+        "tf": (reader("tf", TFMessage, reliable), check_tf),
     }
     if args.px4:
         checks["fmu/in/trajectory_setpoint"] = (
@@ -502,17 +671,21 @@ def main():
     else:
         checks["setpoint"] = (reader("setpoint", MultiDOFJointTrajectory, best_effort), check_setpoint)
 
-    state = {"markers_complete": False}
+    state = {"markers_complete": False, "yaws_matched": False, "odom_stamps": set(),
+             "trajectory_yaws": {}, "path_yaws": {}, "px4_yaws": {}}
     passed = {}
     deadline = time.monotonic() + args.timeout
     next_publish = time.monotonic()
     while time.monotonic() < deadline:
+        if clock_w is not None:
+            clock_w.write(Clock(clock=now_stamp()))
         if time.monotonic() >= next_publish:
             stamp = now_stamp()
+            state["odom_stamps"].add((stamp.sec, stamp.nanosec))
             odom = Odometry(header=Header(stamp=stamp, frame_id=WORLD), child_frame_id=BODY)
             odom.pose.pose.position = Point(*START)
             # A yaw of 90°: the (zero) body-frame twist stays zero in the world.
-            odom.pose.pose.orientation = Quaternion(0.0, 0.0, math.sqrt(0.5), math.sqrt(0.5))
+            odom.pose.pose.orientation = Quaternion(*ODOM_Q)
             odom.pose.covariance = [0.01 if i % 7 == 0 else 0.0 for i in range(36)]
             odom_w.write(odom)
             goal_w.write(PoseStamped(header=Header(stamp=stamp, frame_id=WORLD),
@@ -526,23 +699,91 @@ def main():
         for name, (rd, fn) in checks.items():
             for sample in rd.take(N=50):
                 try:
-                    summary = check_markers(sample, state) if name == "markers" else fn(sample)
+                    summary = fn(sample, state)
                 except CheckFailed as e:
                     print(f"peer: FAILED {name}: {e}", file=sys.stderr)
                     return 1
                 if name not in passed:
                     print(f"peer: {name} ok: {summary}", file=sys.stderr)
                 passed[name] = summary
-        if len(passed) == len(checks) and state["markers_complete"]:
+        if len(passed) == len(checks) and state["markers_complete"] and state["yaws_matched"]:
             print(f"peer: markers complete: {passed['markers']}", file=sys.stderr)
+            print("peer: a path and a trajectory of one cycle carry the same yaws", file=sys.stderr)
+            if state["px4_yaws"]:
+                print(f"peer: px4 yaws checked: {state['px4_yaws']}", file=sys.stderr)
             print("peer: every check passed", file=sys.stderr)
             return 0
         time.sleep(0.01)
     missing = [n for n in checks if n not in passed]
     if not state["markers_complete"]:
         missing.append("markers with a branch and both obstacles' forecasts")
+    if not state["yaws_matched"]:
+        missing.append("a path and a trajectory of the same cycle")
     print(f"peer: FAILED: nothing (valid) within {args.timeout} s from {missing}; received {sorted(passed)}",
           file=sys.stderr)
+    return 1
+
+
+def observe_world(args, reader, best_effort, reliable):
+    """Checks a `trust-sim dds-world` flight whose clock starts at args.observe_world: its
+    `/clock` (decoded field by field: increasing, from the start given on), its odometry on that
+    clock, and the node's `/tf` (the world's odometry, same stamps) and `trajectory` (stamped on
+    the world's clock: the node follows /clock)."""
+    start = args.observe_world
+    clock_r = reader("clock", Clock, best_effort)
+    odom_r = reader("odom", Odometry, best_effort)
+    tf_r = reader("tf", TFMessage, reliable)
+    traj_r = reader("trajectory", MultiDOFJointTrajectory, reliable)
+    latest = None
+    clocks, odom_stamps, tf_matched, trajectories = 0, {}, 0, 0
+    deadline = time.monotonic() + args.timeout
+    try:
+        while time.monotonic() < deadline:
+            for c in clock_r.take(N=100):
+                s = seconds(c.clock)
+                check(0 <= c.clock.nanosec < 1_000_000_000, f"clock.nanosec = {c.clock.nanosec}")
+                check(start <= s < start + 600.0, f"clock = {s:.3f}: not on the world's clock from {start}")
+                check(latest is None or s >= latest, f"clock went back: {s:.6f} after {latest}")
+                latest = s
+                clocks += 1
+            for o in odom_r.take(N=100):
+                s = seconds(o.header.stamp)
+                check(o.header.frame_id == WORLD, f"world odom.header.frame_id = {o.header.frame_id!r}")
+                check(start <= s < start + 600.0, f"world odom stamp {s:.3f}: not on the world's clock")
+                q = o.pose.pose.orientation
+                check(abs(q.x ** 2 + q.y ** 2 + q.z ** 2 + q.w ** 2 - 1.0) < 1e-9, f"world odom orientation {q}")
+                odom_stamps[(o.header.stamp.sec, o.header.stamp.nanosec)] = o
+            for m in tf_r.take(N=100):
+                check(len(m.transforms) == 1, f"tf: {len(m.transforms)} transforms")
+                tr = m.transforms[0]
+                check((tr.header.frame_id, tr.child_frame_id) == (WORLD, BODY),
+                      f"tf frames {tr.header.frame_id!r} -> {tr.child_frame_id!r}")
+                o = odom_stamps.get((tr.header.stamp.sec, tr.header.stamp.nanosec))
+                if o is None:
+                    continue  # an odometry this peer did not receive (best effort)
+                check(xyz(tr.transform.translation) == xyz(o.pose.pose.position), "tf translation is not the odometry's")
+                q, r = tr.transform.rotation, o.pose.pose.orientation
+                check(max(abs(a - b) for a, b in zip((q.x, q.y, q.z, q.w), (r.x, r.y, r.z, r.w))) < 1e-9,
+                      f"tf rotation {q} is not the odometry's {r}")
+                tf_matched += 1
+            for m in traj_r.take(N=10):
+                s = seconds(m.header.stamp)
+                check(latest is not None and abs(s - latest) < 5.0,
+                      f"trajectory stamped {s:.3f}: the world's clock reads {latest}")
+                trajectories += 1
+            if clocks >= 50 and tf_matched >= 5 and trajectories >= 3:
+                print(f"peer: world clock ok: {clocks} /clock from {start} on, now {latest:.3f}", file=sys.stderr)
+                print(f"peer: tf ok: {tf_matched} transforms equal to the world's odometry of the same stamp",
+                      file=sys.stderr)
+                print(f"peer: trajectory ok: {trajectories} stamped on the world's clock", file=sys.stderr)
+                print("peer: every check passed", file=sys.stderr)
+                return 0
+            time.sleep(0.01)
+    except CheckFailed as e:
+        print(f"peer: FAILED observing the world: {e}", file=sys.stderr)
+        return 1
+    print(f"peer: FAILED: within {args.timeout} s {clocks} /clock, {tf_matched} tf matched, "
+          f"{trajectories} trajectories", file=sys.stderr)
     return 1
 
 

@@ -264,6 +264,52 @@ mod tests {
     }
 
     #[test]
+    fn tf_message_and_clock_match_hand_computed_bytes() {
+        use crate::msg::rosgraph_msgs::Clock;
+        use crate::msg::tf2_msgs::{TFMessage, TransformStamped};
+        let msg = TFMessage {
+            transforms: vec![TransformStamped {
+                header: Header {
+                    stamp: Time { sec: 7, nanosec: 9 },
+                    frame_id: "map".into(),
+                },
+                child_frame_id: "base_link".into(),
+                transform: Transform {
+                    translation: Vector3 {
+                        x: 1.0,
+                        y: 2.0,
+                        z: 3.0,
+                    },
+                    rotation: Quaternion::from_yaw(0.5),
+                },
+            }],
+        };
+        let q = Quaternion::from_yaw(0.5);
+        let mut b = Bytes::new();
+        b.u32(1); // transforms count    0..4
+        b.i32(7); // stamp.sec           4..8
+        b.u32(9); // stamp.nanosec       8..12
+        b.string("map"); // frame_id     12..20
+        b.string("base_link"); // child  20..34
+        assert_eq!(b.pad(8), 6, "translation.x is a float64: 34 -> 40");
+        b.f64s(&[1.0, 2.0, 3.0, q.x, q.y, q.z, q.w]); // 40..96
+        let payload = encode(&msg).expect("encodes");
+        assert_eq!(payload, b.0);
+        assert_eq!(decode::<TFMessage>(&payload).expect("decodes"), msg);
+
+        let clock = Clock {
+            clock: Time {
+                sec: 1000,
+                nanosec: 20_000_000,
+            },
+        };
+        let mut b = Bytes::new();
+        b.i32(1000);
+        b.u32(20_000_000);
+        assert_eq!(encode(&clock).expect("encodes"), b.0);
+    }
+
+    #[test]
     fn another_encapsulation_is_a_typed_error() {
         let err = decode::<Time>(&[0x00, 0x00, 0x00, 0x00, 1, 0, 0, 0, 0, 0, 0, 0])
             .expect_err("big-endian header");

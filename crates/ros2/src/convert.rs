@@ -5,12 +5,15 @@
 
 use nalgebra::{Quaternion as NaQuaternion, UnitQuaternion};
 use trust_core::{Forecast, ObstacleShape, PolyTraj, State, Vec3};
+use trust_flightstack::yaw::YawSample;
 
 use crate::error::Ros2Error;
+use crate::heading::Heading;
 use crate::msg::builtin_interfaces::{Duration, Time};
 use crate::msg::geometry_msgs::{Point, Pose, PoseStamped, Quaternion, Transform, Twist, Vector3};
 use crate::msg::nav_msgs::{Odometry, Path};
 use crate::msg::std_msgs::{ColorRGBA, Header};
+use crate::msg::tf2_msgs::TransformStamped;
 use crate::msg::trajectory_msgs::{MultiDOFJointTrajectory, MultiDOFJointTrajectoryPoint};
 use crate::msg::visualization_msgs::Marker;
 
@@ -120,6 +123,31 @@ pub fn odometry_state(
     })
 }
 
+/// The transform from `msg`'s frame (the world frame) to `body_frame` at `msg`'s stamp: the
+/// odometry's position and orientation (normalized), for `/tf`. The child is `body_frame`, not
+/// `msg.child_frame_id`, which may name the world frame (a twist given in the world).
+///
+/// # Errors
+/// [`Ros2Error::Invalid`] naming the field for a non-finite position or a zero or non-finite
+/// orientation.
+pub fn odometry_transform(msg: &Odometry, body_frame: &str) -> Result<TransformStamped, Ros2Error> {
+    let p = finite_vec("odom.pose.pose.position", msg.pose.pose.position.into())?;
+    let q = unit_quaternion("odom.pose.pose.orientation", &msg.pose.pose.orientation)?;
+    Ok(TransformStamped {
+        header: msg.header.clone(),
+        child_frame_id: body_frame.to_owned(),
+        transform: Transform {
+            translation: p.into(),
+            rotation: Quaternion {
+                x: q.i,
+                y: q.j,
+                z: q.k,
+                w: q.w,
+            },
+        },
+    })
+}
+
 /// The goal position of a `PoseStamped` (its orientation is checked, then ignored: the planner
 /// plans positions).
 ///
@@ -161,9 +189,23 @@ pub fn sample_times(traj: &PolyTraj, from: f64, dt: f64) -> Result<Vec<f64>, Ros
     Ok(out)
 }
 
-/// One trajectory point of `traj` at node time `t`: position (identity rotation: the planner
-/// plans positions, not yaw), velocity and acceleration in the world frame, `time_from_start =
-/// t − start`.
+/// The yaw sample as a rotation about +z, checked finite.
+fn yaw_rotation(field: &str, yaw: &YawSample) -> Result<Quaternion, Ros2Error> {
+    if !(yaw.yaw_rad.is_finite() && yaw.yaw_rate_rad_s.is_finite()) {
+        return Err(Ros2Error::invalid(
+            field,
+            format!("yaw {} rad, rate {} rad/s", yaw.yaw_rad, yaw.yaw_rate_rad_s),
+            "a finite yaw and yaw rate",
+        ));
+    }
+    Ok(Quaternion::from_yaw(yaw.yaw_rad))
+}
+
+/// One trajectory point of `traj` at node time `t`: position and the rotation by `yaw` about
+/// +z (`transforms[0]`), velocity with the yaw rate as `angular.z` (`velocities[0]`),
+/// acceleration with zero angular part (`accelerations[0]`), all in the world frame;
+/// `time_from_start = t − start`. `heading` gives the yaw ([`Heading::next`], module
+/// [`crate::heading`]).
 ///
 /// # Errors
 /// [`Ros2Error::Invalid`] for a negative or non-finite `t − start` or a non-finite sample.
@@ -171,11 +213,14 @@ pub fn trajectory_point(
     traj: &PolyTraj,
     t: f64,
     start: f64,
+    heading: &mut Heading,
 ) -> Result<MultiDOFJointTrajectoryPoint, Ros2Error> {
     let s = traj.state(t);
     let p = finite_vec("trajectory.position", s.p)?;
     let v = finite_vec("trajectory.velocity", s.v)?;
     let a = finite_vec("trajectory.acceleration", s.a)?;
+    let yaw = heading.next(&v, &a)?;
+    let rotation = yaw_rotation("trajectory.yaw", &yaw)?;
     let since = t - start;
     if since.is_nan() || since < 0.0 {
         return Err(Ros2Error::invalid(
@@ -187,11 +232,15 @@ pub fn trajectory_point(
     Ok(MultiDOFJointTrajectoryPoint {
         transforms: vec![Transform {
             translation: p.into(),
-            rotation: Quaternion::IDENTITY,
+            rotation,
         }],
         velocities: vec![Twist {
             linear: v.into(),
-            angular: Vector3::default(),
+            angular: Vector3 {
+                x: 0.0,
+                y: 0.0,
+                z: yaw.yaw_rate_rad_s,
+            },
         }],
         accelerations: vec![Twist {
             linear: a.into(),
@@ -202,7 +251,8 @@ pub fn trajectory_point(
 }
 
 /// `traj` from node time `from` on as a `MultiDOFJointTrajectory` sampled every `dt`
-/// ([`sample_times`]), stamped at the first sample, one joint named `body_frame`.
+/// ([`sample_times`]), stamped at the first sample, one joint named `body_frame`, the yaws
+/// from `heading` fed the samples in order (pass [`Heading::ahead`]'s copy).
 ///
 /// # Errors
 /// As [`sample_times`] and [`trajectory_point`].
@@ -211,14 +261,15 @@ pub fn trajectory_message(
     from: f64,
     dt: f64,
     clock: &Clock,
-    world_frame: &str,
-    body_frame: &str,
+    frames: (&str, &str),
+    heading: &mut Heading,
 ) -> Result<MultiDOFJointTrajectory, Ros2Error> {
+    let (world_frame, body_frame) = frames;
     let times = sample_times(traj, from, dt)?;
     let start = times[0];
     let points = times
         .iter()
-        .map(|&t| trajectory_point(traj, t, start))
+        .map(|&t| trajectory_point(traj, t, start, heading))
         .collect::<Result<Vec<_>, _>>()?;
     Ok(MultiDOFJointTrajectory {
         header: clock.header(start, world_frame)?,
@@ -228,7 +279,7 @@ pub fn trajectory_message(
 }
 
 /// `traj` from node time `from` on as a `nav_msgs/Path` (positions every `dt`, each pose
-/// stamped with its time, identity orientation).
+/// stamped with its time, oriented by the yaw `heading` gives, as in [`trajectory_message`]).
 ///
 /// # Errors
 /// As [`sample_times`]; [`Ros2Error::Invalid`] for a non-finite sample.
@@ -238,16 +289,19 @@ pub fn path_message(
     dt: f64,
     clock: &Clock,
     world_frame: &str,
+    heading: &mut Heading,
 ) -> Result<Path, Ros2Error> {
     let times = sample_times(traj, from, dt)?;
     let poses = times
         .iter()
         .map(|&t| {
+            let s = traj.state(t);
+            let yaw = heading.next(&s.v, &s.a)?;
             Ok(PoseStamped {
                 header: clock.header(t, world_frame)?,
                 pose: Pose {
-                    position: finite_vec("path.position", traj.position(t))?.into(),
-                    orientation: Quaternion::IDENTITY,
+                    position: finite_vec("path.position", s.p)?.into(),
+                    orientation: yaw_rotation("path.yaw", &yaw)?,
                 },
             })
         })

@@ -1,10 +1,12 @@
 //! The thin DDS layer: one ros2-client node with the subscriptions and publishers of
 //! `docs/ros2.md`, and a loop ([`DdsNode::run`]) that drains the subscriptions into a
 //! [`NodeCore`], runs a cycle every `cycle_period_s` and a setpoint every
-//! `1/setpoint_rate_hz`, and publishes what the core returns. Everything else is in the core.
+//! `1/setpoint_rate_hz` of ROS time (the system clock, or `/clock` with
+//! [`DdsOptions::use_sim_time`]), and publishes what the core returns. Everything else is in
+//! the core.
 
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration as StdDuration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration as StdDuration, SystemTime, UNIX_EPOCH};
 
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{Context, MessageTypeName, Name, Node, NodeName, NodeOptions, QosProfile};
@@ -17,6 +19,8 @@ use crate::msg::RosMessage;
 use crate::msg::builtin_interfaces::Time;
 use crate::msg::geometry_msgs::PoseStamped;
 use crate::msg::nav_msgs::{Odometry, Path};
+use crate::msg::rosgraph_msgs::Clock;
+use crate::msg::tf2_msgs::TFMessage;
 use crate::msg::trajectory_msgs::MultiDOFJointTrajectory;
 use crate::msg::trust_msgs::{MovingObstacleArray, PlannerEvent};
 use crate::msg::visualization_msgs::MarkerArray;
@@ -43,6 +47,11 @@ pub mod topics {
     pub const MARKERS: &str = "markers";
     /// Out: `trust_msgs/PlannerEvent`.
     pub const EVENTS: &str = "events";
+    /// Out: `tf2_msgs/TFMessage`, the world-to-body transform of each odometry (absolute, as
+    /// tf2's broadcasters).
+    pub const TF: &str = "/tf";
+    /// In with `use_sim_time` (out of `trust-sim dds-world`): `rosgraph_msgs/Clock`, absolute.
+    pub const CLOCK: &str = "/clock";
 }
 
 /// `px4_msgs/msg/TrajectorySetpoint` as a ROS message: the flight stack's struct
@@ -77,6 +86,26 @@ pub fn input_qos() -> QosProfile {
         .history(History::KeepLast { depth: 10 })
 }
 
+/// `/tf`: reliable, volatile, keep last 100, as tf2's `TransformBroadcaster` (RViz's and
+/// Foxglove's listeners match it).
+pub fn tf_qos() -> QosProfile {
+    plan_qos().history(History::KeepLast { depth: 100 })
+}
+
+/// `/clock`: the writer (`trust-sim dds-world`) reliable, volatile, keep last 1, so that both
+/// reliable readers and rclcpp's best-effort clock subscription match; the node's reader is
+/// best effort, keep last 1 (rclcpp's `ClockQoS`), matching either kind of writer.
+pub fn clock_writer_qos() -> QosProfile {
+    plan_qos()
+}
+
+/// `/clock`'s reader (see [`clock_writer_qos`]).
+pub fn clock_reader_qos() -> QosProfile {
+    QosProfile::subscription_default()
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 1 })
+}
+
 /// How the node joins the DDS domain.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct DdsOptions {
@@ -86,6 +115,11 @@ pub struct DdsOptions {
     pub node_name: String,
     /// Publish PX4's `TrajectorySetpoint` on [`topics::PX4_SETPOINT`] instead of `setpoint`.
     pub px4: bool,
+    /// Publish each accepted odometry on [`topics::TF`] (`NodeParams::publish_tf`).
+    pub publish_tf: bool,
+    /// ROS time from [`topics::CLOCK`] instead of the system clock
+    /// (`NodeParams::use_sim_time`).
+    pub use_sim_time: bool,
 }
 
 impl Default for DdsOptions {
@@ -94,6 +128,19 @@ impl Default for DdsOptions {
             namespace: "/".into(),
             node_name: "trust_planner".into(),
             px4: false,
+            publish_tf: true,
+            use_sim_time: false,
+        }
+    }
+}
+
+impl DdsOptions {
+    /// The defaults with `params`'s `publish_tf` and `use_sim_time`.
+    pub fn for_params(params: &crate::NodeParams) -> Self {
+        DdsOptions {
+            publish_tf: params.publish_tf,
+            use_sim_time: params.use_sim_time,
+            ..DdsOptions::default()
         }
     }
 }
@@ -199,6 +246,9 @@ pub struct DdsNode {
     setpoint: SetpointOut,
     markers: Publisher<MarkerArray>,
     events: Publisher<PlannerEvent>,
+    tf: Option<Publisher<TFMessage>>,
+    /// `/clock` with `use_sim_time`, and the latest time it gave.
+    clock: Option<(Subscription<Clock>, Option<Time>)>,
 }
 
 impl std::fmt::Debug for DdsNode {
@@ -248,6 +298,19 @@ impl DdsNode {
             topics::EVENTS,
             plan_qos().history(History::KeepLast { depth: 10 }),
         )?;
+        let tf = if options.publish_tf {
+            Some(publisher(&mut node, topics::TF, tf_qos())?)
+        } else {
+            None
+        };
+        let clock = if options.use_sim_time {
+            Some((
+                subscription(&mut node, topics::CLOCK, clock_reader_qos())?,
+                None,
+            ))
+        } else {
+            None
+        };
         let spinner = node
             .spinner()
             .map_err(|e| Ros2Error::dds("create spinner", e))?;
@@ -265,13 +328,48 @@ impl DdsNode {
             setpoint,
             markers,
             events,
+            tf,
+            clock,
         })
     }
 
+    /// The ROS time now: the system clock, or with `use_sim_time` the latest `/clock` received
+    /// (`None` before the first, as ROS's time is zero until then: nothing runs).
+    pub fn now(&mut self) -> Option<Time> {
+        let Some((sub, latest)) = &mut self.clock else {
+            return Some(system_time());
+        };
+        while let Ok(Some((m, _))) = sub.take() {
+            *latest = Some(m.clock);
+        }
+        *latest
+    }
+
+    /// With `use_sim_time`, waits for the first `/clock` (polling every 10 ms) until `stop` is
+    /// set; otherwise the system time at once.
+    pub fn wait_for_time(&mut self, stop: &AtomicBool) -> Option<Time> {
+        loop {
+            if let Some(t) = self.now() {
+                return Some(t);
+            }
+            if stop.load(Ordering::Relaxed) {
+                return None;
+            }
+            std::thread::sleep(StdDuration::from_millis(10));
+        }
+    }
+
     /// Hands every message received so far to `core`; a rejected message, or one that does
-    /// not decode, goes to `warn`.
+    /// not decode, goes to `warn`. Publishes `/tf` once after new odometry was accepted.
     pub fn receive(&mut self, core: &mut NodeCore, warn: &mut dyn FnMut(&str, &Ros2Error)) {
+        let odom_count = core.counters().odom_count;
         drain(&self.odom, topics::ODOM, warn, |m| core.on_odometry(&m));
+        if core.counters().odom_count > odom_count
+            && let (Some(tf), Some(m)) = (&self.tf, core.transform())
+            && let Err(e) = tf.publish(m)
+        {
+            warn(topics::TF, &Ros2Error::dds("publish tf", e));
+        }
         drain(&self.goal, topics::GOAL, warn, |m| core.on_goal(&m));
         drain(&self.obstacles, topics::OBSTACLES, warn, |m| {
             core.on_obstacles(&m)
@@ -331,42 +429,75 @@ impl DdsNode {
     }
 
     /// Runs the node until `stop` is set: receives continuously (polling every 1 ms), runs a
-    /// cycle every `cycle_period_s` and a setpoint every `1/setpoint_rate_hz` on the system
-    /// clock. Errors of a cycle or a setpoint go to `warn` and the loop goes on.
+    /// cycle every `cycle_period_s` and a setpoint every `1/setpoint_rate_hz` of ROS time
+    /// ([`DdsNode::now`]: with `use_sim_time` nothing runs before the first `/clock`, and the
+    /// timers restart when the clock goes back). Errors of a cycle or a setpoint go to `warn`
+    /// and the loop goes on.
     pub fn run(
         &mut self,
         core: &mut NodeCore,
         stop: &AtomicBool,
         warn: &mut dyn FnMut(&str, &Ros2Error),
     ) {
-        let cycle_period = StdDuration::from_secs_f64(core.params().cycle_period_s);
-        let setpoint_period = StdDuration::from_secs_f64(1.0 / core.params().setpoint_rate_hz);
-        let mut next_cycle = Instant::now();
-        let mut next_setpoint = Instant::now();
+        let mut cycle_timer = Timer::new(core.params().cycle_period_s);
+        let mut setpoint_timer = Timer::new(1.0 / core.params().setpoint_rate_hz);
         while !stop.load(Ordering::Relaxed) {
             self.receive(core, warn);
-            let now = Instant::now();
-            if now >= next_cycle {
-                if let Err(e) = self.cycle(core, system_time()) {
+            if let Some(now) = self.now() {
+                let s = now.as_seconds();
+                if cycle_timer.due(s)
+                    && let Err(e) = self.cycle(core, now)
+                {
                     warn("cycle", &e);
                 }
-                next_cycle += cycle_period;
-                if next_cycle < now {
-                    // An overrun: skip the missed ticks instead of running them back to back.
-                    next_cycle = now + cycle_period;
-                }
-            }
-            if now >= next_setpoint {
-                if let Err(e) = self.setpoint(core, system_time()) {
+                if setpoint_timer.due(s)
+                    && let Err(e) = self.setpoint(core, now)
+                {
                     warn(topics::SETPOINT, &e);
-                }
-                next_setpoint += setpoint_period;
-                if next_setpoint < now {
-                    next_setpoint = now + setpoint_period;
                 }
             }
             std::thread::sleep(StdDuration::from_millis(1));
         }
+    }
+}
+
+/// A periodic timer on ROS time (s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Timer {
+    period_s: f64,
+    /// The next tick; `None` before the first (which is due at once).
+    next_s: Option<f64>,
+    /// The latest time seen.
+    last_s: f64,
+}
+
+impl Timer {
+    fn new(period_s: f64) -> Self {
+        Timer {
+            period_s,
+            next_s: None,
+            last_s: f64::NEG_INFINITY,
+        }
+    }
+
+    /// Whether a tick is due at time `now_s`; if so, the next one is scheduled a period later
+    /// (after an overrun, a period from now: missed ticks are skipped, not run back to back).
+    /// A clock that went back (a simulator restarted) restarts the timer.
+    fn due(&mut self, now_s: f64) -> bool {
+        if now_s < self.last_s {
+            self.next_s = None;
+        }
+        self.last_s = now_s;
+        let next = self.next_s.unwrap_or(now_s);
+        if now_s < next {
+            return false;
+        }
+        let mut following = next + self.period_s;
+        if following < now_s {
+            following = now_s + self.period_s;
+        }
+        self.next_s = Some(following);
+        true
     }
 }
 
@@ -383,6 +514,22 @@ mod tests {
     }
 
     #[test]
+    fn timers_tick_on_ros_time_skip_overruns_and_restart_when_it_goes_back() {
+        // Binary fractions: the sums are exact.
+        let mut t = Timer::new(0.25);
+        let ticks: Vec<f64> = [0.0, 0.125, 0.25, 0.375, 0.5, 1.375, 1.5, 1.625]
+            .into_iter()
+            .filter(|&s| t.due(1000.0 + s))
+            .collect();
+        // The overrun to 1.375 skips 0.75..1.25; the next tick is 1.625.
+        assert_eq!(ticks, vec![0.0, 0.25, 0.5, 1.375, 1.625]);
+        // The clock restarts at 0: a tick at once, then every period.
+        assert!(t.due(0.0));
+        assert!(!t.due(0.125));
+        assert!(t.due(0.25));
+    }
+
+    #[test]
     fn relative_names_in_the_root_namespace_are_rt_slash_name_not_rt_double_slash() {
         assert_eq!(dds_topic("/", topics::ODOM), "rt/odom");
         assert_eq!(dds_topic("/uav1", topics::ODOM), "rt/uav1/odom");
@@ -394,5 +541,7 @@ mod tests {
             dds_topic("/uav1", topics::PX4_SETPOINT),
             "rt/fmu/in/trajectory_setpoint"
         );
+        assert_eq!(dds_topic("/uav1", topics::TF), "rt/tf");
+        assert_eq!(dds_topic("/uav1", topics::CLOCK), "rt/clock");
     }
 }

@@ -1,9 +1,12 @@
 //! The simulator as the ROS 2 world of a separate `trust-node` (`trust-sim dds-world`): the
 //! scenario's true obstacles move and the vehicle model flies the `trajectory` the node
-//! publishes, in real time on the system clock (the node's clock); the world publishes the
-//! vehicle's `odom`, the `goal` and the obstacles (`obstacles`, their true centres and sizes)
-//! and writes the flight's run log (`trust_runlog`, contract `run-log-v1`): a `state` record
-//! every physics step, a `cycle` record per `events` message of the node, the `outcome`.
+//! publishes (positions and yaw), in real time; the world publishes its ROS time on `/clock`
+//! (`rosgraph_msgs/Clock`, every physics step: the system time by default, so that a node on
+//! either clock works, or simulated from `clock_start_s`, for a node with `use_sim_time`), and
+//! stamped with it the vehicle's `odom` (position, attitude, velocity), the `goal` and the
+//! obstacles (`obstacles`, their true centres and sizes), and
+//! writes the flight's run log (`trust_runlog`, contract `run-log-v1`): a `state` record every
+//! physics step, a `cycle` record per `events` message of the node, the `outcome`.
 //!
 //! Not yet as `trust-sim run`: no sensor noise or dropouts (the node's tracker gets the true
 //! centres), no `[clock]` model (the node's real cycle times apply), the `cycle` records carry
@@ -14,19 +17,29 @@ use std::time::{Duration as StdDuration, Instant};
 
 use trust_core::Vec3;
 use trust_flight::{Clearances, Tally};
+use trust_flightstack::frame::wrap_angle;
 use trust_runlog::{CycleRecord, LogWriter, Outcome, Record, StateRecord, Status};
-use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle};
+use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle, VehicleState};
 use trust_world::World;
 use trust_world::scenario::VehicleModel;
 use trust_world::traffic::MovingShape;
 
+use crate::convert::unit_quaternion;
 use crate::dds::{self, input_qos, plan_qos, system_time, topics};
 use crate::error::Ros2Error;
+use crate::heading::yaw_of;
 use crate::msg::builtin_interfaces::Time;
-use crate::msg::geometry_msgs::{Point, PoseStamped, Vector3};
+use crate::msg::geometry_msgs::{Point, PoseStamped, Quaternion, Vector3};
 use crate::msg::nav_msgs::Odometry;
+use crate::msg::rosgraph_msgs::Clock;
 use crate::msg::trajectory_msgs::MultiDOFJointTrajectory;
 use crate::msg::trust_msgs::{MovingObstacle, MovingObstacleArray, PlannerEvent};
+
+/// The fastest the world's vehicle turns towards the trajectory's yaw (rad/s): PX4's default
+/// `MPC_YAWRAUTO_MAX` (45°/s). A flight stack limits the yaw rate so; our SE(3) controller holds
+/// a yaw with no rate feed-forward, and a step of the reference yaw (the node's yaw steps where
+/// the speed crosses its threshold) would ask it for a large yaw torque at once.
+pub const YAW_RATE_LIMIT_RAD_S: f64 = std::f64::consts::FRAC_PI_4;
 
 /// How the world runs.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,6 +52,12 @@ pub struct DdsWorldOptions {
     pub obstacles_period_s: f64,
     /// Give up when no trajectory arrives within this long (s) before take-off.
     pub wait_for_plan_s: f64,
+    /// The world's ROS time, published on `/clock` every step and the stamp of every message
+    /// it writes: `Some(start)`: simulated, `start + t` at `t` s of simulated time since [`fly`]
+    /// started (the node needs `use_sim_time`); `None` (the default): the system time when it
+    /// writes, so that a node on either clock works (the world runs in real time; when it lags
+    /// behind, its stamps still say when its messages left).
+    pub clock_start_s: Option<f64>,
 }
 
 impl Default for DdsWorldOptions {
@@ -48,6 +67,7 @@ impl Default for DdsWorldOptions {
             dt_s: 0.02,
             obstacles_period_s: 0.1,
             wait_for_plan_s: 60.0,
+            clock_start_s: None,
         }
     }
 }
@@ -122,10 +142,15 @@ pub fn obstacle_message(
 
 /// The reference of `traj` at ROS time `now` (s): linear between its samples, with the jerk
 /// of the accelerations' slope (the controller's body-rate feed-forward: without it the
-/// quadrotor lags and overshoots the planned speed), its last sample held (at rest) after its
-/// end, its first before its start.
+/// quadrotor lags and overshoots the planned speed) and the yaw of the rotations (the shorter
+/// way round), its last sample held (at rest) after its end, its first before its start.
 pub fn reference_at(traj: &MultiDOFJointTrajectory, now: f64) -> Option<Reference> {
     let t0 = traj.header.stamp.as_seconds();
+    let yaw_at = |k: usize| {
+        let q = traj.points[k].transforms.first()?.rotation;
+        // A zero rotation (not ours) flies heading 0.
+        Some(unit_quaternion("rotation", &q).map_or(0.0, |q| yaw_of(&q)))
+    };
     let sample = |k: usize| {
         let p = &traj.points[k];
         Some((
@@ -142,12 +167,13 @@ pub fn reference_at(traj: &MultiDOFJointTrajectory, now: f64) -> Option<Referenc
     let k = traj
         .points
         .partition_point(|p| t0 + p.time_from_start.as_seconds() <= now);
-    let (p, v, a, j) = if k == 0 {
+    let (p, v, a, j, yaw) = if k == 0 {
         let (_, p, v, a) = sample(0)?;
-        (p, v, a, Vec3::zeros())
+        (p, v, a, Vec3::zeros(), yaw_at(0)?)
     } else if k == n {
         let (_, p, _, _) = sample(n - 1)?;
-        (p, Vec3::zeros(), Vec3::zeros(), Vec3::zeros())
+        let rest = Vec3::zeros();
+        (p, rest, rest, rest, yaw_at(n - 1)?)
     } else {
         let (ta, pa, va, aa) = sample(k - 1)?;
         let (tb, pb, vb, ab) = sample(k)?;
@@ -157,15 +183,143 @@ pub fn reference_at(traj: &MultiDOFJointTrajectory, now: f64) -> Option<Referenc
         } else {
             (0.0, Vec3::zeros())
         };
-        (pa.lerp(&pb, s), va.lerp(&vb, s), aa.lerp(&ab, s), j)
+        let (ya, yb) = (yaw_at(k - 1)?, yaw_at(k)?);
+        let yaw = wrap_angle(ya + wrap_angle(yb - ya) * s);
+        (pa.lerp(&pb, s), va.lerp(&vb, s), aa.lerp(&ab, s), j, yaw)
     };
-    Some(Reference {
-        p,
-        v,
-        a,
-        j,
-        yaw: 0.0,
-    })
+    Some(Reference { p, v, a, j, yaw })
+}
+
+/// The world's DDS side: its node, the node's inputs it writes, what it reads back.
+struct Ports {
+    /// Kept alive while its publishers and subscriptions are used.
+    _node: ros2_client::Node,
+    frame: String,
+    goal: Vec3,
+    clock: ros2_client::Publisher<Clock>,
+    odom: ros2_client::Publisher<Odometry>,
+    goal_pub: ros2_client::Publisher<PoseStamped>,
+    obstacles: ros2_client::Publisher<MovingObstacleArray>,
+    trajectory: ros2_client::Subscription<MultiDOFJointTrajectory>,
+    events: ros2_client::Subscription<PlannerEvent>,
+}
+
+impl Ports {
+    fn new(domain_id: u16, frame: &str, goal: Vec3) -> Result<Self, Ros2Error> {
+        let context = ros2_client::Context::with_options(
+            ros2_client::ContextOptions::new().domain_id(domain_id),
+        )
+        .map_err(|e| Ros2Error::dds("create DDS participant", e))?;
+        let mut node = context
+            .new_node(
+                ros2_client::NodeName::new("/", "trust_sim_world")
+                    .map_err(|e| Ros2Error::dds("node name", e))?,
+                ros2_client::NodeOptions::new().enable_rosout(false),
+            )
+            .map_err(|e| Ros2Error::dds("create node", e))?;
+        Ok(Ports {
+            clock: dds::publisher(&mut node, topics::CLOCK, dds::clock_writer_qos())?,
+            odom: dds::publisher(&mut node, topics::ODOM, input_qos())?,
+            goal_pub: dds::publisher(&mut node, topics::GOAL, plan_qos())?,
+            obstacles: dds::publisher(&mut node, topics::OBSTACLES, input_qos())?,
+            trajectory: dds::subscription(&mut node, topics::TRAJECTORY, plan_qos())?,
+            events: dds::subscription(
+                &mut node,
+                topics::EVENTS,
+                plan_qos().history(ros2_client::qos::History::KeepLast { depth: 100 }),
+            )?,
+            _node: node,
+            frame: frame.to_owned(),
+            goal,
+        })
+    }
+
+    /// The node's inputs at ROS time `now`: `/clock`, the vehicle's `odom` (twist in the world
+    /// frame), and with `slow` (every `obstacles_period_s`) the obstacles at `positions` and
+    /// the goal. Writes before discovery matches a reader may fail; the next ones are sent.
+    fn publish_inputs(
+        &self,
+        world: &World,
+        now: Time,
+        vehicle: &VehicleState,
+        positions: &[Vec3],
+        slow: bool,
+    ) -> Result<(), Ros2Error> {
+        let frame = self.frame.as_str();
+        let _ = self.clock.publish(Clock { clock: now });
+        let mut odom = Odometry {
+            header: now.into_header(frame),
+            child_frame_id: frame.to_owned(), // the twist is in the world frame
+            ..Odometry::default()
+        };
+        odom.pose.pose.position = vehicle.p.into();
+        let q = vehicle.attitude.quaternion();
+        odom.pose.pose.orientation = Quaternion {
+            x: q.i,
+            y: q.j,
+            z: q.k,
+            w: q.w,
+        };
+        odom.twist.twist.linear = vehicle.v.into();
+        let _ = self.odom.publish(odom);
+        if slow {
+            let _ = self
+                .obstacles
+                .publish(obstacle_message(world, positions, now, frame)?);
+            let _ = self.goal_pub.publish(PoseStamped {
+                header: now.into_header(frame),
+                pose: crate::msg::geometry_msgs::Pose {
+                    position: Point::from(self.goal),
+                    ..Default::default()
+                },
+            });
+        }
+        Ok(())
+    }
+
+    /// The latest trajectory received since the last call, if any.
+    fn latest_trajectory(&self) -> Option<MultiDOFJointTrajectory> {
+        let mut latest = None;
+        while let Ok(Some((m, _))) = self.trajectory.take() {
+            latest = Some(m);
+        }
+        latest
+    }
+}
+
+/// The world's ROS time ([`DdsWorldOptions::clock_start_s`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum SimClock {
+    /// The system time when a message is written.
+    System,
+    /// `start_s + t` at simulated time `t` (s since [`fly`] started).
+    Simulated { start_s: f64 },
+}
+
+impl SimClock {
+    /// Simulated from `start_s`, or the system clock.
+    fn new(start_s: Option<f64>) -> Result<Self, Ros2Error> {
+        let Some(start_s) = start_s else {
+            return Ok(SimClock::System);
+        };
+        // A day of simulated time must stay within `int32` seconds.
+        if !(start_s.is_finite() && start_s >= 0.0 && start_s < f64::from(i32::MAX) - 86_400.0) {
+            return Err(Ros2Error::invalid(
+                "clock_start_s",
+                start_s,
+                "a finite time >= 0 s, a day short of the int32 seconds range",
+            ));
+        }
+        Ok(SimClock::Simulated { start_s })
+    }
+
+    /// The ROS time at simulated time `t`.
+    fn at(&self, t: f64) -> Result<Time, Ros2Error> {
+        match self {
+            SimClock::System => Ok(system_time()),
+            SimClock::Simulated { start_s } => Time::from_seconds(start_s + t),
+        }
+    }
 }
 
 /// Flies `world` against a `trust-node` on `domain_id` (module docs) and writes the run log to
@@ -173,7 +327,7 @@ pub fn reference_at(traj: &MultiDOFJointTrajectory, now: f64) -> Option<Referenc
 ///
 /// # Errors
 /// [`Ros2Error`] when DDS, the world, the vehicle model or the log fail, or when no trajectory
-/// arrives within `wait_for_plan_s`.
+/// arrives within `wait_for_plan_s`; [`Ros2Error::Invalid`] for an invalid `clock_start_s`.
 pub fn fly(
     world: &World,
     domain_id: u16,
@@ -181,7 +335,6 @@ pub fn fly(
     options: &DdsWorldOptions,
 ) -> Result<Outcome, Ros2Error> {
     let scenario = world.scenario();
-    let frame = options.world_frame.as_str();
     let dt = options.dt_s;
     let mut traffic = world.traffic()?;
     let hover = Reference::hover(world.start());
@@ -196,75 +349,38 @@ pub fn fly(
             Box::new(PerfectTracking::new(0.0, &hover).map_err(|e| sim_err("vehicle", e))?)
         }
     };
+    let clock = SimClock::new(options.clock_start_s)?;
+    let ports = Ports::new(domain_id, &options.world_frame, world.goal())?;
 
-    let context =
-        ros2_client::Context::with_options(ros2_client::ContextOptions::new().domain_id(domain_id))
-            .map_err(|e| Ros2Error::dds("create DDS participant", e))?;
-    let mut node = context
-        .new_node(
-            ros2_client::NodeName::new("/", "trust_sim_world")
-                .map_err(|e| Ros2Error::dds("node name", e))?,
-            ros2_client::NodeOptions::new().enable_rosout(false),
-        )
-        .map_err(|e| Ros2Error::dds("create node", e))?;
-    let odom_pub = dds::publisher::<Odometry>(&mut node, topics::ODOM, input_qos())?;
-    let goal_pub = dds::publisher::<PoseStamped>(&mut node, topics::GOAL, plan_qos())?;
-    let obstacles_pub =
-        dds::publisher::<MovingObstacleArray>(&mut node, topics::OBSTACLES, input_qos())?;
-    let traj_sub =
-        dds::subscription::<MultiDOFJointTrajectory>(&mut node, topics::TRAJECTORY, plan_qos())?;
-    let events_sub = dds::subscription::<PlannerEvent>(
-        &mut node,
-        topics::EVENTS,
-        plan_qos().history(ros2_client::qos::History::KeepLast { depth: 100 }),
-    )?;
-
-    let odom_at = |p: Vec3, v: Vec3| {
-        let mut m = Odometry {
-            header: system_time().into_header(frame),
-            child_frame_id: frame.to_owned(), // the twist is in the world frame
-            ..Odometry::default()
-        };
-        m.pose.pose.position = p.into();
-        m.twist.twist.linear = v.into();
-        m
-    };
-    let goal = PoseStamped {
-        header: system_time().into_header(frame),
-        pose: crate::msg::geometry_msgs::Pose {
-            position: Point::from(world.goal()),
-            ..Default::default()
-        },
-    };
-
-    // Before take-off: hover at the start until the node's first plan.
+    // Before take-off: hover at the start until the node's first plan; the simulated time runs
+    // with the wall clock.
     let waited = Instant::now();
     let mut plan: Option<MultiDOFJointTrajectory> = None;
+    let mut next_slow = 0.0;
     while plan.is_none() {
-        if waited.elapsed().as_secs_f64() > options.wait_for_plan_s {
+        let t = waited.elapsed().as_secs_f64();
+        if t > options.wait_for_plan_s {
             return Err(Ros2Error::dds(
                 format!("no trajectory on domain {domain_id}"),
                 format!("within {} s", options.wait_for_plan_s),
             ));
         }
-        let _ = odom_pub.publish(odom_at(world.start(), Vec3::zeros()));
-        let _ = goal_pub.publish(PoseStamped {
-            header: system_time().into_header(frame),
-            ..goal.clone()
-        });
-        let _ = obstacles_pub.publish(obstacle_message(
-            world,
-            traffic.positions(),
-            system_time(),
-            frame,
-        )?);
-        std::thread::sleep(StdDuration::from_millis(100));
-        while let Ok(Some((m, _))) = traj_sub.take() {
-            plan = Some(m);
+        let slow = t >= next_slow;
+        if slow {
+            next_slow = t + options.obstacles_period_s;
         }
+        ports.publish_inputs(
+            world,
+            clock.at(t)?,
+            vehicle.state(),
+            traffic.positions(),
+            slow,
+        )?;
+        std::thread::sleep(StdDuration::from_secs_f64(dt));
+        plan = ports.latest_trajectory();
     }
     // Cycles before take-off are not the flight's.
-    while let Ok(Some(_)) = events_sub.take() {}
+    while let Ok(Some(_)) = ports.events.take() {}
 
     let mut log = LogWriter::create(log_path).map_err(|e| sim_err("run log", e))?;
     log.write(&Record::Header(trust_flight::header(
@@ -277,12 +393,15 @@ pub fn fly(
     let radius = world.vehicle_radius_m();
     let tolerance = scenario.mission.goal_tolerance_m;
     let max_steps = (scenario.time_limit_s / dt).round() as u64;
-    let t0_ros = system_time().as_seconds();
+    // Flight time t is simulated time takeoff + t, ROS time t0_ros + t.
+    let takeoff = waited.elapsed().as_secs_f64();
+    let t0_ros = clock.at(takeoff)?.as_seconds();
     let wall0 = Instant::now();
     let mut tally = Tally::default();
     let mut cycles = 0usize;
     let mut step = 0u64;
     let mut next_obstacles = 0.0;
+    let mut yaw = vehicle.state().attitude.euler_angles().2;
     let state_record = |t: f64, vehicle: &dyn Vehicle, positions: &[Vec3]| {
         let s = vehicle.state();
         StateRecord {
@@ -307,24 +426,21 @@ pub fn fly(
     let (status, with) = loop {
         let t = step as f64 * dt;
         // Inputs of the node at t.
-        let _ = odom_pub.publish(odom_at(vehicle.state().p, vehicle.state().v));
-        if t + 1e-9 >= next_obstacles {
-            let _ = obstacles_pub.publish(obstacle_message(
-                world,
-                traffic.positions(),
-                system_time(),
-                frame,
-            )?);
-            let _ = goal_pub.publish(PoseStamped {
-                header: system_time().into_header(frame),
-                ..goal.clone()
-            });
+        let slow = t + 1e-9 >= next_obstacles;
+        if slow {
             next_obstacles += options.obstacles_period_s;
         }
-        while let Ok(Some((m, _))) = traj_sub.take() {
+        ports.publish_inputs(
+            world,
+            clock.at(takeoff + t)?,
+            vehicle.state(),
+            traffic.positions(),
+            slow,
+        )?;
+        if let Some(m) = ports.latest_trajectory() {
             plan = Some(m);
         }
-        while let Ok(Some((e, _))) = events_sub.take() {
+        while let Ok(Some((e, _))) = ports.events.take() {
             let te = e.header.stamp.as_seconds() - t0_ros;
             if te < 0.0 || te > t + 1e-9 {
                 continue; // outside the logged flight
@@ -333,13 +449,22 @@ pub fn fly(
             log.write(&Record::Cycle(cycle_record(te, &e)))
                 .map_err(|e| sim_err("run log", e))?;
         }
-        // Physics from t to t + dt, the plan sampled on the ROS clock.
+        // Physics from t to t + dt, the plan sampled on the ROS clock; the yaw turns towards
+        // the plan's at most YAW_RATE_LIMIT_RAD_S.
         let current = plan.clone();
+        let target = current
+            .as_ref()
+            .and_then(|p| reference_at(p, t0_ros + t))
+            .map_or(yaw, |r| r.yaw);
+        let turn = YAW_RATE_LIMIT_RAD_S * dt;
+        yaw = wrap_angle(yaw + wrap_angle(target - yaw).clamp(-turn, turn));
+        let step_yaw = yaw;
         let reference = move |tau: f64| {
-            current
+            let r = current
                 .as_ref()
                 .and_then(|p| reference_at(p, t0_ros + tau))
-                .unwrap_or(hover)
+                .unwrap_or(hover);
+            Reference { yaw: step_yaw, ..r }
         };
         vehicle
             .step(dt, &reference)
@@ -457,9 +582,9 @@ mod tests {
         assert!(reference_at(&MultiDOFJointTrajectory::default(), 0.0).is_none());
     }
 
-    #[test]
-    fn the_reference_carries_the_jerk_of_the_sampled_accelerations() {
-        let mut traj = MultiDOFJointTrajectory {
+    /// Two samples 0.5 s apart at x = 0, the first at ROS time 100 s.
+    fn two_samples_at_rest() -> MultiDOFJointTrajectory {
+        MultiDOFJointTrajectory {
             header: Time {
                 sec: 100,
                 nanosec: 0,
@@ -467,12 +592,57 @@ mod tests {
             .into_header("map"),
             joint_names: vec!["base_link".into()],
             points: vec![point(0.0, 0.0, 0.0), point(0.5, 0.0, 0.0)],
-        };
+        }
+    }
+
+    #[test]
+    fn the_reference_carries_the_jerk_of_the_sampled_accelerations() {
+        let mut traj = two_samples_at_rest();
         traj.points[1].accelerations[0].linear.x = 2.0;
         let r = reference_at(&traj, 100.25).expect("a reference");
         assert_relative_eq!(r.a.x, 1.0, epsilon = 1e-9);
         assert_relative_eq!(r.j.x, 4.0, epsilon = 1e-9);
         let after = reference_at(&traj, 101.0).expect("a reference");
         assert_relative_eq!(after.j.norm(), 0.0, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn the_reference_turns_the_shorter_way_between_the_samples_yaws() {
+        let mut traj = two_samples_at_rest();
+        // From 170° to -170°: through 180°, not through 0°.
+        traj.points[0].transforms[0].rotation = Quaternion::from_yaw(170f64.to_radians());
+        traj.points[1].transforms[0].rotation = Quaternion::from_yaw(-170f64.to_radians());
+        let mid = reference_at(&traj, 100.25).expect("a reference");
+        assert_relative_eq!(mid.yaw.abs(), std::f64::consts::PI, epsilon = 1e-9);
+        let quarter = reference_at(&traj, 100.125).expect("a reference");
+        assert_relative_eq!(quarter.yaw, 175f64.to_radians(), epsilon = 1e-9);
+        assert_relative_eq!(
+            reference_at(&traj, 99.0).expect("before").yaw,
+            170f64.to_radians(),
+            epsilon = 1e-9
+        );
+        assert_relative_eq!(
+            reference_at(&traj, 101.0).expect("after").yaw,
+            -170f64.to_radians(),
+            epsilon = 1e-9
+        );
+    }
+
+    #[test]
+    fn the_clock_starts_where_asked_and_refuses_what_int32_cannot_hold() {
+        let c = SimClock::new(Some(1000.0)).expect("valid");
+        assert_eq!(
+            c.at(2.5).expect("in range"),
+            Time {
+                sec: 1002,
+                nanosec: 500_000_000
+            }
+        );
+        let now = system_time().as_seconds();
+        let system = SimClock::new(None).expect("system");
+        assert!((system.at(1e6).expect("now").as_seconds() - now).abs() < 5.0);
+        for bad in [f64::NAN, -1.0, 3e9] {
+            assert!(SimClock::new(Some(bad)).is_err(), "{bad}");
+        }
     }
 }

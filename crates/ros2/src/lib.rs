@@ -6,8 +6,9 @@
 //! (`trust_msgs/MovingObstacleArray`), runs a planning cycle (Algorithm 1,
 //! `trust_manager::Manager::step`) every `cycle_period_s`, and publishes `trajectory`
 //! (`trajectory_msgs/MultiDOFJointTrajectory`), `path`, `setpoint` (or PX4's
-//! `TrajectorySetpoint` on `/fmu/in/trajectory_setpoint`), `markers` and `events`. Topics,
-//! frames, QoS and parameters: `docs/ros2.md`.
+//! `TrajectorySetpoint` on `/fmu/in/trajectory_setpoint`), `markers`, `events` and `/tf` (the
+//! odometry as `map → base_link`), with a yaw per [`heading`]; with `use_sim_time` its ROS time
+//! is `/clock`'s. Topics, frames, QoS and parameters: `docs/ros2.md`.
 //!
 //! Use it to fly the planner on a ROS 2 vehicle or in a ROS 2 simulator. DDS comes from
 //! `ros2-client` (pure Rust over RustDDS): the binary `trust-node` builds with cargo alone and
@@ -49,9 +50,12 @@ pub mod convert;
 pub mod dds;
 pub mod dds_world;
 pub mod error;
+pub mod heading;
 pub mod msg;
 pub mod node_core;
 pub mod params;
+#[doc(hidden)]
+pub mod test_support;
 pub mod tracker;
 
 pub use error::Ros2Error;

@@ -14,17 +14,18 @@ use std::sync::Arc;
 use trust_core::{Forecast, Scene, State, StaticMap, Vec3};
 use trust_flightstack::frame::FrameTransform;
 use trust_flightstack::px4::{self, TrajectorySetpoint};
-use trust_flightstack::yaw::{YawPolicy, YawTracker};
 use trust_planner::AnyManager;
 
 use crate::convert::{
-    Clock, goal_position, markers, odometry_state, path_message, trajectory_message,
-    trajectory_point,
+    Clock, goal_position, markers, odometry_state, odometry_transform, path_message,
+    trajectory_message, trajectory_point, unit_quaternion,
 };
 use crate::error::Ros2Error;
+use crate::heading::{Heading, yaw_of};
 use crate::msg::builtin_interfaces::Time;
 use crate::msg::geometry_msgs::PoseStamped;
 use crate::msg::nav_msgs::{Odometry, Path};
+use crate::msg::tf2_msgs::{TFMessage, TransformStamped};
 use crate::msg::trajectory_msgs::MultiDOFJointTrajectory;
 use crate::msg::trust_msgs::{MovingObstacleArray, PlannerEvent};
 use crate::msg::visualization_msgs::MarkerArray;
@@ -75,7 +76,9 @@ pub struct NodeCore {
     odom: Option<State>,
     goal: Option<Vec3>,
     forecasts: Vec<Forecast>,
-    yaw: YawTracker,
+    heading: Heading,
+    /// The latest accepted odometry as the world-to-body transform.
+    odom_transform: Option<TransformStamped>,
     counters: NodeCounters,
 }
 
@@ -107,7 +110,8 @@ impl NodeCore {
             odom: None,
             goal: None,
             forecasts: Vec::new(),
-            yaw: YawTracker::new(YawPolicy::default())?,
+            heading: Heading::new(params.yaw)?,
+            odom_transform: None,
             counters: NodeCounters::default(),
             params,
         })
@@ -151,11 +155,24 @@ impl NodeCore {
     /// # Errors
     /// As [`odometry_state`]; the message is ignored and counted.
     pub fn on_odometry(&mut self, msg: &Odometry) -> Result<(), Ros2Error> {
-        let r = odometry_state(msg, &self.params.world_frame, &self.clock);
-        let state = self.rejected(r)?;
+        let r = odometry_state(msg, &self.params.world_frame, &self.clock).and_then(|state| {
+            let q = unit_quaternion("odom.pose.pose.orientation", &msg.pose.pose.orientation)?;
+            Ok((state, q, odometry_transform(msg, &self.params.body_frame)?))
+        });
+        let (state, q, transform) = self.rejected(r)?;
         self.odom = Some(state);
+        self.heading.observe_vehicle(yaw_of(&q));
+        self.odom_transform = Some(transform);
         self.counters.odom_count += 1;
         Ok(())
+    }
+
+    /// `/tf`: the latest accepted odometry as the transform from the world frame to
+    /// `body_frame`, stamped with the odometry's stamp; `None` before the first odometry.
+    pub fn transform(&self) -> Option<TFMessage> {
+        Some(TFMessage {
+            transforms: vec![self.odom_transform.clone()?],
+        })
     }
 
     /// Takes a goal ([`goal_position`]); it replaces the previous one.
@@ -239,23 +256,30 @@ impl NodeCore {
         self.counters.cycle_count += 1;
         let p = &self.params;
         let (trajectory, path) = match self.manager.plan() {
-            Some(plan) => (
-                Some(trajectory_message(
+            Some(plan) => {
+                // The plan ahead is sampled with copies of the yaw stream; the stream itself
+                // advances to the present only.
+                let ahead = self.heading.ahead()?;
+                let trajectory = trajectory_message(
+                    plan,
+                    t,
+                    p.trajectory_dt_s,
+                    &self.clock,
+                    (&p.world_frame, &p.body_frame),
+                    &mut ahead.clone(),
+                )?;
+                let path = path_message(
                     plan,
                     t,
                     p.trajectory_dt_s,
                     &self.clock,
                     &p.world_frame,
-                    &p.body_frame,
-                )?),
-                Some(path_message(
-                    plan,
-                    t,
-                    p.trajectory_dt_s,
-                    &self.clock,
-                    &p.world_frame,
-                )?),
-            ),
+                    &mut ahead.clone(),
+                )?;
+                let now = plan.state(t.clamp(plan.t_start(), plan.t_end()));
+                self.heading.next(&now.v, &now.a)?;
+                (Some(trajectory), Some(path))
+            }
             None => (None, None),
         };
         let main = self.manager.main();
@@ -309,24 +333,25 @@ impl NodeCore {
     }
 
     /// The setpoint at ROS time `now`: a one-point `MultiDOFJointTrajectory` stamped `now`
-    /// (`time_from_start` 0) of the committed plan at `now` (its end after it ends); `None`
-    /// without a plan.
+    /// (`time_from_start` 0) of the committed plan at `now` (its end after it ends), its yaw
+    /// the yaw stream's next ([`crate::heading`]); `None` without a plan.
     ///
     /// # Errors
     /// Conversion errors naming the field (a non-finite sample, a stamp out of range).
-    pub fn setpoint(&self, now: Time) -> Result<Option<MultiDOFJointTrajectory>, Ros2Error> {
+    pub fn setpoint(&mut self, now: Time) -> Result<Option<MultiDOFJointTrajectory>, Ros2Error> {
         let (Some(plan), Some(t)) = (self.manager.plan(), self.plan_time(&now)) else {
             return Ok(None);
         };
         Ok(Some(MultiDOFJointTrajectory {
             header: now.into_header(&self.params.world_frame),
             joint_names: vec![self.params.body_frame.clone()],
-            points: vec![trajectory_point(plan, t, t)?],
+            points: vec![trajectory_point(plan, t, t, &mut self.heading)?],
         }))
     }
 
-    /// The PX4 setpoint at ROS time `now` ([`trust_flightstack::px4::setpoint_at`]: NED, yaw
-    /// held at 0 rad), stamped with `now` in µs; `None` without a plan.
+    /// The PX4 setpoint at ROS time `now` ([`trust_flightstack::px4::setpoint_at`]: NED, the
+    /// yaw stream's yaw as `π/2 − yaw` and its rate negated, NaN with `uncontrolled`), stamped
+    /// with `now` in µs; `None` without a plan.
     ///
     /// # Errors
     /// [`Ros2Error::FlightStack`] naming the field that does not fit PX4's `f32`.
@@ -340,7 +365,7 @@ impl NodeCore {
             t,
             us,
             &FrameTransform::identity(),
-            &mut self.yaw,
+            self.heading.tracker()?,
         )?))
     }
 }
@@ -349,7 +374,10 @@ impl NodeCore {
 mod tests {
     use approx::assert_relative_eq;
 
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
     use super::*;
+    use crate::heading::YawMode;
     use crate::msg::geometry_msgs::{Point, Quaternion, Vector3};
     use crate::msg::trust_msgs::MovingObstacle;
     use crate::msg::visualization_msgs::Marker;
@@ -410,7 +438,7 @@ mod tests {
         core.on_goal(&goal([38.0, 10.0, 3.0])).expect("valid");
         let out = core.cycle(at(0.0)).expect("cycle").expect("a cycle ran");
         let traj = out.trajectory.expect("a plan");
-        let plan = core.manager().plan().expect("committed plan");
+        let plan = core.manager().plan().expect("committed plan").clone();
         assert_eq!(traj.header.frame_id, "map");
         assert_eq!(traj.joint_names, vec!["base_link".to_string()]);
         assert!(traj.points.len() > 10, "{} samples", traj.points.len());
@@ -460,6 +488,158 @@ mod tests {
         assert_relative_eq!(f64::from(px4.position[0]), p.y, epsilon = 1e-4);
         assert_relative_eq!(f64::from(px4.position[1]), p.x, epsilon = 1e-4);
         assert_relative_eq!(f64::from(px4.position[2]), -p.z, epsilon = 1e-4);
+    }
+
+    /// The yaw of a rotation about z alone, decoded on its own: `2 atan2(z, w)`.
+    fn yaw_of_rotation(q: &Quaternion) -> f64 {
+        assert_eq!((q.x, q.y), (0.0, 0.0), "a rotation about z alone: {q:?}");
+        assert_relative_eq!(q.z * q.z + q.w * q.w, 1.0, epsilon = 1e-12);
+        2.0 * q.z.atan2(q.w)
+    }
+
+    /// `a` wrapped to `[−π, π)`.
+    fn wrapped(a: f64) -> f64 {
+        (a + PI).rem_euclid(TAU) - PI
+    }
+
+    /// The heading of the plan's horizontal velocity at node time `t` (ENU, from east).
+    fn heading(plan: &trust_core::PolyTraj, t: f64) -> f64 {
+        let v = plan.velocity(t);
+        v.y.atan2(v.x)
+    }
+
+    #[test]
+    fn the_yaw_faces_the_velocity_holds_when_slow_and_px4_gets_it_in_ned() {
+        let mut core = core();
+        // The vehicle faces north; the goal lies east-north-east, past the cylinder at (12, 8):
+        // the plan curves.
+        let mut m = odom(0.0, [2.0, 4.0, 3.0]);
+        m.pose.pose.orientation = Quaternion::from_yaw(FRAC_PI_2);
+        core.on_odometry(&m).expect("valid");
+        core.on_goal(&goal([20.0, 9.0, 3.0])).expect("valid");
+        let out = core.cycle(at(0.0)).expect("cycle").expect("ran");
+        let plan = core.manager().plan().expect("a plan").clone();
+        // The plan starts at rest: its first sample holds the vehicle's heading.
+        let traj = out.trajectory.expect("a trajectory");
+        let first = &traj.points[0];
+        assert_eq!(yaw_of_rotation(&first.transforms[0].rotation), FRAC_PI_2);
+        assert_eq!(first.velocities[0].angular.z, 0.0);
+
+        // The setpoint stream, every 20 ms to beyond the plan's end, against the plan's own
+        // velocity: facing it when faster than 0.3 m/s with its heading's rate (a central
+        // difference), else the last yaw; PX4's yaw from north clockwise (the NED velocity
+        // (north, east) = (v_y, v_x)), its rate negated.
+        let (mut fast, mut turning, mut slow) = (0, 0, 0);
+        let mut last_yaw = FRAC_PI_2;
+        let steps = ((plan.t_end() + 0.5) / 0.02) as usize;
+        for k in 0..=steps {
+            let t = k as f64 * 0.02;
+            let sp = core.setpoint(at(t)).expect("valid").expect("a plan");
+            let px4 = core.px4_setpoint(at(t)).expect("valid").expect("a plan");
+            let point = &sp.points[0];
+            let yaw = yaw_of_rotation(&point.transforms[0].rotation);
+            let rate = point.velocities[0].angular.z;
+            let (px4_yaw, px4_rate) = (f64::from(px4.yaw), f64::from(px4.yawspeed));
+            assert!(yaw.is_finite() && rate.is_finite() && px4_yaw.is_finite());
+            // ψ_ned = π/2 − ψ_enu, in [−π, π].
+            assert!((-PI..=PI).contains(&px4_yaw), "{px4_yaw}");
+            assert!(wrapped(px4_yaw - (FRAC_PI_2 - yaw)).abs() < 2e-6, "t {t}");
+            assert!(
+                (px4_rate + rate).abs() <= 1e-5 * rate.abs().max(1.0),
+                "t {t}"
+            );
+            let tc = t.clamp(plan.t_start(), plan.t_end());
+            let v = plan.velocity(tc);
+            let speed = (v.x * v.x + v.y * v.y).sqrt();
+            if speed > 0.3 {
+                fast += 1;
+                // (The stamps are whole nanoseconds: the node's time is t within 1e-9 s.)
+                assert!(wrapped(yaw - heading(&plan, tc)).abs() < 1e-6, "t {t}");
+                let north_east = v.x.atan2(v.y);
+                assert!(wrapped(px4_yaw - north_east).abs() < 2e-6, "t {t}");
+                let h = 1e-5;
+                if tc - h > plan.t_start() && tc + h < plan.t_end() {
+                    let fd = wrapped(heading(&plan, tc + h) - heading(&plan, tc - h)) / (2.0 * h);
+                    assert!(
+                        (rate - fd).abs() <= 1e-4 * fd.abs().max(1.0),
+                        "t {t}: {rate} vs {fd}"
+                    );
+                    turning += usize::from(rate.abs() > 0.01);
+                }
+            } else {
+                slow += 1;
+                assert_eq!((yaw, rate), (last_yaw, 0.0), "t {t}");
+            }
+            last_yaw = yaw;
+        }
+        assert!(fast > 20 && slow > 0, "{fast} fast, {slow} slow setpoints");
+        assert!(
+            turning > 20,
+            "the plan curves: some yaw rate ({turning} setpoints)"
+        );
+    }
+
+    #[test]
+    fn uncontrolled_yaw_is_nan_for_px4_and_the_vehicles_heading_in_ros_messages() {
+        let setup = NodeSetup::from_scenario(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../scenarios/quickstart.toml"),
+        )
+        .expect("quickstart");
+        let params = NodeParams {
+            yaw: YawMode::Uncontrolled,
+            ..NodeParams::default()
+        };
+        let mut core = NodeCore::new(setup, params, ORIGIN).expect("valid");
+        let mut m = odom(0.0, [2.0, 10.0, 3.0]);
+        m.pose.pose.orientation = Quaternion::from_yaw(-0.4);
+        core.on_odometry(&m).expect("valid");
+        core.on_goal(&goal([38.0, 10.0, 3.0])).expect("valid");
+        core.cycle(at(0.0)).expect("cycle").expect("ran");
+        let px4 = core.px4_setpoint(at(0.5)).expect("valid").expect("a plan");
+        assert!(px4.yaw.is_nan() && px4.yawspeed.is_nan());
+        assert!(px4.position.iter().all(|x| x.is_finite()));
+        let sp = core.setpoint(at(0.5)).expect("valid").expect("a plan");
+        assert_relative_eq!(
+            yaw_of_rotation(&sp.points[0].transforms[0].rotation),
+            -0.4,
+            epsilon = 1e-12
+        );
+        assert_eq!(sp.points[0].velocities[0].angular.z, 0.0);
+    }
+
+    #[test]
+    fn the_latest_odometry_is_the_tf_transform_to_the_body_frame() {
+        let mut core = core();
+        assert!(core.transform().is_none());
+        let mut m = odom(0.25, [2.0, 10.0, 3.0]);
+        // The twist in the world frame: the child frame of /tf is still the body frame.
+        m.child_frame_id = "map".into();
+        // Not normalized: /tf carries the unit quaternion.
+        let q = Quaternion::from_yaw(0.7);
+        m.pose.pose.orientation = Quaternion {
+            x: 0.0,
+            y: 0.0,
+            z: 2.0 * q.z,
+            w: 2.0 * q.w,
+        };
+        core.on_odometry(&m).expect("valid");
+        let tf = core.transform().expect("after an odometry");
+        assert_eq!(tf.transforms.len(), 1);
+        let t = &tf.transforms[0];
+        assert_eq!(t.header, m.header);
+        assert_eq!(t.child_frame_id, "base_link");
+        assert_eq!(
+            Vec3::from(t.transform.translation),
+            Vec3::new(2.0, 10.0, 3.0)
+        );
+        assert_relative_eq!(t.transform.rotation.z, q.z, epsilon = 1e-15);
+        assert_relative_eq!(t.transform.rotation.w, q.w, epsilon = 1e-15);
+        // A rejected odometry leaves it as it was.
+        let mut bad = odom(0.5, [f64::NAN, 0.0, 0.0]);
+        bad.child_frame_id = "map".into();
+        assert!(core.on_odometry(&bad).is_err());
+        assert_eq!(core.transform().expect("kept"), tf);
     }
 
     #[test]

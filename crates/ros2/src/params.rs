@@ -12,6 +12,7 @@ use trust_predict::EkfParams;
 use trust_world::{Scenario, World};
 
 use crate::error::Ros2Error;
+use crate::heading::YawMode;
 
 /// `[node]` parameters (all optional; defaults below).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -34,6 +35,17 @@ pub struct NodeParams {
     pub odom_timeout_s: f64,
     /// An obstacle track not observed for this long (s) is dropped. Default 1.0 s.
     pub obstacle_timeout_s: f64,
+    /// The yaw policy of the published trajectory and setpoints ([`crate::heading`]); default
+    /// `face_velocity` above 0.3 m/s, holding the last yaw (at first the vehicle's) below.
+    pub yaw: YawMode,
+    /// Publish the latest odometry on `/tf` as the transform `world_frame` → `body_frame`.
+    /// Default `true`; set `false` where the vehicle's localization broadcasts that transform
+    /// already (two publishers of one transform make it jump).
+    pub publish_tf: bool,
+    /// Take ROS time from `/clock` (`rosgraph_msgs/Clock`, a simulator's clock) instead of the
+    /// system clock, as ROS's `use_sim_time` parameter: stamps, cycles and setpoints follow it.
+    /// Default `false`; `trust-node --use-sim-time` sets it.
+    pub use_sim_time: bool,
 }
 
 impl Default for NodeParams {
@@ -46,6 +58,9 @@ impl Default for NodeParams {
             setpoint_rate_hz: 50.0,
             odom_timeout_s: 0.5,
             obstacle_timeout_s: 1.0,
+            yaw: YawMode::default(),
+            publish_tf: true,
+            use_sim_time: false,
         }
     }
 }
@@ -98,7 +113,7 @@ impl NodeParams {
                 "a rate in [2, 1000] Hz",
             ));
         }
-        Ok(())
+        self.yaw.validate()
     }
 }
 
@@ -152,5 +167,50 @@ impl NodeSetup {
             r_safe_margin_m: scenario.sensing.r_safe_margin_m,
             ekf: scenario.sensing.ekf.clone(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `text` loaded from a file of its own (tests run in parallel threads).
+    fn parse(text: &str) -> Result<NodeParams, Ros2Error> {
+        static FILES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let k = FILES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("trust-node-params-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let path = dir.join(format!("{k}.toml"));
+        std::fs::write(&path, text).expect("write");
+        let r = NodeParams::load(&path);
+        let _ = std::fs::remove_file(&path);
+        r
+    }
+
+    #[test]
+    fn yaw_tf_and_sim_time_read_from_the_parameter_file() {
+        let p = parse(
+            "publish_tf = false\nuse_sim_time = true\n[yaw]\nkind = \"fixed\"\nyaw_rad = 1.5\n",
+        )
+        .expect("valid");
+        assert_eq!(p.yaw, YawMode::Fixed { yaw_rad: 1.5 });
+        assert!(!p.publish_tf && p.use_sim_time);
+        let p = parse("[yaw]\nkind = \"face_velocity\"\nmin_speed_m_s = 0.5\n").expect("valid");
+        assert_eq!(p.yaw, YawMode::FaceVelocity { min_speed_m_s: 0.5 });
+        assert_eq!(parse("").expect("defaults"), NodeParams::default());
+        assert_eq!(
+            NodeParams::default().yaw,
+            YawMode::FaceVelocity { min_speed_m_s: 0.3 }
+        );
+    }
+
+    #[test]
+    fn a_bad_yaw_is_named() {
+        let e =
+            parse("[yaw]\nkind = \"face_velocity\"\nmin_speed_m_s = -1\n").expect_err("negative");
+        assert!(e.to_string().contains("yaw.min_speed_m_s"), "{e}");
+        let e = parse("[yaw]\nkind = \"fixed\"\nyaw = 1\n").expect_err("unknown field");
+        assert!(e.to_string().contains("yaw"), "{e}");
+        assert!(parse("[yaw]\nkind = \"spin\"\n").is_err());
     }
 }

@@ -1,8 +1,10 @@
 //! `trust-node` against an independent DDS implementation: Eclipse Cyclone DDS through its
 //! Python binding (`interop/peer.py`, types written from the ROS 2 `.msg` files), over loopback
-//! on a ROS domain of the test's own. The peer publishes odometry, a goal and obstacles and
-//! checks every message type the node publishes field by field; a field laid out differently
-//! on the two sides fails here, where the loopback test (ros2-client on both ends) cannot see it.
+//! on a ROS domain of the test's own. The peer publishes odometry, a goal and obstacles (and,
+//! for a node with `--use-sim-time`, `/clock`) and checks every message type the node publishes
+//! field by field; a field laid out differently on the two sides fails here, where the loopback
+//! test (ros2-client on both ends) cannot see it. The last test observes a `dds-world` flight
+//! (`trust_ros2::dds_world::fly`) and decodes its `/clock`.
 //!
 //! The Python interpreter is `$TRUST_CYCLONE_PYTHON` (else `python3`). Without the `cyclonedds`
 //! module the tests are skipped, unless `TRUST_REQUIRE_CYCLONE` is set (CI: `.ci/run` installs
@@ -55,10 +57,10 @@ fn cyclone_python() -> Option<PathBuf> {
     None
 }
 
-/// A domain id in 21..=220 of this process and test (`k` < 2): parallel test processes, and
-/// the two tests of this one, do not meet.
+/// A domain id in 21..=220 of this process and test (`k` < 4): parallel test processes, and
+/// the tests of this one, do not meet.
 fn domain_id(k: u32) -> u16 {
-    ((std::process::id() % 100) * 2 + 21 + k) as u16
+    ((std::process::id() % 50) * 4 + 21 + k) as u16
 }
 
 /// Waits for `child` at most `limit`, killing it after that (`None`).
@@ -86,10 +88,21 @@ fn stderr_of(child: &mut Child) -> String {
 /// Runs `trust-node` (with `node_args`) and the Cyclone peer (with `peer_args`) on a domain of
 /// their own and fails with both logs unless the peer's checks pass.
 fn node_against_cyclone_peer(k: u32, node_args: &[&str], peer_args: &[&str]) {
+    node_and_cyclone_peer_with(k, node_args, peer_args, |_| {});
+}
+
+/// As [`node_against_cyclone_peer`], running `meanwhile(domain)` once both have started.
+fn node_and_cyclone_peer_with(
+    k: u32,
+    node_args: &[&str],
+    peer_args: &[&str],
+    meanwhile: impl FnOnce(u16),
+) {
     let Some(python) = cyclone_python() else {
         return;
     };
-    let domain = domain_id(k).to_string();
+    let domain_number = domain_id(k);
+    let domain = domain_number.to_string();
     let scenario = crate_dir().join("../../scenarios/quickstart.toml");
     let mut node = Command::new(env!("CARGO_BIN_EXE_trust-node"))
         .arg(&scenario)
@@ -115,6 +128,7 @@ fn node_against_cyclone_peer(k: u32, node_args: &[&str], peer_args: &[&str]) {
         .stderr(Stdio::piped())
         .spawn()
         .expect("start the Cyclone DDS peer");
+    meanwhile(domain_number);
     // The peer's stderr is read after it exits: its output is a few lines.
     let peer_status = wait_at_most(&mut peer, Duration::from_secs(PEER_TIMEOUT_S + 20));
     let peer_log = stderr_of(&mut peer);
@@ -147,4 +161,41 @@ fn every_message_type_round_trips_with_cyclone_dds() {
 #[test]
 fn px4_setpoints_decode_in_cyclone_dds() {
     node_against_cyclone_peer(1, &["--px4"], &["--px4"]);
+}
+
+/// The peer is the node's clock: its `/clock` starts at 1000 s, far from the system time, and
+/// every stamp the node publishes must be on it.
+#[test]
+fn a_node_with_use_sim_time_follows_a_cyclone_clock() {
+    node_against_cyclone_peer(2, &["--use-sim-time"], &["--sim-time", "1000"]);
+}
+
+/// `trust-sim dds-world`'s flight (quickstart, its clock from 1000 s) with `trust-node
+/// --use-sim-time`, observed by the peer: the world's `/clock` decoded field by field, the
+/// node's `/tf` equal to the world's odometry, its trajectories on the world's clock; the
+/// flight arrives.
+#[test]
+fn cyclone_decodes_the_world_clock_and_the_node_follows_it() {
+    let scenario = crate_dir().join("../../scenarios/quickstart.toml");
+    node_and_cyclone_peer_with(
+        3,
+        &["--use-sim-time"],
+        &["--observe-world", "1000"],
+        |domain| {
+            let s = trust_world::load_checked::<trust_planner::PlannerSpec>(&scenario)
+                .expect("quickstart");
+            let world = trust_world::World::build(&s).expect("world");
+            let dir = std::env::temp_dir().join(format!("trust-cyclone-world-{domain}"));
+            std::fs::create_dir_all(&dir).expect("temp dir");
+            let options = trust_ros2::dds_world::DdsWorldOptions {
+                clock_start_s: Some(1000.0),
+                ..Default::default()
+            };
+            let outcome =
+                trust_ros2::dds_world::fly(&world, domain, &dir.join("run.jsonl"), &options)
+                    .expect("the flight on the world's clock");
+            let _ = std::fs::remove_dir_all(&dir);
+            assert_eq!(outcome.status, trust_runlog::Status::Arrived, "{outcome:?}");
+        },
+    );
 }

@@ -28,9 +28,21 @@ fn world(scenario: &Path, seed: u64) -> World {
 /// Flies `scenario` (trial `seed`) with `trust-node` on domain `domain`; checks the log's audit
 /// and returns the outcome.
 fn fly_over_dds(scenario: &Path, seed: u64, domain: u16) -> Outcome {
+    fly_over_dds_with(scenario, seed, domain, &[], &DdsWorldOptions::default())
+}
+
+/// As [`fly_over_dds`], with more arguments of `trust-node` and the world's options.
+fn fly_over_dds_with(
+    scenario: &Path,
+    seed: u64,
+    domain: u16,
+    node_args: &[&str],
+    options: &DdsWorldOptions,
+) -> Outcome {
     let mut node = Command::new(env!("CARGO_BIN_EXE_trust-node"))
         .arg(scenario)
         .args(["--domain-id", &domain.to_string(), "--until-stdin-closes"])
+        .args(node_args)
         .stdin(Stdio::piped())
         .stdout(Stdio::null())
         .spawn()
@@ -39,7 +51,7 @@ fn fly_over_dds(scenario: &Path, seed: u64, domain: u16) -> Outcome {
     let dir = std::env::temp_dir().join(format!("trust-dds-world-{}-{domain}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let log = dir.join("run.jsonl");
-    let outcome = fly(&world, domain, &log, &DdsWorldOptions::default());
+    let outcome = fly(&world, domain, &log, options);
     drop(node.stdin.take());
     let _ = node.wait();
     let outcome = outcome.expect("the flight over DDS");
@@ -58,6 +70,25 @@ fn domain(offset: u16) -> u16 {
 #[test]
 fn quickstart_flown_by_trust_node_over_dds_arrives_and_its_log_passes_the_audit() {
     let outcome = fly_over_dds(&scenario_path("quickstart.toml"), 0, domain(0));
+    assert_eq!(outcome.status, Status::Arrived, "{outcome:?}");
+}
+
+/// The world's clock far from the system clock (from 1000 s): a node on the system clock would
+/// find every odometry 1.7e9 s old; with `--use-sim-time` it follows `/clock` and the flight is
+/// the same.
+#[test]
+fn quickstart_on_the_worlds_clock_with_use_sim_time_arrives() {
+    let options = DdsWorldOptions {
+        clock_start_s: Some(1000.0),
+        ..DdsWorldOptions::default()
+    };
+    let outcome = fly_over_dds_with(
+        &scenario_path("quickstart.toml"),
+        0,
+        domain(2),
+        &["--use-sim-time"],
+        &options,
+    );
     assert_eq!(outcome.status, Status::Arrived, "{outcome:?}");
 }
 

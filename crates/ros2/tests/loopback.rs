@@ -7,12 +7,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use ros2_client::{Context, ContextOptions, NodeName, NodeOptions};
-use trust_ros2::dds::{self, DdsNode, DdsOptions, plan_qos, system_time, topics};
-use trust_ros2::msg::builtin_interfaces::Time;
-use trust_ros2::msg::geometry_msgs::{Point, PoseStamped};
+use trust_core::Vec3;
+use trust_ros2::dds::{self, plan_qos, system_time, topics};
+use trust_ros2::msg::geometry_msgs::PoseStamped;
 use trust_ros2::msg::nav_msgs::Odometry;
+use trust_ros2::msg::tf2_msgs::TFMessage;
 use trust_ros2::msg::trajectory_msgs::MultiDOFJointTrajectory;
-use trust_ros2::{NodeCore, NodeParams, NodeSetup};
+use trust_ros2::test_support::{goal, odometry, quickstart_dds_node};
 
 /// A domain id in 0..=232 of this process (tests running in parallel processes do not meet).
 fn domain_id() -> u16 {
@@ -29,16 +30,7 @@ fn odometry_and_goal_over_dds_give_a_trajectory() {
     let stop = Arc::new(AtomicBool::new(false));
     let node_stop = Arc::clone(&stop);
     let node = std::thread::spawn(move || {
-        let scenario = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../scenarios/quickstart.toml");
-        let setup = NodeSetup::from_scenario(&scenario).expect("quickstart");
-        let origin = Time {
-            sec: system_time().sec,
-            nanosec: 0,
-        };
-        let mut core = NodeCore::new(setup, NodeParams::default(), origin).expect("core");
-        let ctx = context(domain);
-        let mut node = DdsNode::new(&ctx, &DdsOptions::default()).expect("node");
+        let (mut core, mut node) = quickstart_dds_node(domain).expect("quickstart node");
         node.run(&mut core, &node_stop, &mut |what, e| {
             eprintln!("node warning ({what}): {e}");
         });
@@ -62,36 +54,27 @@ fn odometry_and_goal_over_dds_give_a_trajectory() {
         plan_qos(),
     )
     .expect("trajectory");
+    let tf_sub =
+        dds::subscription::<TFMessage>(&mut test_node, topics::TF, dds::tf_qos()).expect("tf");
 
     let deadline = Instant::now() + Duration::from_secs(30);
     let mut received = None;
+    let mut tf = None;
     let mut next_publish = Instant::now();
-    while Instant::now() < deadline && received.is_none() {
+    let start = Vec3::new(2.0, 10.0, 3.0);
+    while Instant::now() < deadline && (received.is_none() || tf.is_none()) {
         if Instant::now() >= next_publish {
-            let mut odom = Odometry::default();
-            odom.header.stamp = system_time();
-            odom.header.frame_id = "map".into();
-            odom.child_frame_id = "base_link".into();
-            odom.pose.pose.position = Point {
-                x: 2.0,
-                y: 10.0,
-                z: 3.0,
-            };
             // Before discovery matches the writers a publish may fail; it is retried.
+            let odom = odometry(system_time(), "base_link", start, Vec3::zeros());
             let _ = odom_pub.publish(odom);
-            let mut goal = PoseStamped::default();
-            goal.header.stamp = system_time();
-            goal.header.frame_id = "map".into();
-            goal.pose.position = Point {
-                x: 38.0,
-                y: 10.0,
-                z: 3.0,
-            };
-            let _ = goal_pub.publish(goal);
+            let _ = goal_pub.publish(goal(system_time(), Vec3::new(38.0, 10.0, 3.0)));
             next_publish += Duration::from_millis(100);
         }
         if let Ok(Some((msg, _))) = traj_sub.take() {
             received = Some(msg);
+        }
+        if let Ok(Some((msg, _))) = tf_sub.take() {
+            tf = Some(msg);
         }
         std::thread::sleep(Duration::from_millis(5));
     }
@@ -109,4 +92,13 @@ fn odometry_and_goal_over_dds_give_a_trajectory() {
         "the plan starts at the vehicle: {p:?}"
     );
     assert!(counters.cycle_count >= 1);
+    // The odometry came back on /tf as map -> base_link.
+    let tf = tf.expect("a /tf message");
+    assert_eq!(tf.transforms.len(), 1);
+    let t = &tf.transforms[0];
+    assert_eq!(
+        (t.header.frame_id.as_str(), t.child_frame_id.as_str()),
+        ("map", "base_link")
+    );
+    assert_eq!(Vec3::from(t.transform.translation), start);
 }

@@ -131,6 +131,10 @@ enum Cmd {
         /// Output directory.
         #[arg(long, default_value = "out/dds-world")]
         out: PathBuf,
+        /// Simulated ROS time: `/clock` and every stamp are this (s) plus the simulated time
+        /// since the start (`trust-node --use-sim-time` needed); default: the system time.
+        #[arg(long)]
+        clock_start: Option<f64>,
     },
     /// Run a comparative study (the paper's E4 by default): every planner on the same trials;
     /// writes runs.csv, summary.json, report.md, plots and every run log.
@@ -611,6 +615,7 @@ fn run_cli() -> Result<ExitCode> {
             seed,
             domain_id,
             out,
+            clock_start,
         } => {
             let mut s = Scenario::parse_file(&scenario)?;
             if let Some(seed) = seed {
@@ -635,7 +640,10 @@ fn run_cli() -> Result<ExitCode> {
                 &world,
                 domain_id,
                 &log_path,
-                &trust_ros2::dds_world::DdsWorldOptions::default(),
+                &trust_ros2::dds_world::DdsWorldOptions {
+                    clock_start_s: clock_start,
+                    ..Default::default()
+                },
             )?;
             out!(
                 "trust-node over DDS: {}{} at t = {:.2} s; path {:.1} m; min clearance static {}, \

@@ -2,6 +2,7 @@
 //!
 //! ```text
 //! trust-node SCENARIO.toml [--params NODE.toml] [--domain-id N] [--namespace NS] [--px4]
+//!     [--use-sim-time]
 //! ```
 //!
 //! The scenario file gives the planner (`[planner]`), the vehicle and the map (bounds, static
@@ -15,7 +16,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context as _, Result};
 use clap::Parser;
 use ros2_client::{Context, ContextOptions};
-use trust_ros2::dds::{DdsNode, DdsOptions, system_time};
+use trust_ros2::dds::{DdsNode, DdsOptions};
 use trust_ros2::msg::builtin_interfaces::Time;
 use trust_ros2::{NodeCore, NodeParams, NodeSetup, Ros2Error};
 
@@ -37,6 +38,10 @@ struct Args {
     /// Publish PX4's TrajectorySetpoint (NED) on /fmu/in/trajectory_setpoint instead of setpoint.
     #[arg(long)]
     px4: bool,
+    /// Take ROS time from /clock (a simulator's, e.g. `trust-sim dds-world`) instead of the
+    /// system clock: ROS's `use_sim_time` (also the parameter file's `use_sim_time = true`).
+    #[arg(long)]
+    use_sim_time: bool,
     /// Stop when standard input closes (for scripts and tests); otherwise run until killed.
     #[arg(long)]
     until_stdin_closes: bool,
@@ -44,18 +49,13 @@ struct Args {
 
 fn main() -> Result<()> {
     let args = Args::parse();
-    let params = match &args.params {
+    let mut params = match &args.params {
         Some(p) => NodeParams::load(p)?,
         None => NodeParams::default(),
     };
+    params.use_sim_time |= args.use_sim_time;
     let setup = NodeSetup::from_scenario(&args.scenario)
         .with_context(|| format!("reading {}", args.scenario.display()))?;
-    let start = system_time();
-    let origin = Time {
-        sec: start.sec,
-        nanosec: 0,
-    };
-    let mut core = NodeCore::new(setup, params, origin)?;
     let domain_id = match args.domain_id {
         Some(d) => d,
         None => match std::env::var("ROS_DOMAIN_ID") {
@@ -70,13 +70,9 @@ fn main() -> Result<()> {
     let options = DdsOptions {
         namespace: args.namespace.clone(),
         px4: args.px4,
-        ..DdsOptions::default()
+        ..DdsOptions::for_params(&params)
     };
     let mut node = DdsNode::new(&context, &options)?;
-    eprintln!(
-        "trust-node: domain {domain_id}, namespace {}, node time 0 = ROS time {} s",
-        args.namespace, origin.sec
-    );
     let stop = Arc::new(AtomicBool::new(false));
     if args.until_stdin_closes {
         let stop = Arc::clone(&stop);
@@ -85,6 +81,29 @@ fn main() -> Result<()> {
             stop.store(true, Ordering::Relaxed);
         });
     }
+    if params.use_sim_time {
+        eprintln!("trust-node: use_sim_time: waiting for /clock on domain {domain_id}...");
+    }
+    // Node time 0 is the whole second of ROS time at the start (the first /clock in sim time).
+    let Some(start) = node.wait_for_time(&stop) else {
+        eprintln!("trust-node: stopped before the first /clock");
+        return Ok(());
+    };
+    let origin = Time {
+        sec: start.sec,
+        nanosec: 0,
+    };
+    let clock = if params.use_sim_time {
+        "/clock"
+    } else {
+        "system clock"
+    };
+    let mut core = NodeCore::new(setup, params, origin)?;
+    eprintln!(
+        "trust-node: domain {domain_id}, namespace {}, ROS time from the {clock}, node time 0 = \
+         ROS time {} s",
+        args.namespace, origin.sec
+    );
     let mut warnings = 0u64;
     node.run(&mut core, &stop, &mut |what, e| {
         warnings += 1;
