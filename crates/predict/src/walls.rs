@@ -57,14 +57,7 @@ struct AxisPiece {
 /// # Ok::<(), trust_predict::PredictError>(())
 /// ```
 pub fn wall_images(forecast: &Forecast, walls: &Aabb, from: f64, until: f64) -> Vec<Forecast> {
-    let half_extent = [
-        forecast.r_o,
-        forecast.r_o,
-        match forecast.shape {
-            ObstacleShape::Sphere => forecast.r_o,
-            ObstacleShape::Cylinder { half_height } => half_height,
-        },
-    ];
+    let half_extent = half_extents(forecast.shape, forecast.r_o);
     let axes: [Vec<AxisPiece>; 3] = std::array::from_fn(|a| {
         axis_pieces(
             forecast.p0[a],
@@ -95,6 +88,20 @@ pub fn wall_images(forecast: &Forecast, walls: &Aabb, from: f64, until: f64) -> 
         }
     }
     images
+}
+
+/// The shape's half extents along x, y and z: where its centre turns at a wall
+/// (`r_o` horizontally; a cylinder's half-height vertically). Shared by [`wall_images`] and the
+/// tracker's fold ([`crate::CvEkf::with_walls`]), so the two agree on where an obstacle turns.
+pub(crate) fn half_extents(shape: ObstacleShape, r_o: f64) -> [f64; 3] {
+    [
+        r_o,
+        r_o,
+        match shape {
+            ObstacleShape::Sphere => r_o,
+            ObstacleShape::Cylinder { half_height } => half_height,
+        },
+    ]
 }
 
 /// The straight pieces of `q + w·(t − t0)` folded into `[lo, hi]`, from the unreflected line up

@@ -403,7 +403,8 @@ impl World {
             &shapes,
             self.vehicle_radius_m(),
             self.seeds.sensing,
-        )?;
+        )?
+        .with_walls(self.obstacles.iter().map(|o| Some(o.region)).collect())?;
         let positions: Vec<Vec3> = self.obstacles.iter().map(|o| o.position).collect();
         let velocities: Vec<Vec3> = self.obstacles.iter().map(|o| o.velocity).collect();
         s.warm_up(&positions, &velocities)?;
@@ -471,6 +472,7 @@ fn preflight<P>(scenario: &Scenario<P>, layout: &generate::Layout, p: &mut probl
         scenario.vehicle.radius_m,
         seeds.sensing,
     )
+    .and_then(|s| s.with_walls(layout.obstacles.iter().map(|o| Some(o.region)).collect()))
     .and_then(|mut s| {
         s.warm_up(&positions, &velocities)?;
         if let Some(t) = &traffic {
