@@ -572,3 +572,52 @@ impl StepReport {
             .any(|e| matches!(e, Event::SwitchedMain { .. }))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failure_events_keep_the_message_and_name_the_cause() {
+        let e = PlanError::invalid("start.v", f64::NAN, "a finite vector");
+        let event = Event::solve_failed(Some(3), &e);
+        assert!(matches!(
+            event,
+            Event::SolveFailed {
+                cause: PlanErrorKind::InvalidInput,
+                ..
+            }
+        ));
+        // The message is the error's text, as before; the cause is added beside it.
+        let json = serde_json::to_string(&event).unwrap();
+        let message = serde_json::to_string(&e.to_string()).unwrap();
+        assert_eq!(
+            json,
+            format!(
+                r#"{{"event":"solve_failed","id":3,"error":{message},"cause":"invalid_input"}}"#
+            )
+        );
+        assert_eq!(serde_json::from_str::<Event>(&json).unwrap(), event);
+
+        let r = RouteError::ExpansionCap { cap: 50 };
+        let event = Event::route_failed(RouteReason::Stalled, &r);
+        let json = serde_json::to_string(&event).unwrap();
+        assert!(
+            json.starts_with(&format!(
+                r#"{{"event":"route_failed","reason":"stalled","error":{}"#,
+                serde_json::to_string(&r.to_string()).unwrap()
+            )),
+            "{json}"
+        );
+        assert!(json.ends_with(r#","cause":"expansion_cap"}"#), "{json}");
+        assert_eq!(serde_json::from_str::<Event>(&json).unwrap(), event);
+        assert_eq!(
+            Event::checker_failed(&e),
+            Event::CheckerFailed {
+                error: e.to_string(),
+                cause: PlanErrorKind::InvalidInput
+            }
+        );
+        assert_eq!(Event::frontend_failed(&e).tag(), "frontend_failed");
+    }
+}
