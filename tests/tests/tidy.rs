@@ -436,7 +436,11 @@ fn no_module_cycles_at_any_depth() {
         for file in modules::crate_roots(&m.dir) {
             crates += 1;
             let krate = modules::Crate::parse(&file);
-            let at = file.strip_prefix(&root).unwrap_or(&file).display().to_string();
+            let at = file
+                .strip_prefix(&root)
+                .unwrap_or(&file)
+                .display()
+                .to_string();
             for cycle in modules::module_cycles(&krate) {
                 offenders.push(format!("{} ({at}): {cycle}", m.name()));
             }
@@ -456,8 +460,11 @@ fn no_module_cycles_at_any_depth() {
 #[test]
 #[ignore = "a tool: set TIDY_GRAPH=<crate root>:<module>"]
 fn print_module_graph() {
-    let spec = std::env::var("TIDY_GRAPH").unwrap_or_else(|_| "crates/world/src/lib.rs:crate".into());
-    let (file, parent) = spec.split_once(':').expect("TIDY_GRAPH=<crate root>:<module>");
+    let spec =
+        std::env::var("TIDY_GRAPH").unwrap_or_else(|_| "crates/world/src/lib.rs:crate".into());
+    let (file, parent) = spec
+        .split_once(':')
+        .expect("TIDY_GRAPH=<crate root>:<module>");
     let krate = modules::Crate::parse(&workspace_root().join(file));
     let levels = krate.sibling_graphs();
     let level = levels

@@ -71,7 +71,10 @@ impl Crate {
         };
         let file = parse_file(root);
         // A crate root owns its directory: `mod x;` is `x.rs` or `x/mod.rs` beside it.
-        let dir = root.parent().expect("a crate root has a folder").to_path_buf();
+        let dir = root
+            .parent()
+            .expect("a crate root has a folder")
+            .to_path_buf();
         krate.fill(0, &file.items, &dir);
         krate
     }
@@ -701,15 +704,32 @@ mod tests {
                      #[cfg(test)] mod tests { use super::*; #[test] fn t() { a::f(); } }",
                 ),
                 ("a.rs", "pub fn f() { println!(\"{}\", crate::b::X); }"),
-                ("b.rs", "pub const X: u8 = 1; fn g() { use crate::c::*; let _ = Y; }"),
-                ("c.rs", "pub const Y: u8 = 2; fn h() { assert!(matches!(super::d::Z, 3)); }"),
-                ("d.rs", "pub const Z: u8 = 3; use super::a as first; fn k() { first::f(); }"),
+                (
+                    "b.rs",
+                    "pub const X: u8 = 1; fn g() { use crate::c::*; let _ = Y; }",
+                ),
+                (
+                    "c.rs",
+                    "pub const Y: u8 = 2; fn h() { assert!(matches!(super::d::Z, 3)); }",
+                ),
+                (
+                    "d.rs",
+                    "pub const Z: u8 = 3; use super::a as first; fn k() { first::f(); }",
+                ),
             ],
         );
         let cycles = module_cycles(&krate);
         assert_eq!(cycles.len(), 1, "{cycles:?}");
-        assert!(cycles[0].starts_with("a -> b -> c -> d -> a\n"), "{}", cycles[0]);
-        assert!(cycles[0].contains("b -> c: `b` names `crate::c`"), "{}", cycles[0]);
+        assert!(
+            cycles[0].starts_with("a -> b -> c -> d -> a\n"),
+            "{}",
+            cycles[0]
+        );
+        assert!(
+            cycles[0].contains("b -> c: `b` names `crate::c`"),
+            "{}",
+            cycles[0]
+        );
     }
 
     #[test]
