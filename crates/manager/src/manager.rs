@@ -24,7 +24,8 @@ use crate::safety::{
 };
 use trust_route::{GlobalRoute, RoutePoint, RouteProgress, UnreachableCause};
 
-use crate::routing::{RouteReason, Router, SearchSlot, TakenBack, rerouted, route_failed};
+use crate::report::RouteReason;
+use crate::routing::{Router, SearchSlot, TakenBack, rerouted};
 
 mod worker;
 use worker::{Job, JobInput, JobOutput};
@@ -502,7 +503,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         };
         self.deferred_guides = std::mem::take(&mut explored.deferred);
         if let Some(error) = explored.frontend_error {
-            cycle.events.push(Event::FrontendFailed { error });
+            cycle.events.push(Event::frontend_failed(&error));
         }
 
         // The safety pass over the re-solved branches, then one branch per homotopy class.
@@ -716,7 +717,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                 }
                 Err(e) => {
                     self.route_search = None;
-                    cycle.events.push(route_failed(reason, &e));
+                    cycle.events.push(Event::route_failed(reason, &e));
                     return;
                 }
             }
@@ -813,7 +814,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                 verdict.nearest
             }
             RouteProgress::Failed(e) => {
-                cycle.events.push(route_failed(reason, &e));
+                cycle.events.push(Event::route_failed(reason, &e));
                 None
             }
             // A future kind of answer: keep the previous route.
@@ -1211,10 +1212,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         }
         match cand.result {
             Err(e) => {
-                cycle.events.push(Event::SolveFailed {
-                    id,
-                    error: e.to_string(),
-                });
+                cycle.events.push(Event::solve_failed(id, &e));
                 None
             }
             Ok((solution, _)) if self.is_stub(&solution.traj, &cycle.goal) => {
@@ -1424,9 +1422,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                         continue 'branches;
                     }
                     Ok(false) => {}
-                    Err(e) => events.push(Event::CheckerFailed {
-                        error: e.to_string(),
-                    }),
+                    Err(e) => events.push(Event::checker_failed(&e)),
                 }
             }
             out.push(b);
@@ -1458,9 +1454,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                     worse_equivalent.get_or_insert(i);
                 }
                 Ok(false) => {}
-                Err(e) => events.push(Event::CheckerFailed {
-                    error: e.to_string(),
-                }),
+                Err(e) => events.push(Event::checker_failed(&e)),
             }
         }
         match worse_equivalent {
@@ -1912,7 +1906,7 @@ struct Explored {
     /// The frontend's report (`None` if it failed or did not run).
     frontend: Option<FrontendReport>,
     /// The frontend's error, if it failed.
-    frontend_error: Option<String>,
+    frontend_error: Option<PlanError>,
     /// Whether the straight guide was explored ([`ManagerParams::straight_guide_when_empty`]).
     straight_guide: bool,
     /// Guide paths left for the following cycles ([`ManagerParams::cold_solves_per_cycle`]).
@@ -1945,7 +1939,7 @@ fn fwd_explore<F: PathFrontend, B: TrajectoryBackend>(
             result.paths
         }
         Err(e) => {
-            explored.frontend_error = Some(e.to_string());
+            explored.frontend_error = Some(e);
             Vec::new()
         }
     };

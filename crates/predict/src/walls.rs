@@ -145,6 +145,23 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    #[test]
+    fn the_walls_an_obstacle_stays_inside_are_optional_and_round_trip() {
+        let f = Forecast::sphere(Vec3::zeros(), Vec3::x(), 1.0, 0.5, 0.2, 0.4).unwrap();
+        assert_eq!(f.walls, None);
+        let json = serde_json::to_string(&f).unwrap();
+        assert!(!json.contains("walls"), "{json}");
+        let region = Aabb::new(Vec3::new(-5.0, -5.0, 0.0), Vec3::new(5.0, 5.0, 3.0)).unwrap();
+        let w = f.with_walls(region);
+        assert_eq!(w.walls, Some(region));
+        assert_eq!(w.radius(3.0), f.radius(3.0));
+        let json = serde_json::to_string(&w).unwrap();
+        assert_eq!(serde_json::from_str::<Forecast>(&json).unwrap(), w);
+        // The images at the walls keep them.
+        let images = wall_images(&w, &region, 1.0, 10.0);
+        assert!(!images.is_empty() && images.iter().all(|i| i.walls == Some(region)));
+    }
+
     fn room() -> Aabb {
         Aabb {
             min: Vec3::zeros(),
