@@ -315,6 +315,7 @@ fn without_branches_there_is_no_branch_channel_and_a_log_file_exports() {
                 overrun_ticks: None,
                 worker_ms: None,
                 waited_ms: None,
+                map_ms: None,
             }
         })
         .collect();

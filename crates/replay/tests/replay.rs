@@ -169,6 +169,7 @@ fn write_log(path: &Path, t_end: f64, with_branches: bool) {
                 overrun_ticks: None,
                 worker_ms: None,
                 waited_ms: None,
+                map_ms: None,
             }))
             .unwrap();
         }

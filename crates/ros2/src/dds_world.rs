@@ -414,6 +414,7 @@ fn cycle_record(t: f64, e: &PlannerEvent) -> CycleRecord {
         overrun_ticks: None,
         worker_ms: None,
         waited_ms: None,
+        map_ms: None,
     }
 }
 

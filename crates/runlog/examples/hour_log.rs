@@ -146,6 +146,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 overrun_ticks: None,
                 worker_ms: None,
                 waited_ms: None,
+                map_ms: None,
             }))?;
         }
     }

@@ -276,6 +276,11 @@ pub struct CycleRecord {
     /// (ms). The real-time clock charges `wall_ms − waited_ms` plus the job's lateness.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub waited_ms: Option<f64>,
+    /// Added (issue 34), only when the static map is sensed (`[sensing.static]`): the time the
+    /// online map took since the previous cycle (ms): the scans, their insertion and the export
+    /// of the planner's map. Perception, not planning: not part of `wall_ms`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub map_ms: Option<f64>,
 }
 
 /// One kept branch's trajectory, sampled (added, issue 20).
@@ -844,6 +849,7 @@ mod tests {
             overrun_ticks: None,
             worker_ms: None,
             waited_ms: None,
+            map_ms: None,
         }
     }
 

@@ -71,6 +71,7 @@ fn parse_record(line: &str, light_cycles: bool) -> Result<Record, serde_json::Er
                 overrun_ticks: None,
                 worker_ms: None,
                 waited_ms: None,
+                map_ms: None,
             }));
         }
         return serde_json::from_str(line).map(Record::Cycle);

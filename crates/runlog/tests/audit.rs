@@ -95,6 +95,7 @@ fn cycle(t: f64) -> CycleRecord {
         overrun_ticks: None,
         worker_ms: None,
         waited_ms: None,
+        map_ms: None,
     }
 }
 
