@@ -348,10 +348,7 @@ pub fn step(
 
     // Physics. With a sensed map the vehicle turns to look where it goes; else yaw 0.
     let yaw = state.map_sensing.as_mut().map_or(0.0, |m| m.turn(dt));
-    let hover = Reference {
-        yaw,
-        ..state.hover
-    };
+    let hover = Reference { yaw, ..state.hover };
     let active = &state.active;
     let reference = |tau: f64| match active {
         Some(plan) => Reference::from_traj(plan, tau, yaw),

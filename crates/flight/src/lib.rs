@@ -578,7 +578,9 @@ impl FlightObserver for Logger {
             cycle.effective_t,
             self.zero_timing,
         );
-        rec.map_ms = cycle.map_ms.map(|ms| if self.zero_timing { 0.0 } else { ms });
+        rec.map_ms = cycle
+            .map_ms
+            .map(|ms| if self.zero_timing { 0.0 } else { ms });
         if self.real_time {
             rec.charged_ms = Some(cycle.charged_s * 1e3);
             rec.overrun_ticks = (cycle.overrun_ticks > 0).then_some(cycle.overrun_ticks);

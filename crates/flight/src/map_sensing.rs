@@ -193,9 +193,7 @@ impl MapSensing {
             .and_then(|id| manager.branches().iter().find(|b| b.id == id))
             .or(manager.branches().first());
         let ahead = best.map(|b| b.traj().position(t + LOOK_AHEAD_S) - p);
-        let toward = ahead
-            .filter(|d| d.xy().norm() > 0.05)
-            .unwrap_or(goal - p);
+        let toward = ahead.filter(|d| d.xy().norm() > 0.05).unwrap_or(goal - p);
         if toward.xy().norm() > 0.05 {
             self.target_yaw = toward.y.atan2(toward.x);
         }

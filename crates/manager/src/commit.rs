@@ -50,7 +50,11 @@ pub fn committed_stretch(traj: &PolyTraj, from: f64, until: f64, a_max: f64) -> 
         if last.v.norm() > 1e-6
             && let Ok(tail) = braking_tail(&last, a_max, COMMIT_SAMPLE_S)
         {
-            points.extend(sample(&tail, tail.t_start(), tail.t_end()).into_iter().skip(1));
+            points.extend(
+                sample(&tail, tail.t_start(), tail.t_end())
+                    .into_iter()
+                    .skip(1),
+            );
         }
     }
     points
@@ -95,7 +99,10 @@ mod tests {
         let pts = committed_stretch(&line(2.0, 5.0), 0.0, 0.2, 3.0);
         let last = pts.last().unwrap();
         assert!((last.0 - (0.2 + 2.0 / 2.7)).abs() < 1e-9, "{last:?}");
-        assert!(pts.windows(2).all(|w| w[1].0 - w[0].0 <= COMMIT_SAMPLE_S + 1e-12));
+        assert!(
+            pts.windows(2)
+                .all(|w| w[1].0 - w[0].0 <= COMMIT_SAMPLE_S + 1e-12)
+        );
     }
 
     #[test]

@@ -1229,7 +1229,9 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                     self.main = Some(main.id);
                     return None;
                 }
-                Some(t) => cycle.events.push(Event::NotKnownFree { branch: main.id, t }),
+                Some(t) => cycle
+                    .events
+                    .push(Event::NotKnownFree { branch: main.id, t }),
             }
         }
         let (start, reanchored) = (cycle.start, cycle.reanchored);

@@ -283,8 +283,8 @@ mod tests {
         assert_eq!(sensor, StaticSensor::Depth(DepthCameraParams::default()));
         assert_eq!(map.dims, [200, 200, 48]);
         assert_eq!(map.resolution_m, LocalMapParams::default().resolution_m);
-        let d = parse("static = { depth = { rate_hz = 15.0, map = { resolution_m = 0.2 } } }")
-            .unwrap();
+        let d =
+            parse("static = { depth = { rate_hz = 15.0, map = { resolution_m = 0.2 } } }").unwrap();
         let (sensor, map) = d.sensor().unwrap();
         assert_eq!(sensor.rate_hz(), 15.0);
         assert_eq!(map.resolution_m, 0.2);
