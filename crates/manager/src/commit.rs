@@ -60,7 +60,7 @@ pub fn committed_stretch(traj: &PolyTraj, from: f64, until: f64, a_max: f64) -> 
     points
 }
 
-/// `traj` at `from`, every [`COMMIT_SAMPLE_S`] (or coarser, at most [`MAX_POINTS`]), and `to`.
+/// `traj` at `from`, every [`COMMIT_SAMPLE_S`] (or coarser, at most `MAX_POINTS`), and `to`.
 fn sample(traj: &PolyTraj, from: f64, to: f64) -> Vec<(f64, Vec3)> {
     let span = (to - from).max(0.0);
     let n = ((span / COMMIT_SAMPLE_S).ceil() as usize).clamp(1, MAX_POINTS);

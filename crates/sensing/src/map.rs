@@ -446,7 +446,7 @@ impl LocalMap {
     pub fn assume_free(&mut self, center: &Vec3, radius: f64) -> usize {
         let res = self.ring.res;
         if !trust_geometry::scale::position_in_scale(center)
-            || !(radius >= 0.0 && radius <= 16.0 * res)
+            || !(0.0..=16.0 * res).contains(&radius)
         {
             return 0;
         }
@@ -458,12 +458,7 @@ impl LocalMap {
             for dy in -n..=n {
                 for dx in -n..=n {
                     let k = [c[0] + dx, c[1] + dy, c[2] + dz];
-                    let centre = Vec3::new(
-                        (k[0] as f64 + 0.5) * res,
-                        (k[1] as f64 + 0.5) * res,
-                        (k[2] as f64 + 0.5) * res,
-                    );
-                    if !self.ring.contains(&k) || (centre - center).norm() > radius {
+                    if !self.ring.contains(&k) || (self.ring.center(&k) - center).norm() > radius {
                         continue;
                     }
                     let v = &mut self.voxels[self.ring.slot(&k)];
