@@ -39,6 +39,7 @@ use trust_core::{Forecast, Rng, Vec3};
 use trust_predict::{CvEkf, EkfParams, PredictError};
 
 use crate::error::WorldError;
+use crate::map_sensing::StaticSensing;
 use crate::problem::Problems;
 use crate::traffic::MovingShape;
 
@@ -63,6 +64,10 @@ pub struct SensingParams {
     pub warmup_s: f64,
     /// The tracking filter's parameters (`trust_predict::EkfParams`).
     pub ekf: EkfParams,
+    /// `[sensing.static]`: whether the planner is given the static map (`"known"`, the
+    /// default) or senses it with a depth camera or a LiDAR ([`crate::map_sensing`]).
+    #[serde(rename = "static", skip_serializing_if = "StaticSensing::is_known")]
+    pub static_map: StaticSensing,
 }
 
 impl Default for SensingParams {
@@ -74,6 +79,7 @@ impl Default for SensingParams {
             r_safe_margin_m: 0.1,
             warmup_s: 2.0,
             ekf: EkfParams::default(),
+            static_map: StaticSensing::Known,
         }
     }
 }
@@ -101,6 +107,7 @@ impl SensingParams {
         if let Err(e) = self.ekf.validate() {
             p.list.push(predict_problem(e, field));
         }
+        self.static_map.check(&format!("{field}.static"), p);
     }
 }
 
