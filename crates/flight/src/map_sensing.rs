@@ -10,9 +10,17 @@
 //!   (`LocalMap::to_static_map` over the world's bounds); shared with the manager's worker.
 //! * **Commitment.** The committed part of a plan and its braking must lie in observed free
 //!   voxels with the vehicle's radius as clearance ([`KnownFree`], FASTER's rule): the manager
-//!   consults it through `trust_manager::CommitCheck`. At take-off the ball of the vehicle's
-//!   radius plus two voxels around the start counts as known free (the start is clear: it is
-//!   where the vehicle is; FASTER's initial condition).
+//!   consults it through `trust_manager::CommitCheck`. Two kinds of space count as known free
+//!   without a measurement, because the vehicle is physically there: at take-off the ball
+//!   around the start of radius `r + blind + voxel diagonal` (`r` the vehicle's radius, `blind`
+//!   the sensor's blind reach for it, `StaticSensor::blind_reach_m`: the first stretch of any
+//!   path has parts the sensor cannot see from the start, e.g. below and above the camera's 58°
+//!   vertical field within 0.54 m; FASTER's initial condition, the vehicle starts in known
+//!   free space), and at every scan the ball the vehicle's body fills, grown by a voxel
+//!   diagonal (the voxels its body touches; the commit check's own discretization: a voxel
+//!   within its clearance of the vehicle's voxel, `LocalMap::segment_known_free`). Without it
+//!   the camera's minimum depth (0.3 m) and vertical field leave the voxels round a hovering
+//!   vehicle unobserved, and a plan that sets off sideways, up or down is never committed.
 //! * **Heading.** A forward-looking camera must look where the vehicle goes: the commanded yaw
 //!   turns toward the direction of the best branch (main, else the best-ranked kept one) one
 //!   second ahead, else toward the goal, at most [`YAW_RATE_RAD_S`]. A known map keeps yaw 0.
@@ -61,6 +69,8 @@ pub struct MapSensing {
     planner_map: Arc<StaticMap>,
     dirty: bool,
     clearance_m: f64,
+    /// The radius of the ball round the vehicle that counts as free at each scan (m).
+    body_m: f64,
     map_ms: f64,
     /// The commanded yaw (rad).
     yaw: f64,
@@ -80,6 +90,7 @@ impl MapSensing {
         let Some((sensor, map_params)) = scenario.sensing.static_map.sensor() else {
             return Ok(None);
         };
+        let blind = sensor.blind_reach_m(world.vehicle_radius_m());
         if world.static_points().is_some() {
             return Err(FlightError::Sensing(trust_sensing::SensingError::Scan {
                 field: "sensing.static".into(),
@@ -94,7 +105,10 @@ impl MapSensing {
         let start = world.start();
         let mut map = LocalMap::new(map_params, &start)?;
         let radius = world.vehicle_radius_m();
-        map.assume_free(&start, radius + 2.0 * map_params.resolution_m);
+        map.assume_free(
+            &start,
+            radius + blind + 3f64.sqrt() * map_params.resolution_m,
+        );
         let bounds = *world.bounds();
         let planner_map = Arc::new(map.to_static_map(bounds)?);
         let goal = world.goal() - start;
@@ -110,6 +124,7 @@ impl MapSensing {
             planner_map,
             dirty: false,
             clearance_m: radius,
+            body_m: radius + 3f64.sqrt() * map_params.resolution_m,
             map_ms: 0.0,
             yaw,
             target_yaw: if goal.xy().norm() > 1e-9 {
@@ -147,6 +162,7 @@ impl MapSensing {
         let map = Arc::make_mut(&mut self.map);
         map.recentre(&vehicle.p)?;
         map.insert_scan(&self.scan)?;
+        map.assume_free(&vehicle.p, self.body_m);
         self.dirty = true;
         self.map_ms += started.elapsed().as_secs_f64() * 1e3;
         Ok(())

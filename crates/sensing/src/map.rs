@@ -442,11 +442,11 @@ impl LocalMap {
     /// (one miss of the sensor model), leaving observed voxels as they are; returns how many it
     /// marked. For space known free without a measurement: the ball the vehicle occupies at
     /// take-off (FASTER's initial condition: the vehicle starts in known free space). Non-finite
-    /// input, a negative radius or one above 16 voxels marks nothing.
+    /// input, a negative radius or one above 64 voxels marks nothing.
     pub fn assume_free(&mut self, center: &Vec3, radius: f64) -> usize {
         let res = self.ring.res;
         if !trust_geometry::scale::position_in_scale(center)
-            || !(0.0..=16.0 * res).contains(&radius)
+            || !(0.0..=64.0 * res).contains(&radius)
         {
             return 0;
         }

@@ -53,6 +53,12 @@ pub struct MapSpec {
     /// Truncation of the distance field (m).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_distance_m: Option<f64>,
+    /// Fast-Planner's ray-casting shortcut (`LocalMapParams::stop_at_visited`). Default true
+    /// in flight (unlike the library's default): a frame's rays share the voxels near the
+    /// sensor, and tracing each from its end back to the first voxel another ray cleared costs a
+    /// fraction of the exact update (`cargo bench -p trust-sensing --bench map_update`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stop_at_visited: Option<bool>,
 }
 
 /// Most half-width of the default window (m): 10 m, the depth camera's range (the D435's,
@@ -76,6 +82,7 @@ impl MapSpec {
             resolution_m,
             dims: self.dims.unwrap_or([across, across, d.dims[2]]),
             max_distance_m: self.max_distance_m.unwrap_or(d.max_distance_m),
+            stop_at_visited: self.stop_at_visited.unwrap_or(true),
             ..d
         }
     }
@@ -183,6 +190,50 @@ impl StaticSensor {
         }
     }
 }
+
+impl StaticSensor {
+    /// How far from the sensor (m) a ball of radius `clearance` on its forward axis can still
+    /// reach outside the sensor's view: beyond the returned distance the ball lies within the
+    /// field of view (vertically and horizontally) and beyond the minimum range. A depth camera:
+    /// `max(min_depth, clearance / tan(fov/2))` over both fields of view (0.54 m for the D435's
+    /// 58° vertical field and a 0.3 m radius); a LiDAR: `max(min_range, clearance /
+    /// tan(e))` with `e` the smaller of its lowest and highest elevation's magnitudes (a
+    /// pattern that does not look both up and down reaches [`MAX_BLIND_REACH_M`]). At most
+    /// [`MAX_BLIND_REACH_M`]; a negative or NaN clearance counts as 0.
+    pub fn blind_reach_m(&self, clearance: f64) -> f64 {
+        let c = if clearance.is_nan() {
+            0.0
+        } else {
+            clearance.max(0.0)
+        };
+        let beyond = |half_angle: f64| {
+            if half_angle > 0.0 && half_angle.is_finite() {
+                c / half_angle.min(std::f64::consts::FRAC_PI_2 - 1e-9).tan()
+            } else {
+                f64::INFINITY
+            }
+        };
+        let reach = match self {
+            StaticSensor::Depth(p) => p
+                .min_depth_m
+                .max(beyond(0.5 * p.vfov_rad))
+                .max(beyond(0.5 * p.hfov_rad)),
+            StaticSensor::Lidar(p) => {
+                let e = (-p.min_elevation_rad).min(p.max_elevation_rad);
+                p.min_range_m.max(beyond(e))
+            }
+        };
+        if reach.is_nan() {
+            MAX_BLIND_REACH_M
+        } else {
+            reach.min(MAX_BLIND_REACH_M)
+        }
+    }
+}
+
+/// Most [`StaticSensor::blind_reach_m`] (m): 3 m, beyond which a sensor that cannot see
+/// around the vehicle is not one to fly on.
+pub const MAX_BLIND_REACH_M: f64 = 3.0;
 
 impl StaticSensing {
     /// Whether the planner is given the map (`"known"`).
@@ -295,6 +346,26 @@ mod tests {
         }
         assert!(problems(&d).is_empty());
         assert!(problems(&l).is_empty());
+    }
+
+    #[test]
+    fn the_blind_reach_follows_the_field_of_view() {
+        let (d435, _) = parse("static = { depth = {} }").unwrap().sensor().unwrap();
+        // 58° vertical: 0.3 / tan 29° ≈ 0.541 m.
+        assert!((d435.blind_reach_m(0.3) - 0.3 / 29f64.to_radians().tan()).abs() < 1e-9);
+        assert!((d435.blind_reach_m(f64::NAN) - d435_min_depth()).abs() < 1e-9);
+        let (vlp, _) = parse("static = { lidar = {} }").unwrap().sensor().unwrap();
+        // ±15°: 0.3 / tan 15° ≈ 1.12 m.
+        assert!((vlp.blind_reach_m(0.3) - 0.3 / 15f64.to_radians().tan()).abs() < 1e-6);
+        let (up_only, _) = parse("static = { lidar = { min_elevation_rad = 0.1 } }")
+            .unwrap()
+            .sensor()
+            .unwrap();
+        assert_eq!(up_only.blind_reach_m(0.3), MAX_BLIND_REACH_M);
+    }
+
+    fn d435_min_depth() -> f64 {
+        DepthCameraParams::default().min_depth_m
     }
 
     #[test]
