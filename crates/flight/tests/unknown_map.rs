@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use trust_flight::scenario::Scenario;
 use trust_flight::map_sensing::MapSensing;
+use trust_flight::scenario::Scenario;
 use trust_flight::{FlightError, RunOptions, fly};
 use trust_runlog::{RunLog, Status};
 use trust_world::World;
@@ -101,7 +101,11 @@ fn bad_sensing_values_are_problems_naming_the_field_and_typed_errors_in_flight()
     }
     // Known: no online map.
     s.sensing.static_map = Default::default();
-    assert!(MapSensing::new(&World::build(&s).expect("world")).unwrap().is_none());
+    assert!(
+        MapSensing::new(&World::build(&s).expect("world"))
+            .unwrap()
+            .is_none()
+    );
 }
 
 /// Whether building the world or its online map refuses `s` with a typed error (never a panic).
