@@ -13,7 +13,7 @@ use trust_world::error::WorldError;
 
 /// A 10 × 6 × 3 m room, a full-height wall across most of it 4 m ahead of the start (the way
 /// round is its open end at y > 4), a 48 × 36 depth camera reaching 4 m into 0.15 m voxels, and
-/// a slow vehicle.
+/// a slow vehicle of radius 0.1 m.
 const SCENE: &str = r#"
 name = "unknown_small_wall"
 description = "A wall learnt on the way: 10 x 6 x 3 m, depth camera, known-free commitment."
@@ -34,7 +34,7 @@ goal = [8.0, 2.0, 1.5]
 goal_tolerance_m = 0.3
 
 [vehicle]
-radius_m = 0.2
+radius_m = 0.1
 limits = { v_max = 1.5, a_max = 3.0 }
 
 [planner]
