@@ -186,11 +186,18 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-scenes",
                 "trust-vehicle",
                 "trust-runlog",
+                "trust-sensing",
             ][..],
         ),
         (
             "trust-flight",
-            with(&["trust-vehicle", "trust-world", "trust-runlog", "trust-plot"]),
+            with(&[
+                "trust-vehicle",
+                "trust-world",
+                "trust-runlog",
+                "trust-plot",
+                "trust-sensing",
+            ]),
         ),
         (
             "trust-experiments",

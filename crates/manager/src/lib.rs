@@ -53,6 +53,7 @@
 #![warn(missing_docs)]
 
 pub mod brake;
+mod commit;
 mod manager;
 mod params;
 pub mod progress;
@@ -63,6 +64,7 @@ pub mod safety;
 pub use brake::{
     brake_along, brake_straight, braking_tail, dash_maneuvers, escape_maneuvers, hermite_quintic,
 };
+pub use commit::{CommitCheck, committed_stretch};
 pub use manager::{Branch, HOLD_CLEARANCE_M, MainDecision, Manager, choose_main};
 pub use params::{
     GROWTH_FRACTION, ManagerOverrides, ManagerParams, ProgressOverrides, ProgressParams,

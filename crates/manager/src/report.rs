@@ -200,6 +200,16 @@ pub enum Event {
     /// The vehicle is at rest and its first route toward the goal is still being searched: it
     /// holds its place meanwhile ([`crate::routing`]).
     AwaitingRoute,
+    /// The main branch was safe on the planner's map but its committed part or braking tail
+    /// leaves the space the sensors observed free ([`crate::CommitCheck`]): it was not
+    /// committed, the fallback was.
+    NotKnownFree {
+        /// The branch that was not committed.
+        branch: BranchId,
+        /// The first instant (s) of the checked stretch outside known free space (the braking
+        /// tail's time when it is there).
+        t: f64,
+    },
     /// The route planner proved the goal cannot be reached ([`GoalUnreachable`]); the manager
     /// holds a stop at the reachable point nearest the goal and re-checks.
     GoalUnreachable {
@@ -357,6 +367,7 @@ impl Event {
             Event::RouteFailed { .. } => "route_failed",
             Event::GoalUnreachable { .. } => "goal_unreachable",
             Event::AwaitingRoute => "awaiting_route",
+            Event::NotKnownFree { .. } => "not_known_free",
         }
     }
 }

@@ -57,6 +57,7 @@ pub mod error;
 pub mod files;
 pub(crate) mod generate;
 mod kdtree;
+pub mod map_sensing;
 pub mod problem;
 mod sampling;
 pub mod scenario;
@@ -324,6 +325,12 @@ impl World {
             .and_then(|t| t.nearest(p))
             .map_or(f64::INFINITY, |(d, _)| d);
         shapes.min(points)
+    }
+
+    /// The true static shapes as a map (what the vehicle's sensors ray-cast against,
+    /// [`map_sensing`]); the true cloud points are not in it ([`World::static_points`]).
+    pub fn truth_map(&self) -> &StaticMap {
+        &self.truth_map
     }
 
     /// The planner's static map (module docs).

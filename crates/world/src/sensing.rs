@@ -39,6 +39,7 @@ use trust_core::{Aabb, Forecast, Rng, Vec3};
 use trust_predict::{CvEkf, EkfParams, PredictError};
 
 use crate::error::WorldError;
+use crate::map_sensing::StaticSensing;
 use crate::problem::Problems;
 use crate::traffic::MovingShape;
 
@@ -69,6 +70,10 @@ pub struct SensingParams {
     /// obstacle into the wall while its velocity turns (the forecasts' wall images assume the
     /// same box). `false` is the paper's constant-velocity filter.
     pub fold_at_walls: bool,
+    /// `[sensing.static]`: whether the planner is given the static map (`"known"`, the
+    /// default) or senses it with a depth camera or a LiDAR ([`crate::map_sensing`]).
+    #[serde(rename = "static", skip_serializing_if = "StaticSensing::is_known")]
+    pub static_map: StaticSensing,
 }
 
 impl Default for SensingParams {
@@ -81,6 +86,7 @@ impl Default for SensingParams {
             warmup_s: 2.0,
             ekf: EkfParams::default(),
             fold_at_walls: true,
+            static_map: StaticSensing::Known,
         }
     }
 }
@@ -108,6 +114,7 @@ impl SensingParams {
         if let Err(e) = self.ekf.validate() {
             p.list.push(predict_problem(e, field));
         }
+        self.static_map.check(&format!("{field}.static"), p);
     }
 }
 

@@ -96,6 +96,7 @@
 //! position_noise_m = 0.1
 //! dropout_probability = 0.0
 //! r_safe_margin_m = 0.1
+//! # static = "known"             # or { depth = { … } } | { lidar = { … } }: sensed (map_sensing)
 //! # [sensing.ekf]                # trust_predict::EkfParams
 //!
 //! [traffic]
