@@ -4,6 +4,9 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+#[path = "tidy/modules.rs"]
+mod modules;
+
 fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
@@ -183,11 +186,18 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-scenes",
                 "trust-vehicle",
                 "trust-runlog",
+                "trust-sensing",
             ][..],
         ),
         (
             "trust-flight",
-            with(&["trust-vehicle", "trust-world", "trust-runlog", "trust-plot"]),
+            with(&[
+                "trust-vehicle",
+                "trust-world",
+                "trust-runlog",
+                "trust-plot",
+                "trust-sensing",
+            ]),
         ),
         (
             "trust-experiments",
@@ -419,129 +429,60 @@ fn no_todo_or_unimplemented_in_sources() {
     assert!(offenders.is_empty(), "placeholders left in: {offenders:?}");
 }
 
-/// The top-level modules of a crate's `src` and the other top-level modules each names through
-/// `crate::<module>` (comments skipped; the crate root, which declares them all, is not a node).
-fn module_graph(src: &Path) -> BTreeMap<String, std::collections::BTreeSet<String>> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
-        for e in std::fs::read_dir(dir).into_iter().flatten().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                walk(&p, out);
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                out.push(p);
-            }
-        }
-    }
-    let mut files = Vec::new();
-    walk(src, &mut files);
-    let mut graph: BTreeMap<String, std::collections::BTreeSet<String>> = BTreeMap::new();
-    let top = |f: &Path| -> Option<String> {
-        let rel = f.strip_prefix(src).ok()?;
-        let first = rel.components().next()?.as_os_str().to_str()?.to_string();
-        let name = first.strip_suffix(".rs").unwrap_or(&first).to_string();
-        (!matches!(name.as_str(), "lib" | "main")).then_some(name)
-    };
-    for f in &files {
-        if let Some(m) = top(f) {
-            graph.entry(m).or_default();
-        }
-    }
-    for f in &files {
-        let Some(m) = top(f) else { continue };
-        let text = std::fs::read_to_string(f).unwrap_or_default();
-        for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {
-            for (i, _) in line.match_indices("crate::") {
-                if i > 0 && line[..i].ends_with(|c: char| c.is_alphanumeric() || c == '_') {
-                    continue; // `trust_crate::` and the like
-                }
-                let name: String = line[i + "crate::".len()..]
-                    .chars()
-                    .take_while(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || *c == '_')
-                    .collect();
-                if name != m && graph.contains_key(&name) {
-                    graph.get_mut(&m).expect("node").insert(name);
-                }
-            }
-        }
-    }
-    graph
-}
-
-/// A module cycle of `graph`, if any (depth-first search).
-fn find_cycle(graph: &BTreeMap<String, std::collections::BTreeSet<String>>) -> Option<Vec<String>> {
-    fn visit(
-        u: &str,
-        graph: &BTreeMap<String, std::collections::BTreeSet<String>>,
-        state: &mut BTreeMap<String, u8>,
-        stack: &mut Vec<String>,
-    ) -> Option<Vec<String>> {
-        state.insert(u.to_string(), 1);
-        stack.push(u.to_string());
-        for v in &graph[u] {
-            match state.get(v) {
-                Some(1) => {
-                    let at = stack.iter().position(|s| s == v).expect("on stack");
-                    let mut cycle = stack[at..].to_vec();
-                    cycle.push(v.clone());
-                    return Some(cycle);
-                }
-                Some(_) => {}
-                None => {
-                    if let Some(c) = visit(v, graph, state, stack) {
-                        return Some(c);
-                    }
-                }
-            }
-        }
-        stack.pop();
-        state.insert(u.to_string(), 2);
-        None
-    }
-    let mut state = BTreeMap::new();
-    for u in graph.keys() {
-        if !state.contains_key(u)
-            && let Some(c) = visit(u, graph, &mut state, &mut Vec::new())
-        {
-            return Some(c);
-        }
-    }
-    None
-}
-
+/// No crate's modules import each other in a circle, at any depth: not the top-level modules
+/// (issue 17: the simulator's error ↔ scenario ↔ planner ↔ world cycles), nor the children of any
+/// module (issue 33: `world::scenario::generator ↔ sections`). The graph is drawn from every
+/// path the sources name ([`modules`]: `use` trees, `crate::`/`super::` paths in code and macro
+/// calls, re-exports followed); a failure names the crate root and the cycle.
 #[test]
-fn the_cycle_finder_finds_a_cycle() {
-    let g = BTreeMap::from([
-        ("a".to_string(), ["b".to_string()].into()),
-        ("b".to_string(), ["a".to_string()].into()),
-        ("c".to_string(), Default::default()),
-    ]);
-    assert_eq!(
-        find_cycle(&g),
-        Some(vec!["a".into(), "b".into(), "a".into()])
-    );
-    let dag = BTreeMap::from([
-        ("a".to_string(), ["b".to_string()].into()),
-        ("b".to_string(), Default::default()),
-    ]);
-    assert_eq!(find_cycle(&dag), None);
-}
-
-/// No crate's top-level modules import each other in a circle (issue 17: the simulator's
-/// error ↔ scenario ↔ planner ↔ world cycles).
-#[test]
-fn no_module_cycles_inside_a_crate() {
-    let offenders: Vec<String> = members()
-        .iter()
-        .filter_map(|m| {
-            let src = m.dir.join("src");
-            find_cycle(&module_graph(&src)).map(|c| format!("{}: {}", m.name(), c.join(" -> ")))
-        })
-        .collect();
+fn no_module_cycles_at_any_depth() {
+    let root = workspace_root();
+    let mut offenders = Vec::new();
+    let mut crates = 0;
+    for m in members() {
+        for file in modules::crate_roots(&m.dir) {
+            crates += 1;
+            let krate = modules::Crate::parse(&file);
+            let at = file
+                .strip_prefix(&root)
+                .unwrap_or(&file)
+                .display()
+                .to_string();
+            for cycle in modules::module_cycles(&krate) {
+                offenders.push(format!("{} ({at}): {cycle}", m.name()));
+            }
+        }
+    }
+    assert!(crates > 20, "only {crates} crate roots found");
     assert!(
         offenders.is_empty(),
-        "module cycles:\n{}",
+        "module cycles (move the shared items to a module both may use):\n{}",
         offenders.join("\n")
     );
+}
+
+/// Prints the module graph under one module, with the reference behind each edge, to help
+/// break a cycle: `TIDY_GRAPH=crates/world/src/lib.rs:scenario cargo test -p trust-tests --test
+/// tidy -- --ignored print_module_graph --nocapture` (`crate` for the top level).
+#[test]
+#[ignore = "a tool: set TIDY_GRAPH=<crate root>:<module>"]
+fn print_module_graph() {
+    let spec =
+        std::env::var("TIDY_GRAPH").unwrap_or_else(|_| "crates/world/src/lib.rs:crate".into());
+    let (file, parent) = spec
+        .split_once(':')
+        .expect("TIDY_GRAPH=<crate root>:<module>");
+    let krate = modules::Crate::parse(&workspace_root().join(file));
+    let levels = krate.sibling_graphs();
+    let level = levels
+        .get(parent)
+        .unwrap_or_else(|| panic!("{parent}: not a module with children"));
+    for (from, tos) in &level.graph {
+        println!("{from}");
+        for to in tos {
+            println!("  -> {to}: {}", level.why[&(from.clone(), to.clone())]);
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -34,6 +34,7 @@ use trust_experiments::{e1, e2};
 
 mod fuzz;
 mod proptest;
+mod release;
 mod results;
 
 #[derive(Parser)]
@@ -300,14 +301,17 @@ fn experiment_e2(root: &Path, trials: usize, out: &Path) -> Result<()> {
     )
 }
 
-/// Runs `cargo run --release -p trust-sim -- ARGS` in the workspace root, passing the terminal
+/// Runs `trust-sim ARGS` in release ([`release`]) in the workspace root, passing the terminal
 /// through (progress bars, the report), with the source's git sha for the report.
 fn trust_sim(root: &Path, args: &[String]) -> Result<()> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let mut cmd = Command::new(cargo);
-    cmd.current_dir(root)
-        .args(["run", "--quiet", "--release", "-p", "trust-sim", "--"])
-        .args(args);
+    let mut cmd = release::command(
+        root,
+        release::Program::Bin {
+            package: "trust-sim",
+            name: "trust-sim",
+        },
+    )?;
+    cmd.args(args);
     if let Ok(out) = Command::new("git")
         .current_dir(root)
         .args(["rev-parse", "HEAD"])
@@ -331,30 +335,24 @@ fn write_outputs(out: &Path, json: &Value, md: &str) -> Result<()> {
     Ok(())
 }
 
-/// Runs `cargo run --release -p PACKAGE --example EXAMPLE -- ARGS` and returns its stdout.
+/// Runs the release example `EXAMPLE` of `PACKAGE` with `ARGS` ([`release`]) and returns its stdout.
 fn cargo_example_output(
     root: &Path,
     package: &str,
     example: &str,
     args: &[&str],
 ) -> Result<String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let output = Command::new(cargo)
-        .current_dir(root)
-        .args([
-            "run",
-            "--quiet",
-            "--release",
-            "-p",
+    let output = release::command(
+        root,
+        release::Program::Example {
             package,
-            "--example",
-            example,
-            "--",
-        ])
-        .args(args)
-        .stderr(std::process::Stdio::inherit())
-        .output()
-        .with_context(|| format!("failed to start cargo for example {example}"))?;
+            name: example,
+        },
+    )?
+    .args(args)
+    .stderr(std::process::Stdio::inherit())
+    .output()
+    .with_context(|| format!("failed to start cargo for example {example}"))?;
     if !output.status.success() {
         bail!("example {example} failed with {}", output.status);
     }

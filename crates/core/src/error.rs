@@ -99,7 +99,49 @@ pub enum PlanError {
     },
 }
 
+/// Which variant a [`PlanError`] is, without its fields: for code that decides by the kind of
+/// error (a report's events, [`PlanError::kind`]) and for logs (serialized as the variant's name
+/// in snake case, `"in_collision"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum PlanErrorKind {
+    /// [`PlanError::InvalidInput`].
+    InvalidInput,
+    /// [`PlanError::InCollision`].
+    InCollision,
+    /// [`PlanError::OutOfBounds`].
+    OutOfBounds,
+    /// [`PlanError::Unsupported`].
+    Unsupported,
+    /// [`PlanError::Geometry`].
+    Geometry,
+    /// [`PlanError::Predict`].
+    Predict,
+    /// [`PlanError::Scale`].
+    Scale,
+    /// [`PlanError::Count`].
+    Count,
+    /// [`PlanError::Component`].
+    Component,
+}
+
 impl PlanError {
+    /// Which variant this is.
+    pub fn kind(&self) -> PlanErrorKind {
+        match self {
+            PlanError::InvalidInput { .. } => PlanErrorKind::InvalidInput,
+            PlanError::InCollision { .. } => PlanErrorKind::InCollision,
+            PlanError::OutOfBounds { .. } => PlanErrorKind::OutOfBounds,
+            PlanError::Unsupported { .. } => PlanErrorKind::Unsupported,
+            PlanError::Geometry(_) => PlanErrorKind::Geometry,
+            PlanError::Predict(_) => PlanErrorKind::Predict,
+            PlanError::Scale(_) => PlanErrorKind::Scale,
+            PlanError::Count(_) => PlanErrorKind::Count,
+            PlanError::Component { .. } => PlanErrorKind::Component,
+        }
+    }
+
     /// Shorthand for [`PlanError::InvalidInput`].
     pub fn invalid(
         field: impl Into<String>,

@@ -67,8 +67,8 @@ mod verify;
 pub use bernstein::bernstein_points;
 pub use curve::Curve;
 pub use error::{
-    PlanError, check_finite, check_finite_vec, check_non_negative, check_positive, check_range,
-    check_scaled, check_scaled_vec,
+    PlanError, PlanErrorKind, check_finite, check_finite_vec, check_non_negative, check_positive,
+    check_range, check_scaled, check_scaled_vec,
 };
 pub use guidance::{guidance_radius, straight_end};
 pub use overrides::Overridable;

@@ -24,6 +24,8 @@ use trust_world::sensing::Sensing;
 use trust_world::traffic::Traffic;
 
 use crate::FlightError;
+use crate::map_sensing::MapSensing;
+use std::sync::Arc;
 
 /// When a cycle's plan takes effect and when the next cycle may start (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -174,6 +176,9 @@ pub struct FlightState {
     pub worker_since: Option<f64>,
     /// Since when the manager has held that the goal cannot be reached (s), and why.
     pub unreachable_since: Option<(f64, UnreachableCause)>,
+    /// The sensed static map, when the scenario's `[sensing.static]` is not `"known"`
+    /// ([`crate::map_sensing`]); `None`: the planner is given the map.
+    pub map_sensing: Option<MapSensing>,
 }
 
 /// What the vehicle touched; its `Display` is the run log's spelling (`static`,
@@ -256,6 +261,9 @@ pub struct CycleEvent<'a> {
     pub charged_s: f64,
     /// Replanning ticks skipped because the planner was still busy with this cycle.
     pub overrun_ticks: u64,
+    /// The online map's time since the previous cycle (ms; [`crate::map_sensing`]), `None`
+    /// with a known map.
+    pub map_ms: Option<f64>,
 }
 
 /// Hooks into the loop (`()` does nothing). Errors end the flight with that error.
@@ -325,6 +333,9 @@ pub fn step(
 ) -> Result<Option<Ending>, FlightError> {
     let dt = params.dt_s;
     let t = state.t;
+    if let Some(m) = state.map_sensing.as_mut() {
+        m.sense(t, dt, state.vehicle.state(), world)?;
+    }
     if state.step.is_multiple_of(params.replan_steps)
         && t + 0.5 * dt >= state.busy_until
         && let Some(ending) = plan(params, world, walls, state, observer)?
@@ -337,11 +348,12 @@ pub fn step(
         state.active = state.pending.take().map(|(_, p)| p);
     }
 
-    // Physics.
-    let hover = state.hover;
+    // Physics. With a sensed map the vehicle turns to look where it goes; else yaw 0.
+    let yaw = state.map_sensing.as_mut().map_or(0.0, |m| m.turn(dt));
+    let hover = Reference { yaw, ..state.hover };
     let active = &state.active;
     let reference = |tau: f64| match active {
-        Some(plan) => Reference::from_traj(plan, tau, 0.0),
+        Some(plan) => Reference::from_traj(plan, tau, yaw),
         None => hover,
     };
     state.vehicle.step(dt, &reference)?;
@@ -396,9 +408,30 @@ fn plan(
             None => f,
         })
         .collect();
-    let scene = Scene::new(world.planner_map(), &forecasts, t)?;
+    // A sensed map: the cycle plans in it, and commits only to what it observed free.
+    let sensed = match state.map_sensing.as_mut() {
+        Some(m) => {
+            let map = m.planner_map()?;
+            state.manager.share_map(Arc::clone(&map));
+            state.manager.set_commit_check(Some(m.commit_check()));
+            Some(map)
+        }
+        None => None,
+    };
+    let map = sensed.as_deref().unwrap_or(world.planner_map());
+    let scene = Scene::new(map, &forecasts, t)?;
     let measured = state.vehicle.state().kinematic();
-    let report = match state.manager.step(t, &measured, &params.goal, &scene) {
+    let stepped = state.manager.step(t, &measured, &params.goal, &scene);
+    let map_ms = match state.map_sensing.as_mut() {
+        Some(m) => {
+            state.manager.set_commit_check(None);
+            let p = state.vehicle.state().p;
+            m.aim(t, &p, &params.goal, &state.manager);
+            Some(m.take_map_ms())
+        }
+        None => None,
+    };
+    let report = match stepped {
         Ok(report) => report,
         Err(e) => {
             return Ok(Some(Ending::Invalid {
@@ -442,6 +475,7 @@ fn plan(
         effective_t,
         charged_s,
         overrun_ticks,
+        map_ms,
     })?;
     Ok(None)
 }

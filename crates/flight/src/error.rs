@@ -19,6 +19,9 @@ pub enum FlightError {
     /// Invalid input reported by a planning crate.
     #[error(transparent)]
     Plan(#[from] trust_core::PlanError),
+    /// Invalid input to the sensors or the online map (`[sensing.static]`).
+    #[error(transparent)]
+    Sensing(#[from] trust_sensing::SensingError),
     /// The run log could not be written.
     #[error(transparent)]
     Log(#[from] trust_runlog::LogError),

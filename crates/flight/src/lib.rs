@@ -62,6 +62,7 @@ use trust_world::traffic::{MovingShape, Traffic};
 
 pub mod closed_loop;
 mod error;
+pub mod map_sensing;
 pub mod scenario;
 pub use closed_loop::{
     Clearances, Clock, Contact, CycleEvent, Ending, FlightObserver, FlightState, LoopParams,
@@ -404,6 +405,7 @@ pub fn fly(
         busy_until: 0.0,
         worker_since: None,
         unreachable_since: None,
+        map_sensing: map_sensing::MapSensing::new(world)?,
     };
 
     let writer = match &options.log_path {
@@ -602,6 +604,9 @@ impl FlightObserver for Logger {
             cycle.effective_t,
             self.zero_timing,
         );
+        rec.map_ms = cycle
+            .map_ms
+            .map(|ms| if self.zero_timing { 0.0 } else { ms });
         if self.real_time {
             rec.charged_ms = Some(cycle.charged_s * 1e3);
             rec.overrun_ticks = (cycle.overrun_ticks > 0).then_some(cycle.overrun_ticks);
@@ -790,6 +795,7 @@ fn cycle_record(
         worker_ms: merged.then(|| time(report.timing.worker_ms)),
         waited_ms: (merged || route_away).then(|| time(report.timing.waited_ms)),
         route_worker_ms: route_away.then(|| time(report.timing.route_worker_ms)),
+        map_ms: None,
     }
 }
 

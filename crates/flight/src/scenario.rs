@@ -42,9 +42,21 @@ pub fn planner_context(world: &World) -> PlannerContext {
     PlannerContext {
         limits: world.limits(),
         vehicle_radius_m: world.vehicle_radius_m(),
-        static_map_error_m: world.static_map_error_m(),
+        static_map_error_m: world.static_map_error_m().max(sensed_map_error_m(world)),
         seed: world.seeds().planner,
     }
+}
+
+/// How much a sensed map (`[sensing.static]`) may overestimate the distance to a true static
+/// obstacle (m): half a voxel's diagonal, `√3/2` times the voxel edge (a surface anywhere in an
+/// occupied voxel, the field measured between voxel centres); 0 for a known map.
+pub fn sensed_map_error_m(world: &World) -> f64 {
+    world
+        .scenario()
+        .sensing
+        .static_map
+        .sensor()
+        .map_or(0.0, |(_, map)| 0.5 * 3f64.sqrt() * map.resolution_m)
 }
 
 /// The planner's problems of `s` that the file alone shows: the `[planner]` section's own

@@ -130,6 +130,7 @@ fn step_for(s: &Scenario, seconds: f64) -> (Counts, Option<Ending>) {
         busy_until: 0.0,
         worker_since: None,
         unreachable_since: None,
+        map_sensing: None,
     };
     let walls = trust_flight::obstacle_walls(&world);
     let mut counts = Counts::default();

@@ -53,6 +53,7 @@
 #![warn(missing_docs)]
 
 pub mod brake;
+mod commit;
 mod manager;
 mod params;
 pub mod progress;
@@ -63,17 +64,19 @@ pub mod safety;
 pub use brake::{
     brake_along, brake_straight, braking_tail, dash_maneuvers, escape_maneuvers, hermite_quintic,
 };
+pub use commit::{CommitCheck, committed_stretch};
 pub use manager::{Branch, HOLD_CLEARANCE_M, MainDecision, Manager, choose_main};
 pub use params::{
-    GROWTH_FRACTION, ManagerOverrides, ManagerParams, ReanchorOverrides, ReanchorParams,
-    SOLVE_DEADLINE_FRACTION, SafetyOverrides, SafetyParams,
+    GROWTH_FRACTION, ManagerOverrides, ManagerParams, ProgressOverrides, ProgressParams,
+    ReanchorOverrides, ReanchorParams, SOLVE_DEADLINE_FRACTION, SafetyOverrides, SafetyParams,
+    StallRule,
 };
-pub use progress::{ProgressMonitor, ProgressOverrides, ProgressParams, StallRule};
+pub use progress::ProgressMonitor;
 pub use report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackKind, FallbackReport, FrontendReport,
-    GoalUnreachable, LimitExcess, Origin, STUB_FRACTION, StepReport, SwitchReason,
+    GoalUnreachable, LimitExcess, Origin, RouteReason, STUB_FRACTION, StepReport, SwitchReason,
 };
-pub use routing::{RECHECK_S, ROUTE_WORK_PER_CYCLE, RouteReason, Router};
+pub use routing::{RECHECK_S, ROUTE_WORK_PER_CYCLE, Router};
 pub use safety::{Hit, SafetyVerdict, Violation, assess_trajectory, check_trajectory};
 /// Why a goal cannot be reached ([`Event::GoalUnreachable`], [`GoalUnreachable`]).
 pub use trust_route::UnreachableCause;

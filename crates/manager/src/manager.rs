@@ -24,7 +24,8 @@ use crate::safety::{
 };
 use trust_route::{GlobalRoute, RoutePoint, RouteProgress, UnreachableCause};
 
-use crate::routing::{RouteReason, Router, SearchSlot, TakenBack, rerouted, route_failed};
+use crate::report::RouteReason;
+use crate::routing::{Router, SearchSlot, TakenBack, rerouted};
 
 mod worker;
 use worker::{Job, JobInput, JobOutput};
@@ -241,6 +242,9 @@ pub struct Manager<F, B, H> {
     job: Option<Job>,
     /// The time of the last cycle (s): the next cycle is predicted one period later.
     last_now: Option<f64>,
+    /// What the committed part of a plan must pass beyond the safety check
+    /// ([`Manager::set_commit_check`]).
+    commit_check: Option<Arc<dyn crate::CommitCheck>>,
 }
 
 impl<F, B, H> std::fmt::Debug for Manager<F, B, H> {
@@ -293,6 +297,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             shared_map: None,
             job: None,
             last_now: None,
+            commit_check: None,
         })
     }
 
@@ -301,6 +306,13 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     /// A cycle whose scene is built on another map solves everything itself.
     pub fn share_map(&mut self, map: Arc<StaticMap>) {
         self.shared_map = Some(map);
+    }
+
+    /// Sets (or with `None` clears) the check the committed part of every plan must pass beyond
+    /// the safety check (FASTER's rule for a sensed map: what the vehicle commits to fly lies in
+    /// observed free space, [`crate::CommitCheck`]). Without one, every cycle is as before.
+    pub fn set_commit_check(&mut self, check: Option<Arc<dyn crate::CommitCheck>>) {
+        self.commit_check = check;
     }
 
     /// The parameters.
@@ -502,7 +514,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         };
         self.deferred_guides = std::mem::take(&mut explored.deferred);
         if let Some(error) = explored.frontend_error {
-            cycle.events.push(Event::FrontendFailed { error });
+            cycle.events.push(Event::frontend_failed(&error));
         }
 
         // The safety pass over the re-solved branches, then one branch per homotopy class.
@@ -716,7 +728,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                 }
                 Err(e) => {
                     self.route_search = None;
-                    cycle.events.push(route_failed(reason, &e));
+                    cycle.events.push(Event::route_failed(reason, &e));
                     return;
                 }
             }
@@ -813,7 +825,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                 verdict.nearest
             }
             RouteProgress::Failed(e) => {
-                cycle.events.push(route_failed(reason, &e));
+                cycle.events.push(Event::route_failed(reason, &e));
                 None
             }
             // A future kind of answer: keep the previous route.
@@ -1211,10 +1223,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         }
         match cand.result {
             Err(e) => {
-                cycle.events.push(Event::SolveFailed {
-                    id,
-                    error: e.to_string(),
-                });
+                cycle.events.push(Event::solve_failed(id, &e));
                 None
             }
             Ok((solution, _)) if self.is_stub(&solution.traj, &cycle.goal) => {
@@ -1321,9 +1330,16 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         spans: &mut Spans,
     ) -> Option<FallbackReport> {
         if let Some(main) = main.and_then(|id| kept.iter().find(|b| b.id == id)) {
-            self.committed = Some(main.solution.traj.clone());
-            self.main = Some(main.id);
-            return None;
+            match self.outside_known_free(&main.solution.traj, cycle) {
+                None => {
+                    self.committed = Some(main.solution.traj.clone());
+                    self.main = Some(main.id);
+                    return None;
+                }
+                Some(t) => cycle
+                    .events
+                    .push(Event::NotKnownFree { branch: main.id, t }),
+            }
         }
         let (start, reanchored) = (cycle.start, cycle.reanchored);
         let report = spans.time(Span::Checks, || {
@@ -1337,6 +1353,26 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         });
         self.main = None;
         report
+    }
+
+    /// With a commit check ([`Manager::set_commit_check`]), the first instant of `traj`'s
+    /// committed stretch ([`crate::committed_stretch`]) outside the space it accepts; `None` if
+    /// it passes or without a check. The committed part lasts until the next plan takes effect
+    /// (the last cycle period, or twice the cycle budget before a second cycle, plus the
+    /// latency).
+    fn outside_known_free(&self, traj: &PolyTraj, cycle: &Cycle) -> Option<f64> {
+        let check = self.commit_check.as_ref()?;
+        let period = self
+            .last_now
+            .map(|last| cycle.start.t - self.params.latency() - last)
+            .filter(|p| p.is_finite() && *p > 0.0)
+            .unwrap_or(2.0 * self.params.cycle_budget_ms * 1e-3);
+        let until = cycle.start.t + period + self.params.latency();
+        let points = crate::committed_stretch(traj, cycle.start.t, until, self.limits.a_max);
+        points
+            .windows(2)
+            .find(|w| !check.segment_free(&w[0].1, &w[1].1))
+            .map(|w| w[0].0)
     }
 
     /// The state the new plan starts from, and whether it was re-anchored on the measurement.
@@ -1424,9 +1460,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                         continue 'branches;
                     }
                     Ok(false) => {}
-                    Err(e) => events.push(Event::CheckerFailed {
-                        error: e.to_string(),
-                    }),
+                    Err(e) => events.push(Event::checker_failed(&e)),
                 }
             }
             out.push(b);
@@ -1458,9 +1492,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                     worse_equivalent.get_or_insert(i);
                 }
                 Ok(false) => {}
-                Err(e) => events.push(Event::CheckerFailed {
-                    error: e.to_string(),
-                }),
+                Err(e) => events.push(Event::checker_failed(&e)),
             }
         }
         match worse_equivalent {
@@ -1912,7 +1944,7 @@ struct Explored {
     /// The frontend's report (`None` if it failed or did not run).
     frontend: Option<FrontendReport>,
     /// The frontend's error, if it failed.
-    frontend_error: Option<String>,
+    frontend_error: Option<PlanError>,
     /// Whether the straight guide was explored ([`ManagerParams::straight_guide_when_empty`]).
     straight_guide: bool,
     /// Guide paths left for the following cycles ([`ManagerParams::cold_solves_per_cycle`]).
@@ -1945,7 +1977,7 @@ fn fwd_explore<F: PathFrontend, B: TrajectoryBackend>(
             result.paths
         }
         Err(e) => {
-            explored.frontend_error = Some(e.to_string());
+            explored.frontend_error = Some(e);
             Vec::new()
         }
     };

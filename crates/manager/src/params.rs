@@ -1,6 +1,5 @@
 //! Parameters of the [`crate::Manager`] and of its safety check.
 
-use crate::ProgressParams;
 use serde::{Deserialize, Serialize};
 use trust_core::{
     Limits, Overridable, PlanError, RankingWeights, check_non_negative, check_positive,
@@ -477,6 +476,67 @@ impl SafetyParams {
 /// 5 ms over it; at 0.8, 6 of 284 cycles of a computer three times slower (`--real-time 3`)
 /// were 1–16 % over it.
 pub const SOLVE_DEADLINE_FRACTION: f64 = 0.7;
+
+/// The thresholds of the progress monitor ([`crate::progress`]), relative to the vehicle and the
+/// horizon.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Overridable)]
+#[serde(deny_unknown_fields, default)]
+pub struct ProgressParams {
+    /// The window as a fraction of the planning horizon `T_h`. Default 0.5 (beyond the paper):
+    /// long enough that braking and turning (each well under `T_h/2` at the limits) are not
+    /// stalls, short enough to react within one horizon.
+    pub window_horizon_fraction: f64,
+    /// The least progress rate, as a fraction of `v_max`, that is not a stall. Default 0.05
+    /// (beyond the paper): the E4 stall of seed 7301 progressed 0 m/s; a flight that weaves
+    /// among obstacles keeps well above 5 % of its top speed.
+    pub stall_speed_fraction: f64,
+}
+
+impl Default for ProgressParams {
+    fn default() -> Self {
+        Self {
+            window_horizon_fraction: 0.5,
+            stall_speed_fraction: 0.05,
+        }
+    }
+}
+
+impl ProgressParams {
+    /// Checks every field; errors name `manager.progress.{field}`.
+    pub fn validate(&self) -> Result<(), PlanError> {
+        check_positive(
+            "manager.progress.window_horizon_fraction",
+            self.window_horizon_fraction,
+        )?;
+        check_positive(
+            "manager.progress.stall_speed_fraction",
+            self.stall_speed_fraction,
+        )
+    }
+
+    /// The rule for a vehicle with `limits` and horizon `horizon_s` (s).
+    pub fn rule(&self, limits: &Limits, horizon_s: f64) -> StallRule {
+        let window_s = self.window_horizon_fraction * horizon_s;
+        let min_rate_mps = self.stall_speed_fraction * limits.v_max;
+        StallRule {
+            window_s,
+            min_rate_mps,
+            min_progress_m: min_rate_mps * window_s,
+        }
+    }
+}
+
+/// The stall rule in absolute units ([`ProgressParams::rule`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StallRule {
+    /// The window (s).
+    pub window_s: f64,
+    /// The least progress rate (m/s) that is not a stall.
+    pub min_rate_mps: f64,
+    /// `min_rate_mps · window_s` (m): the progress that ends a stall, and the distance to the goal
+    /// within which there is no stall.
+    pub min_progress_m: f64,
+}
 
 #[cfg(test)]
 mod tests {

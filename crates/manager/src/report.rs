@@ -1,7 +1,8 @@
 //! What one cycle of the manager did ([`StepReport`]), for logs, tests and studies.
 
 use serde::{Deserialize, Serialize};
-use trust_core::{CostBreakdown, SearchStats, SolveStatus, State};
+use trust_core::{CostBreakdown, PlanError, PlanErrorKind, SearchStats, SolveStatus, State};
+use trust_route::{RouteError, RouteErrorKind};
 
 use crate::safety::Violation;
 
@@ -138,18 +139,24 @@ pub enum Event {
     SolveFailed {
         /// The branch, or `None` for a candidate.
         id: Option<BranchId>,
-        /// The error message.
+        /// The error message (the error's `Display`).
         error: String,
+        /// Which error it was ([`PlanError::kind`]), to decide on.
+        cause: PlanErrorKind,
     },
     /// The frontend returned an error; the cycle went on with the kept branches.
     FrontendFailed {
-        /// The error message.
+        /// The error message (the error's `Display`).
         error: String,
+        /// Which error it was ([`PlanError::kind`]), to decide on.
+        cause: PlanErrorKind,
     },
     /// A homotopy check returned an error; the pair was treated as distinct.
     CheckerFailed {
-        /// The error message.
+        /// The error message (the error's `Display`).
         error: String,
+        /// Which error it was ([`PlanError::kind`]), to decide on.
+        cause: PlanErrorKind,
     },
     /// The main branch changed.
     SwitchedMain {
@@ -174,7 +181,7 @@ pub enum Event {
     /// route yet toward this goal) or `"stalled"` (after [`Event::Stalled`]).
     Rerouted {
         /// Why the route was planned.
-        reason: crate::RouteReason,
+        reason: RouteReason,
         /// Its length (m).
         length_m: f64,
         /// Its vertices, start and goal included.
@@ -184,13 +191,25 @@ pub enum Event {
     /// or aims at the final goal without one.
     RouteFailed {
         /// Why the route was planned.
-        reason: crate::RouteReason,
-        /// The route planner's error message.
+        reason: RouteReason,
+        /// The route planner's error message (the error's `Display`).
         error: String,
+        /// Which error it was ([`RouteError::kind`]: a cap, no free cell, ...), to decide on.
+        cause: RouteErrorKind,
     },
     /// The vehicle is at rest and its first route toward the goal is still being searched: it
     /// holds its place meanwhile ([`crate::routing`]).
     AwaitingRoute,
+    /// The main branch was safe on the planner's map but its committed part or braking tail
+    /// leaves the space the sensors observed free ([`crate::CommitCheck`]): it was not
+    /// committed, the fallback was.
+    NotKnownFree {
+        /// The branch that was not committed.
+        branch: BranchId,
+        /// The first instant (s) of the checked stretch outside known free space (the braking
+        /// tail's time when it is there).
+        t: f64,
+    },
     /// The route planner proved the goal cannot be reached ([`GoalUnreachable`]); the manager
     /// holds a stop at the reachable point nearest the goal and re-checks.
     GoalUnreachable {
@@ -296,6 +315,29 @@ impl std::fmt::Display for SwitchReason {
     }
 }
 
+/// Why the manager planned a route ([`Event::Rerouted`], [`Event::RouteFailed`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RouteReason {
+    /// No route yet toward this goal.
+    First,
+    /// The progress monitor declared a stall.
+    Stalled,
+    /// The goal is held unreachable: the verdict is checked again.
+    Recheck,
+}
+
+impl RouteReason {
+    /// The log's word for it (`"first"`, `"stalled"`, `"recheck"`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            RouteReason::First => "first",
+            RouteReason::Stalled => "stalled",
+            RouteReason::Recheck => "recheck",
+        }
+    }
+}
+
 /// A trajectory shorter than this fraction of the planning horizon that does not reach the goal
 /// is a stub ([`Event::DroppedStub`]): 0.2 s at the default 4 s.
 pub const STUB_FRACTION: f64 = 0.05;
@@ -325,6 +367,43 @@ impl Event {
             Event::RouteFailed { .. } => "route_failed",
             Event::GoalUnreachable { .. } => "goal_unreachable",
             Event::AwaitingRoute => "awaiting_route",
+            Event::NotKnownFree { .. } => "not_known_free",
+        }
+    }
+}
+
+impl Event {
+    /// [`Event::SolveFailed`] for `error`.
+    pub fn solve_failed(id: Option<BranchId>, error: &PlanError) -> Self {
+        Event::SolveFailed {
+            id,
+            error: error.to_string(),
+            cause: error.kind(),
+        }
+    }
+
+    /// [`Event::FrontendFailed`] for `error`.
+    pub fn frontend_failed(error: &PlanError) -> Self {
+        Event::FrontendFailed {
+            error: error.to_string(),
+            cause: error.kind(),
+        }
+    }
+
+    /// [`Event::CheckerFailed`] for `error`.
+    pub fn checker_failed(error: &PlanError) -> Self {
+        Event::CheckerFailed {
+            error: error.to_string(),
+            cause: error.kind(),
+        }
+    }
+
+    /// [`Event::RouteFailed`] for `error`, a search started for `reason`.
+    pub fn route_failed(reason: RouteReason, error: &RouteError) -> Self {
+        Event::RouteFailed {
+            reason,
+            error: error.to_string(),
+            cause: error.kind(),
         }
     }
 }
@@ -502,5 +581,54 @@ impl StepReport {
         self.events
             .iter()
             .any(|e| matches!(e, Event::SwitchedMain { .. }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failure_events_keep_the_message_and_name_the_cause() {
+        let e = PlanError::invalid("start.v", f64::NAN, "a finite vector");
+        let event = Event::solve_failed(Some(3), &e);
+        assert!(matches!(
+            event,
+            Event::SolveFailed {
+                cause: PlanErrorKind::InvalidInput,
+                ..
+            }
+        ));
+        // The message is the error's text, as before; the cause is added beside it.
+        let json = serde_json::to_string(&event).unwrap();
+        let message = serde_json::to_string(&e.to_string()).unwrap();
+        assert_eq!(
+            json,
+            format!(
+                r#"{{"event":"solve_failed","id":3,"error":{message},"cause":"invalid_input"}}"#
+            )
+        );
+        assert_eq!(serde_json::from_str::<Event>(&json).unwrap(), event);
+
+        let r = RouteError::ExpansionCap { cap: 50 };
+        let event = Event::route_failed(RouteReason::Stalled, &r);
+        let json = serde_json::to_string(&event).unwrap();
+        assert!(
+            json.starts_with(&format!(
+                r#"{{"event":"route_failed","reason":"stalled","error":{}"#,
+                serde_json::to_string(&r.to_string()).unwrap()
+            )),
+            "{json}"
+        );
+        assert!(json.ends_with(r#","cause":"expansion_cap"}"#), "{json}");
+        assert_eq!(serde_json::from_str::<Event>(&json).unwrap(), event);
+        assert_eq!(
+            Event::checker_failed(&e),
+            Event::CheckerFailed {
+                error: e.to_string(),
+                cause: PlanErrorKind::InvalidInput
+            }
+        );
+        assert_eq!(Event::frontend_failed(&e).tag(), "frontend_failed");
     }
 }

@@ -35,6 +35,8 @@ use trust_core::{PlanError, Vec3};
 use trust_geometry::StaticMap;
 use trust_route::{GlobalRoute, RouteError, RouteParams, RoutePlanner, RouteProgress, RouteSearch};
 
+use crate::report::{Event, RouteReason};
+
 /// A route planner and the vehicle radius it plans for ([`crate::Manager::set_router`]).
 #[derive(Debug, Clone)]
 pub struct Router {
@@ -155,29 +157,6 @@ pub const ROUTE_WORK_OFF_CYCLE: usize = 24_000;
 /// from the vehicle's position, in case the map or the obstacles changed.
 pub const RECHECK_S: f64 = 2.0;
 
-/// Why the manager planned a route ([`crate::Event::Rerouted`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RouteReason {
-    /// No route yet toward this goal.
-    First,
-    /// The progress monitor declared a stall.
-    Stalled,
-    /// The goal is held unreachable: the verdict is checked again.
-    Recheck,
-}
-
-impl RouteReason {
-    /// The log's word for it (`"first"`, `"stalled"`, `"recheck"`).
-    pub fn as_str(self) -> &'static str {
-        match self {
-            RouteReason::First => "first",
-            RouteReason::Stalled => "stalled",
-            RouteReason::Recheck => "recheck",
-        }
-    }
-}
-
 /// Where a search under way is: with the manager, on a thread doing a slice of it between two
 /// cycles, or back from a slice whose answer is not due yet
 /// ([`crate::ManagerParams::real_time_scale`]).
@@ -266,18 +245,10 @@ impl SearchSlot {
 }
 
 /// The event for a new route.
-pub(crate) fn rerouted(reason: RouteReason, route: &GlobalRoute) -> crate::Event {
-    crate::Event::Rerouted {
+pub(crate) fn rerouted(reason: RouteReason, route: &GlobalRoute) -> Event {
+    Event::Rerouted {
         reason,
         length_m: route.length(),
         vertex_count: route.points().len(),
-    }
-}
-
-/// The event for a search that stopped without an answer.
-pub(crate) fn route_failed(reason: RouteReason, error: &RouteError) -> crate::Event {
-    crate::Event::RouteFailed {
-        reason,
-        error: error.to_string(),
     }
 }

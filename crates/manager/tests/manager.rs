@@ -1740,3 +1740,46 @@ fn without_a_shared_map_or_history_there_is_no_worker() {
     );
     assert!(reports.iter().all(|r| !r.worker_started));
 }
+
+/// Known free space for the commit check: the half-space `x <= max_x` (the rest unobserved).
+struct KnownUpTo {
+    max_x: f64,
+}
+
+impl trust_manager::CommitCheck for KnownUpTo {
+    fn name(&self) -> &str {
+        "known up to x"
+    }
+
+    fn segment_free(&self, a: &Vec3, b: &Vec3) -> bool {
+        a.x <= self.max_x && b.x <= self.max_x
+    }
+}
+
+#[test]
+fn a_plan_whose_committed_part_enters_unknown_space_is_not_committed() {
+    let map = two_gap_corridor();
+    let state = State::at_rest(0.0, START);
+    let scene = Scene::new(&map, &[], 0.0).unwrap();
+    // Everything ahead of the start's plane unobserved: the plan toward the goal (+x) leaves
+    // known free space at once (from rest it moves only millimetres in its committed stretch,
+    // so a margin ahead of the start would let it pass).
+    let mut m = planner(ManagerParams::trust());
+    m.set_commit_check(Some(std::sync::Arc::new(KnownUpTo { max_x: START.x })));
+    let report = m.step(0.0, &state, &GOAL, &scene).unwrap();
+    assert!(
+        report
+            .events
+            .iter()
+            .any(|e| matches!(e, Event::NotKnownFree { .. })),
+        "{:?}",
+        report.event_tags()
+    );
+    assert_eq!(m.main(), None, "a braking fallback is committed instead");
+    assert!(!m.branches().is_empty(), "the branch itself is kept");
+    // Observed free far enough: the same plan is committed.
+    let mut m = planner(ManagerParams::trust());
+    m.set_commit_check(Some(std::sync::Arc::new(KnownUpTo { max_x: 100.0 })));
+    let report = m.step(0.0, &state, &GOAL, &scene).unwrap();
+    assert!(m.main().is_some(), "{:?}", report.event_tags());
+}

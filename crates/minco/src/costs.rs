@@ -23,6 +23,7 @@
 
 mod dynamic;
 mod feasibility;
+mod integrand;
 mod integrate;
 mod params;
 mod penalties;
@@ -32,7 +33,8 @@ mod terminal;
 
 pub use dynamic::{DynamicObstacleTerm, ddf_violation, swept_box};
 pub use feasibility::{FeasibilityTerm, norm_violation};
-pub use integrate::{Integrand, PiecewiseView, SampleGrad, SampleState, TrapezoidIntegrator};
+pub use integrand::{Integrand, SampleGrad, SampleState};
+pub use integrate::{PiecewiseView, TrapezoidIntegrator};
 pub use params::{
     CostWeights, MAX_SAMPLES_PER_PIECE, MAX_SMOOTHING, MAX_WEIGHT, MIN_TIME_WEIGHT, PenaltyParams,
     TERMINAL_NORM_EPSILON_RANGE,

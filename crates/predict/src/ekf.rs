@@ -27,7 +27,8 @@ use serde::{Deserialize, Serialize};
 use trust_geometry::Vec3;
 
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec};
-use crate::{Forecast, ObstacleShape, PredictError};
+use crate::walls::half_extents;
+use crate::{Aabb, Forecast, MAX_REFLECTIONS_PER_AXIS, ObstacleShape, PredictError};
 use trust_geometry::scale::{self, Quantity};
 
 /// Largest accepted [`EkfParams::accel_psd`] (m²/s³).
@@ -235,6 +236,8 @@ pub struct CvEkf {
     over_gate: u32,
     /// Lag compensation ([`EkfParams::accel_smoothing_s`]).
     lag: LagCompensation,
+    /// The box the estimated centre is folded into, `(lo, hi)` ([`CvEkf::with_walls`]).
+    walls: Option<(Vec3, Vec3)>,
 }
 
 /// The state of the lag compensation ([`EkfParams::accel_smoothing_s`]).
@@ -342,7 +345,74 @@ impl CvEkf {
             cov,
             over_gate: 0,
             lag: LagCompensation::new(t),
+            walls: None,
         })
+    }
+
+    /// This filter with the box its obstacle stays inside, turning at the walls (beyond the
+    /// paper; the prior the forecasts' [`crate::wall_images`] take, used here by the tracker too).
+    /// When a prediction carries the estimated centre past a wall's plane while it moves outward
+    /// (the planes of [`crate::wall_images`]: `walls` shrunk by the shape's half extents), the
+    /// estimate is mirrored back: the position reflected at the plane, that axis's velocity and
+    /// acceleration estimate negated, the covariance transformed alike (the fold is a linear map
+    /// per axis, `(p, v) → (2·plane − p, −v)`). Without it a constant-velocity filter keeps
+    /// walking an obstacle that bounced off a wall into the wall while its velocity turns (about
+    /// 0.5 s with the defaults at 20 Hz, and 1 s to settle), and the forecast puts the obstacle
+    /// on the far side of the gap it is coming back into. An obstacle that stops at a wall
+    /// instead is forecast coming back until the measurements say otherwise, as its wall images
+    /// are. An axis on which the shape does not fit inside the box is not folded.
+    ///
+    /// # Errors
+    /// [`PredictError`] naming the field for a non-finite wall, `r_o ≤ 0` or a cylinder's
+    /// `half_height ≤ 0`.
+    pub fn with_walls(
+        mut self,
+        walls: &Aabb,
+        shape: ObstacleShape,
+        r_o: f64,
+    ) -> Result<Self, PredictError> {
+        check_vec("walls.min", &walls.min, Quantity::Position)?;
+        check_vec("walls.max", &walls.max, Quantity::Position)?;
+        check_positive("r_o", r_o, Quantity::Length)?;
+        if let ObstacleShape::Cylinder { half_height } = shape {
+            check_positive("shape.half_height", half_height, Quantity::Length)?;
+        }
+        let e = Vec3::from(half_extents(shape, r_o));
+        self.walls = Some((walls.min + e, walls.max - e));
+        self.fold_at_walls();
+        Ok(self)
+    }
+
+    /// Mirrors the estimate back inside the box of [`CvEkf::with_walls`] (at most
+    /// [`MAX_REFLECTIONS_PER_AXIS`] reflections per axis and call).
+    fn fold_at_walls(&mut self) {
+        let Some((lo, hi)) = self.walls else { return };
+        for a in 0..3 {
+            if lo[a] >= hi[a] {
+                continue;
+            }
+            for _ in 0..MAX_REFLECTIONS_PER_AXIS {
+                let (p, v) = (self.x[a], self.x[3 + a]);
+                let plane = if p < lo[a] && v < 0.0 {
+                    lo[a]
+                } else if p > hi[a] && v > 0.0 {
+                    hi[a]
+                } else {
+                    break;
+                };
+                self.x[a] = 2.0 * plane - p;
+                self.x[3 + a] = -v;
+                // P ← J P J with J = diag(±1), −1 on this axis's position and velocity: the
+                // entries coupling them to the other axes change sign.
+                for i in [a, 3 + a] {
+                    for j in (0..6).filter(|&j| j != a && j != 3 + a) {
+                        self.cov[(i, j)] = -self.cov[(i, j)];
+                        self.cov[(j, i)] = -self.cov[(j, i)];
+                    }
+                }
+                self.lag.accel[a] = -self.lag.accel[a];
+            }
+        }
     }
 
     /// The filter's parameters.
@@ -456,6 +526,7 @@ impl CvEkf {
         self.x = x;
         self.cov = cov;
         self.t += dt;
+        self.fold_at_walls();
         Ok(())
     }
 
@@ -922,6 +993,116 @@ mod tests {
         );
         assert!(missed_on < 0.5 * missed_off, "{missed_on} vs {missed_off}");
         assert!(mu_on < 1.1 * mu_off, "{mu_on} vs {mu_off}");
+    }
+
+    /// A 0.5 m cylinder crossing a corridor at 1.9 m/s toward the wall y = 0, bouncing off it
+    /// (centre plane y = 0.5) at t = 0.5 s, tracked at 20 Hz with σ = 0.1 m, with the walls or
+    /// without (100 seeds). Returns the mean velocity error over the second after the bounce and
+    /// the share of forecasts issued then whose cone misses the true centre 0.25 / 0.5 s later.
+    fn bounce_statistics(walls: bool) -> (f64, f64) {
+        let corridor = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::new(100.0, 20.0, 8.0),
+        };
+        let shape = ObstacleShape::Cylinder { half_height: 4.0 };
+        let (speed, t_bounce) = (1.9, 0.5);
+        let y = |t: f64| 0.5 + speed * (t - t_bounce).abs();
+        let truth = |t: f64| Vec3::new(50.0 - 0.6 * t, y(t), 4.0);
+        let velocity = |t: f64| Vec3::new(-0.6, speed * (t - t_bounce).signum(), 0.0);
+        let params = EkfParams::default();
+        let (mut v_err, mut v_count, mut missed, mut issued) = (0.0, 0, 0, 0);
+        for seed in 0..100 {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let noise = Normal::new(0.0, 0.1).unwrap();
+            let mut z = |t: f64| {
+                let n = Vec3::from_fn(|_, _| noise.sample(&mut rng));
+                truth(t) + n
+            };
+            let mut ekf = CvEkf::new(-2.0, z(-2.0), params.clone()).unwrap();
+            if walls {
+                ekf = ekf.with_walls(&corridor, shape, 0.5).unwrap();
+            }
+            for k in 1..=50 + (t_bounce + 1.0) as usize * 20 {
+                let t = -2.0 + k as f64 / 20.0;
+                ekf.step(t, Some(z(t))).unwrap();
+                assert_spd(ekf.covariance());
+                if t > t_bounce && t <= t_bounce + 1.0 {
+                    v_err += (ekf.velocity() - velocity(t)).norm();
+                    v_count += 1;
+                    let f = ekf.forecast(shape, 0.5, 0.0).unwrap();
+                    for tau in [0.25, 0.5] {
+                        let reach = f.r_safe + f.mu * tau;
+                        issued += 1;
+                        if (truth(t + tau) - f.center(t + tau)).norm() > reach {
+                            missed += 1;
+                        }
+                    }
+                }
+            }
+        }
+        (v_err / v_count as f64, missed as f64 / issued as f64)
+    }
+
+    /// A filter that knows the walls follows an obstacle that bounces off one at once: its
+    /// velocity turns with the obstacle's instead of half a second later, and its forecasts
+    /// contain the obstacle far more often in the second after the bounce.
+    #[test]
+    fn a_bounce_off_a_known_wall_is_followed_at_once() {
+        let (v_without, missed_without) = bounce_statistics(false);
+        let (v_with, missed_with) = bounce_statistics(true);
+        println!(
+            "after the bounce: velocity error {v_without:.3} → {v_with:.3} m/s, forecasts \
+             missing the obstacle {missed_without:.3} → {missed_with:.3}"
+        );
+        assert!(v_with < 0.3 * v_without, "{v_with} vs {v_without}");
+        assert!(
+            missed_with < 0.3 * missed_without,
+            "{missed_with} vs {missed_without}"
+        );
+    }
+
+    /// Folding is exact on a noiseless estimate: the state crosses the plane, comes back
+    /// mirrored, and a filter already inside the box is left alone.
+    #[test]
+    fn the_fold_mirrors_position_velocity_and_covariance_couplings() {
+        let room = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::new(4.0, 4.0, 3.0),
+        };
+        let mut ekf = CvEkf::new(0.0, Vec3::new(3.5, 2.0, 1.0), EkfParams::default()).unwrap();
+        ekf.x[3] = 1.0;
+        ekf.cov[(0, 1)] = 0.001;
+        ekf.cov[(1, 0)] = 0.001;
+        let inside = ekf
+            .clone()
+            .with_walls(&room, ObstacleShape::Sphere, 0.25)
+            .unwrap();
+        assert_eq!(inside.state(), ekf.state());
+        let mut folded = inside.clone();
+        folded.predict(0.5).unwrap();
+        let mut free = ekf.clone();
+        free.predict(0.5).unwrap();
+        // Unfolded: x = 4.0, past the plane 3.75; folded: 3.5 walking back.
+        assert_relative_eq!(free.position().x, 4.0, epsilon = 1e-12);
+        assert_relative_eq!(folded.position().x, 3.5, epsilon = 1e-12);
+        assert_relative_eq!(folded.velocity().x, -1.0, epsilon = 1e-12);
+        assert_relative_eq!(folded.covariance()[(0, 1)], -free.covariance()[(0, 1)]);
+        assert_relative_eq!(folded.covariance()[(0, 3)], free.covariance()[(0, 3)]);
+        assert_spd(folded.covariance());
+        // Bad walls are named.
+        let bad = Aabb {
+            min: Vec3::new(f64::NAN, 0.0, 0.0),
+            max: Vec3::repeat(1.0),
+        };
+        let e = ekf
+            .clone()
+            .with_walls(&bad, ObstacleShape::Sphere, 0.25)
+            .unwrap_err();
+        assert!(e.to_string().contains("walls.min"), "{e}");
+        let e = ekf
+            .with_walls(&room, ObstacleShape::Sphere, 0.0)
+            .unwrap_err();
+        assert!(e.to_string().contains("r_o"), "{e}");
     }
 
     /// Tracks `truth` from `t = -2` s to `until` with 0.1 m of noise at `rate` Hz (stream

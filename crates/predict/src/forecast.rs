@@ -4,8 +4,8 @@
 use serde::{Deserialize, Serialize};
 use trust_geometry::{Aabb, Vec3, cylinder_sdf_with_size_gradient, sphere_sdf};
 
+use crate::PredictError;
 use crate::error::{check_finite, check_non_negative, check_positive, check_vec};
-use crate::{Pdc, PredictError};
 use trust_geometry::scale::Quantity;
 
 /// Base shape of a moving obstacle.
@@ -316,24 +316,6 @@ impl Forecast {
             max: ca.sup(&cb) + half,
         })
     }
-
-    /// The predictive directional cone of this forecast over `[t0, t0 + horizon]` (paper eq. PDC).
-    ///
-    /// # Errors
-    /// As [`Pdc::new`].
-    pub fn pdc(&self, horizon: f64) -> Result<Pdc, PredictError> {
-        Pdc::new(self, horizon)
-    }
-
-    /// Whether the segment `a → b` keeps more than `clearance` (m) from the obstacle as forecast at
-    /// time `t`: [`Pdc::segment_clear`] of [`Pdc::at_time`], without validating the forecast again
-    /// — for temporal checks that test many instants (the chords of temporal visibility
-    /// deformation, dense safety checks of a trajectory). Assumes a valid forecast, like the other
-    /// query methods; a non-finite `t`, end point or clearance counts as not clear.
-    #[inline]
-    pub fn segment_clear(&self, a: &Vec3, b: &Vec3, t: f64, clearance: f64) -> bool {
-        t.is_finite() && Pdc::between(self, t, t).segment_clear(a, b, clearance)
-    }
 }
 
 #[cfg(test)]
@@ -373,23 +355,6 @@ mod tests {
         assert_eq!(serde_json::from_str::<Forecast>(&json).unwrap(), g);
         let json = serde_json::to_string(&f).unwrap();
         assert_eq!(serde_json::from_str::<Forecast>(&json).unwrap(), f);
-    }
-
-    #[test]
-    fn the_walls_an_obstacle_stays_inside_are_optional_and_round_trip() {
-        let f = Forecast::sphere(Vec3::zeros(), Vec3::x(), 1.0, 0.5, 0.2, 0.4).unwrap();
-        assert_eq!(f.walls, None);
-        let json = serde_json::to_string(&f).unwrap();
-        assert!(!json.contains("walls"), "{json}");
-        let region = Aabb::new(Vec3::new(-5.0, -5.0, 0.0), Vec3::new(5.0, 5.0, 3.0)).unwrap();
-        let w = f.with_walls(region);
-        assert_eq!(w.walls, Some(region));
-        assert_eq!(w.radius(3.0), f.radius(3.0));
-        let json = serde_json::to_string(&w).unwrap();
-        assert_eq!(serde_json::from_str::<Forecast>(&json).unwrap(), w);
-        // The images at the walls keep them.
-        let images = crate::wall_images(&w, &region, 1.0, 10.0);
-        assert!(!images.is_empty() && images.iter().all(|i| i.walls == Some(region)));
     }
 
     use super::*;

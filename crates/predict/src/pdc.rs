@@ -600,5 +600,27 @@ pub fn frame_along(axis: &Vec3) -> [Vec3; 3] {
     [x, y, z]
 }
 
+// Here, not in `forecast`: the cone is made from a forecast, and `forecast` knows nothing of it
+// (no module cycle, tests/tests/tidy.rs).
+impl Forecast {
+    /// The predictive directional cone of this forecast over `[t0, t0 + horizon]` (paper eq. PDC).
+    ///
+    /// # Errors
+    /// As [`Pdc::new`].
+    pub fn pdc(&self, horizon: f64) -> Result<Pdc, PredictError> {
+        Pdc::new(self, horizon)
+    }
+
+    /// Whether the segment `a → b` keeps more than `clearance` (m) from the obstacle as forecast at
+    /// time `t`: [`Pdc::segment_clear`] of [`Pdc::at_time`], without validating the forecast again
+    /// — for temporal checks that test many instants (the chords of temporal visibility
+    /// deformation, dense safety checks of a trajectory). Assumes a valid forecast, like the other
+    /// query methods; a non-finite `t`, end point or clearance counts as not clear.
+    #[inline]
+    pub fn segment_clear(&self, a: &Vec3, b: &Vec3, t: f64, clearance: f64) -> bool {
+        t.is_finite() && Pdc::between(self, t, t).segment_clear(a, b, clearance)
+    }
+}
+
 #[cfg(test)]
 mod tests;

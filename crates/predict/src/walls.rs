@@ -57,14 +57,7 @@ struct AxisPiece {
 /// # Ok::<(), trust_predict::PredictError>(())
 /// ```
 pub fn wall_images(forecast: &Forecast, walls: &Aabb, from: f64, until: f64) -> Vec<Forecast> {
-    let half_extent = [
-        forecast.r_o,
-        forecast.r_o,
-        match forecast.shape {
-            ObstacleShape::Sphere => forecast.r_o,
-            ObstacleShape::Cylinder { half_height } => half_height,
-        },
-    ];
+    let half_extent = half_extents(forecast.shape, forecast.r_o);
     let axes: [Vec<AxisPiece>; 3] = std::array::from_fn(|a| {
         axis_pieces(
             forecast.p0[a],
@@ -95,6 +88,20 @@ pub fn wall_images(forecast: &Forecast, walls: &Aabb, from: f64, until: f64) -> 
         }
     }
     images
+}
+
+/// The shape's half extents along x, y and z: where its centre turns at a wall
+/// (`r_o` horizontally; a cylinder's half-height vertically). Shared by [`wall_images`] and the
+/// tracker's fold ([`crate::CvEkf::with_walls`]), so the two agree on where an obstacle turns.
+pub(crate) fn half_extents(shape: ObstacleShape, r_o: f64) -> [f64; 3] {
+    [
+        r_o,
+        r_o,
+        match shape {
+            ObstacleShape::Sphere => r_o,
+            ObstacleShape::Cylinder { half_height } => half_height,
+        },
+    ]
 }
 
 /// The straight pieces of `q + w·(t − t0)` folded into `[lo, hi]`, from the unreflected line up
@@ -137,6 +144,23 @@ fn axis_pieces(q: f64, w: f64, t0: f64, lo: f64, hi: f64, until: f64) -> Vec<Axi
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn the_walls_an_obstacle_stays_inside_are_optional_and_round_trip() {
+        let f = Forecast::sphere(Vec3::zeros(), Vec3::x(), 1.0, 0.5, 0.2, 0.4).unwrap();
+        assert_eq!(f.walls, None);
+        let json = serde_json::to_string(&f).unwrap();
+        assert!(!json.contains("walls"), "{json}");
+        let region = Aabb::new(Vec3::new(-5.0, -5.0, 0.0), Vec3::new(5.0, 5.0, 3.0)).unwrap();
+        let w = f.with_walls(region);
+        assert_eq!(w.walls, Some(region));
+        assert_eq!(w.radius(3.0), f.radius(3.0));
+        let json = serde_json::to_string(&w).unwrap();
+        assert_eq!(serde_json::from_str::<Forecast>(&json).unwrap(), w);
+        // The images at the walls keep them.
+        let images = wall_images(&w, &region, 1.0, 10.0);
+        assert!(!images.is_empty() && images.iter().all(|i| i.walls == Some(region)));
+    }
 
     fn room() -> Aabb {
         Aabb {

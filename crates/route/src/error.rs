@@ -240,6 +240,53 @@ pub enum RouteError {
     },
 }
 
+/// Which variant a [`RouteError`] is, without its fields: for code that decides by the kind of
+/// error (the manager's `route_failed` event, [`RouteError::kind`]) and for logs (serialized as
+/// the variant's name in snake case, `"expansion_cap"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum RouteErrorKind {
+    /// [`RouteError::InvalidParam`].
+    InvalidParam,
+    /// [`RouteError::PointOutOfScale`].
+    PointOutOfScale,
+    /// [`RouteError::NonFinitePoint`].
+    NonFinitePoint,
+    /// [`RouteError::OutsideBounds`].
+    OutsideBounds,
+    /// [`RouteError::TooManyCells`].
+    TooManyCells,
+    /// [`RouteError::ExpansionCap`].
+    ExpansionCap,
+    /// [`RouteError::Deadline`].
+    Deadline,
+    /// [`RouteError::NoFreeCell`].
+    NoFreeCell,
+    /// [`RouteError::Unreachable`].
+    Unreachable,
+    /// [`RouteError::Unresolved`].
+    Unresolved,
+}
+
+impl RouteError {
+    /// Which variant this is.
+    pub fn kind(&self) -> RouteErrorKind {
+        match self {
+            RouteError::InvalidParam { .. } => RouteErrorKind::InvalidParam,
+            RouteError::PointOutOfScale { .. } => RouteErrorKind::PointOutOfScale,
+            RouteError::NonFinitePoint { .. } => RouteErrorKind::NonFinitePoint,
+            RouteError::OutsideBounds { .. } => RouteErrorKind::OutsideBounds,
+            RouteError::TooManyCells { .. } => RouteErrorKind::TooManyCells,
+            RouteError::ExpansionCap { .. } => RouteErrorKind::ExpansionCap,
+            RouteError::Deadline { .. } => RouteErrorKind::Deadline,
+            RouteError::NoFreeCell { .. } => RouteErrorKind::NoFreeCell,
+            RouteError::Unreachable { .. } => RouteErrorKind::Unreachable,
+            RouteError::Unresolved { .. } => RouteErrorKind::Unresolved,
+        }
+    }
+}
+
 /// `Ok(value)` if `value` is finite and in `[lo, hi]`, else [`RouteError::InvalidParam`].
 pub(crate) fn check_range(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64, RouteError> {
     if value.is_finite() && (lo..=hi).contains(&value) {

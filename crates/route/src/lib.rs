@@ -68,7 +68,7 @@ mod search;
 /// The public vector type: `nalgebra::Vector3<f64>` (as in `trust-geometry`).
 pub type Vec3 = nalgebra::Vector3<f64>;
 
-pub use error::{Endpoint, Readable, RouteError, UnreachableCause};
+pub use error::{Endpoint, Readable, RouteError, RouteErrorKind, UnreachableCause};
 pub use params::{DEFAULT_HEURISTIC_WEIGHT, RouteParams};
 pub use planner::RoutePlanner;
 pub use route::{Blocked, GlobalRoute, Projection, RoutePoint};

@@ -283,6 +283,11 @@ pub struct CycleRecord {
     /// charged: its answer is taken once its time × `cpu_scale` has passed since it was sent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub route_worker_ms: Option<f64>,
+    /// Added (issue 34), only when the static map is sensed (`[sensing.static]`): the time the
+    /// online map took since the previous cycle (ms): the scans, their insertion and the export
+    /// of the planner's map. Perception, not planning: not part of `wall_ms`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub map_ms: Option<f64>,
 }
 
 impl CycleRecord {

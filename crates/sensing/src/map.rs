@@ -438,6 +438,41 @@ impl LocalMap {
         })
     }
 
+    /// Marks the unknown voxels whose centre lies within `radius` of `center` as known free
+    /// (one miss of the sensor model), leaving observed voxels as they are; returns how many it
+    /// marked. For space known free without a measurement: the ball the vehicle occupies at
+    /// take-off (FASTER's initial condition: the vehicle starts in known free space). Non-finite
+    /// input, a negative radius or one above 64 voxels marks nothing.
+    pub fn assume_free(&mut self, center: &Vec3, radius: f64) -> usize {
+        let res = self.ring.res;
+        if !trust_geometry::scale::position_in_scale(center)
+            || !(0.0..=64.0 * res).contains(&radius)
+        {
+            return 0;
+        }
+        let c = voxel_key(center, res);
+        let n = (radius / res).ceil() as i64 + 1;
+        let miss = self.params.log_odds.update(0.0, false) as f32;
+        let mut count = 0;
+        for dz in -n..=n {
+            for dy in -n..=n {
+                for dx in -n..=n {
+                    let k = [c[0] + dx, c[1] + dy, c[2] + dz];
+                    if !self.ring.contains(&k) || (self.ring.center(&k) - center).norm() > radius {
+                        continue;
+                    }
+                    let v = &mut self.voxels[self.ring.slot(&k)];
+                    if !v.known {
+                        v.known = true;
+                        v.log_odds = miss;
+                        count += 1;
+                    }
+                }
+            }
+        }
+        count
+    }
+
     /// Brings the distance field up to date with the occupancy: recomputes it exactly in the box
     /// of the voxels that flipped since the last call, grown by the truncation distance. Returns
     /// the number of voxels recomputed (0 if nothing flipped).

@@ -30,12 +30,12 @@ pub enum WorldError {
     },
     /// A file is larger than the cap for its kind ([`crate::files`]); nothing beyond
     /// the cap was read.
-    #[error("cannot read {}: larger than the cap of {} for {what}", path.display(), fmt_bytes(*limit_bytes))]
+    #[error("cannot read {}: larger than the cap of {limit} for {what}", path.display())]
     TooLarge {
         /// The file.
         path: PathBuf,
-        /// The cap (bytes).
-        limit_bytes: u64,
+        /// The cap exceeded (`16 MiB`; for one line, `line 7: 67108864 bytes a line`).
+        limit: String,
         /// What kind of file (`"a scenario file"`, `"a track file"`, `"a points file"`).
         what: &'static str,
     },
@@ -88,11 +88,38 @@ pub enum WorldError {
 }
 
 /// `4 MiB` for whole mebibytes, else bytes.
-fn fmt_bytes(n: u64) -> String {
+pub(crate) fn fmt_bytes(n: u64) -> String {
     if n >= 1 << 20 && n.is_multiple_of(1 << 20) {
         format!("{} MiB", n >> 20)
     } else {
         format!("{n} bytes")
+    }
+}
+
+/// The errors of the one line reader, [`trust_runlog::files::BoundedLines`] (a track or points
+/// file read line by line), as the world's: a line that is not UTF-8 is a
+/// [`WorldError::PointsFile`] naming it (docs/decisions/0041-one-line-reader.md).
+impl From<trust_runlog::LogError> for WorldError {
+    fn from(e: trust_runlog::LogError) -> Self {
+        use trust_runlog::LogError;
+        match e {
+            LogError::Io { path, source } => WorldError::Read { path, source },
+            LogError::NotAFile { path, .. } => WorldError::NotAFile { path },
+            LogError::TooLarge { path, what, limit } => WorldError::TooLarge { path, limit, what },
+            LogError::Parse {
+                path,
+                line,
+                message,
+            } => WorldError::PointsFile {
+                path,
+                line,
+                message,
+            },
+            other => WorldError::Read {
+                path: PathBuf::new(),
+                source: std::io::Error::other(other.to_string()),
+            },
+        }
     }
 }
 

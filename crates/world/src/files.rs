@@ -11,7 +11,8 @@
 //!   `script::MAX_SAMPLES` lines of 160 bytes) for a track, [`MAX_POINTS_BYTES`]
 //!   (512 MiB, about 20 M lines of `x y z` with six decimals) for a points file. Beyond it,
 //!   [`WorldError::TooLarge`].
-//! * **Incremental**: tracks and points files are read line by line ([`for_each_line`]) and
+//! * **Incremental**: tracks and points files are read line by line ([`for_each_line`], over the
+//!   workspace's one line reader, `trust_runlog::files::BoundedLines`, decision 0041) and
 //!   parsed as they are read; the parsers stop at their count caps
 //!   (`script::MAX_SAMPLES`, `scenario::scale::MAX_CLOUD_POINTS`).
 //! * **Relative paths** are resolved against the scenario file's folder and **may not leave
@@ -22,8 +23,10 @@
 //! * **No file contents in messages** beyond the offending line, cut to [`MAX_ECHO_CHARS`]
 //!   characters ([`echo`]).
 
-use std::io::{BufRead, BufReader, Read};
+use std::io::Read;
+
 use std::path::{Component, Path, PathBuf};
+use trust_runlog::files::BoundedLines;
 
 use crate::error::WorldError;
 use crate::problem::fmt_num;
@@ -69,7 +72,7 @@ pub fn read_text(path: &Path, max_bytes: u64, what: &'static str) -> Result<Stri
     if text.len() as u64 > max_bytes {
         return Err(WorldError::TooLarge {
             path: path.to_path_buf(),
-            limit_bytes: max_bytes,
+            limit: crate::error::fmt_bytes(max_bytes),
             what,
         });
     }
@@ -77,51 +80,29 @@ pub fn read_text(path: &Path, max_bytes: u64, what: &'static str) -> Result<Stri
 }
 
 /// Calls `line(number, text)` for every line of a regular file of at most `max_bytes` bytes
-/// (1-based numbers, line ends removed), reading incrementally; `line` returns `Err((number,
+/// (1-based numbers, line ends removed), read incrementally by the one line reader,
+/// [`trust_runlog::files::BoundedLines`] (its byte and line caps); `line` returns `Err((number,
 /// message))` to stop with [`WorldError::PointsFile`].
 ///
 /// # Errors
-/// [`WorldError::NotAFile`], [`WorldError::TooLarge`], [`WorldError::Read`] (also for a line
-/// that is not UTF-8), [`WorldError::PointsFile`] from `line`.
+/// [`WorldError::NotAFile`], [`WorldError::TooLarge`] (the file, or one line over
+/// [`trust_runlog::files::MAX_LINE_BYTES`]), [`WorldError::Read`], [`WorldError::PointsFile`]
+/// for a line that is not UTF-8 or from `line`.
 pub fn for_each_line(
     path: &Path,
     max_bytes: u64,
     what: &'static str,
     mut line: impl FnMut(usize, &str) -> Result<(), (usize, String)>,
 ) -> Result<(), WorldError> {
-    let file = open_regular(path)?;
-    let mut reader = BufReader::new(file.take(max_bytes + 1));
-    let mut buf = String::new();
-    let mut total: u64 = 0;
-    let mut number = 0;
-    loop {
-        buf.clear();
-        let n = reader
-            .read_line(&mut buf)
-            .map_err(|source| WorldError::Read {
-                path: path.to_path_buf(),
-                source,
-            })?;
-        if n == 0 {
-            return Ok(());
-        }
-        total += n as u64;
-        if total > max_bytes {
-            return Err(WorldError::TooLarge {
-                path: path.to_path_buf(),
-                limit_bytes: max_bytes,
-                what,
-            });
-        }
-        number += 1;
-        line(number, buf.trim_end_matches(['\n', '\r'])).map_err(|(line, message)| {
-            WorldError::PointsFile {
-                path: path.to_path_buf(),
-                line,
-                message,
-            }
+    let mut lines = BoundedLines::open(path, max_bytes, what)?;
+    while let Some((number, text)) = lines.next_line()? {
+        line(number, text).map_err(|(line, message)| WorldError::PointsFile {
+            path: path.to_path_buf(),
+            line,
+            message,
         })?;
     }
+    Ok(())
 }
 
 /// A line of a file for a message: quoted, cut to [`MAX_ECHO_CHARS`] characters (`…` marks the
@@ -326,7 +307,7 @@ mod tests {
     }
 
     #[test]
-    fn the_cap_is_enforced_while_reading() {
+    fn the_cap_is_enforced_and_lines_are_utf8() {
         let dir = std::env::temp_dir().join(format!("trust-files-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let f = dir.join("big.txt");
@@ -337,17 +318,20 @@ mod tests {
             Ok(())
         })
         .unwrap_err();
+        // Refused before any line is parsed (the reader checks the size first, then reads
+        // through the cap: a file that grows while it is read cannot pass it either).
         assert!(
-            matches!(
-                e,
-                WorldError::TooLarge {
-                    limit_bytes: 60,
-                    ..
-                }
-            ),
+            matches!(&e, WorldError::TooLarge { limit, .. } if limit == "60 bytes"),
             "{e}"
         );
-        assert_eq!(lines, 10);
+        assert_eq!(lines, 0);
+        let bad = dir.join("latin1.txt");
+        std::fs::write(&bad, b"1 2 3\n4 5 \xe9\n").unwrap();
+        let e = for_each_line(&bad, 600, "a test file", |_, _| Ok(())).unwrap_err();
+        assert!(
+            matches!(&e, WorldError::PointsFile { line: 2, message, .. } if message.contains("UTF-8")),
+            "{e}"
+        );
         assert!(read_text(&f, 600, "a test file").is_ok());
         assert!(read_text(&f, 599, "a test file").is_err());
         std::fs::remove_dir_all(&dir).unwrap();

@@ -57,6 +57,7 @@ pub mod error;
 pub mod files;
 pub(crate) mod generate;
 mod kdtree;
+pub mod map_sensing;
 pub mod problem;
 mod sampling;
 pub mod scenario;
@@ -326,6 +327,12 @@ impl World {
         shapes.min(points)
     }
 
+    /// The true static shapes as a map (what the vehicle's sensors ray-cast against,
+    /// [`map_sensing`]); the true cloud points are not in it ([`World::static_points`]).
+    pub fn truth_map(&self) -> &StaticMap {
+        &self.truth_map
+    }
+
     /// The planner's static map (module docs).
     pub fn planner_map(&self) -> &StaticMap {
         &self.planner_map
@@ -403,7 +410,8 @@ impl World {
             &shapes,
             self.vehicle_radius_m(),
             self.seeds.sensing,
-        )?;
+        )?
+        .with_walls(self.obstacles.iter().map(|o| Some(o.region)).collect())?;
         let positions: Vec<Vec3> = self.obstacles.iter().map(|o| o.position).collect();
         let velocities: Vec<Vec3> = self.obstacles.iter().map(|o| o.velocity).collect();
         s.warm_up(&positions, &velocities)?;
@@ -471,6 +479,7 @@ fn preflight<P>(scenario: &Scenario<P>, layout: &generate::Layout, p: &mut probl
         scenario.vehicle.radius_m,
         seeds.sensing,
     )
+    .and_then(|s| s.with_walls(layout.obstacles.iter().map(|o| Some(o.region)).collect()))
     .and_then(|mut s| {
         s.warm_up(&positions, &velocities)?;
         if let Some(t) = &traffic {

@@ -35,10 +35,11 @@
 use rand::{Rng as _, SeedableRng};
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
-use trust_core::{Forecast, Rng, Vec3};
+use trust_core::{Aabb, Forecast, Rng, Vec3};
 use trust_predict::{CvEkf, EkfParams, PredictError};
 
 use crate::error::WorldError;
+use crate::map_sensing::StaticSensing;
 use crate::problem::Problems;
 use crate::traffic::MovingShape;
 
@@ -63,6 +64,16 @@ pub struct SensingParams {
     pub warmup_s: f64,
     /// The tracking filter's parameters (`trust_predict::EkfParams`).
     pub ekf: EkfParams,
+    /// Whether each filter folds its estimate at the walls of the box its obstacle stays inside
+    /// (its region; `trust_predict::CvEkf::with_walls`). Default `true`: the traffic turns
+    /// obstacles back at those walls, and a filter that does not know it walks a bounced
+    /// obstacle into the wall while its velocity turns (the forecasts' wall images assume the
+    /// same box). `false` is the paper's constant-velocity filter.
+    pub fold_at_walls: bool,
+    /// `[sensing.static]`: whether the planner is given the static map (`"known"`, the
+    /// default) or senses it with a depth camera or a LiDAR ([`crate::map_sensing`]).
+    #[serde(rename = "static", skip_serializing_if = "StaticSensing::is_known")]
+    pub static_map: StaticSensing,
 }
 
 impl Default for SensingParams {
@@ -74,6 +85,8 @@ impl Default for SensingParams {
             r_safe_margin_m: 0.1,
             warmup_s: 2.0,
             ekf: EkfParams::default(),
+            fold_at_walls: true,
+            static_map: StaticSensing::Known,
         }
     }
 }
@@ -101,6 +114,22 @@ impl SensingParams {
         if let Err(e) = self.ekf.validate() {
             p.list.push(predict_problem(e, field));
         }
+        self.static_map.check(&format!("{field}.static"), p);
+    }
+}
+
+/// `filter` folding at `wall` when the parameters ask for it ([`SensingParams::fold_at_walls`]).
+fn fold_filter(
+    filter: CvEkf,
+    shape: &MovingShape,
+    wall: Option<&Aabb>,
+    params: &SensingParams,
+) -> Result<CvEkf, WorldError> {
+    match wall {
+        Some(w) if params.fold_at_walls => {
+            Ok(filter.with_walls(w, shape.forecast_shape(), shape.radius())?)
+        }
+        _ => Ok(filter),
     }
 }
 
@@ -143,6 +172,8 @@ pub struct Sensing {
     params: SensingParams,
     shapes: Vec<MovingShape>,
     filters: Vec<Option<CvEkf>>,
+    /// The box each obstacle stays inside, when known ([`Sensing::with_walls`]).
+    walls: Vec<Option<Aabb>>,
     rng: Rng,
     noise: Normal<f64>,
     period_s: f64,
@@ -185,6 +216,7 @@ impl Sensing {
             params: params.clone(),
             shapes: shapes.to_vec(),
             filters: vec![None; shapes.len()],
+            walls: vec![None; shapes.len()],
             rng: Rng::seed_from_u64(seed),
             noise,
             period_s: 1.0 / params.rate_hz,
@@ -192,6 +224,30 @@ impl Sensing {
             r_safe: vehicle_radius_m + params.r_safe_margin_m,
             stats: SensingStats::default(),
         })
+    }
+
+    /// This sensor with the box each obstacle stays inside (in obstacle order; `None` for an
+    /// obstacle with no known box): with `fold_at_walls` set, each obstacle's filter folds its
+    /// estimate at those walls ([`trust_predict::CvEkf::with_walls`]).
+    ///
+    /// # Errors
+    /// [`WorldError::Input`] if `walls` does not have one entry per obstacle or a box is not
+    /// finite.
+    pub fn with_walls(mut self, walls: Vec<Option<Aabb>>) -> Result<Self, WorldError> {
+        if walls.len() != self.shapes.len() {
+            return Err(WorldError::input(
+                "walls",
+                format!("{} boxes", walls.len()),
+                format!("one per obstacle ({})", self.shapes.len()),
+            ));
+        }
+        self.walls = walls;
+        for ((filter, shape), wall) in self.filters.iter_mut().zip(&self.shapes).zip(&self.walls) {
+            if let Some(f) = filter.take() {
+                *filter = Some(fold_filter(f, shape, wall.as_ref(), &self.params)?);
+            }
+        }
+        Ok(self)
     }
 
     /// The parameters.
@@ -297,7 +353,8 @@ impl Sensing {
             return Err(WorldError::input("t", t, "a finite time"));
         }
         self.stats.round_count += 1;
-        for (filter, p) in self.filters.iter_mut().zip(truth) {
+        let boxes = self.shapes.iter().zip(&self.walls);
+        for ((filter, p), (shape, wall)) in self.filters.iter_mut().zip(truth).zip(boxes) {
             let lost = self.rng.random_bool(self.params.dropout_probability);
             let n = Vec3::new(
                 self.noise.sample(&mut self.rng),
@@ -312,7 +369,10 @@ impl Sensing {
             }
             match (filter.as_mut(), z) {
                 (Some(f), z) => f.step(t, z)?,
-                (None, Some(z)) => *filter = Some(CvEkf::new(t, z, self.params.ekf.clone())?),
+                (None, Some(z)) => {
+                    let f = CvEkf::new(t, z, self.params.ekf.clone())?;
+                    *filter = Some(fold_filter(f, shape, wall.as_ref(), &self.params)?);
+                }
                 (None, None) => {}
             }
         }

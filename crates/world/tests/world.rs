@@ -836,3 +836,59 @@ fn dynamic_forest_paths_stay_in_their_regions_and_clear_of_start_and_goal() {
         }
     }
 }
+
+/// A sensor told the box each obstacle stays inside folds its tracks at the walls
+/// (`SensingParams::fold_at_walls`, `Sensing::with_walls`): a column crossing a corridor at
+/// 1.9 m/s that bounces off the wall is forecast moving away from it at once, where the paper's
+/// filter still walks it into the wall; a box list of the wrong length is named.
+#[test]
+fn sensing_folds_the_tracks_at_the_obstacles_walls() {
+    let region = trust_core::Aabb {
+        min: Vec3::zeros(),
+        max: Vec3::new(60.0, 20.0, 8.0),
+    };
+    let column = MovingObstacle {
+        shape: MovingShape::Cylinder {
+            radius: 0.5,
+            half_height: 4.0,
+        },
+        // The centre turns at y = 0.5, 0.5 s after take-off.
+        position: Vec3::new(30.0, 1.45, 4.0),
+        velocity: Vec3::new(0.0, -1.9, 0.0),
+        motion: Motion::ConstantVelocity {},
+        region,
+    };
+    let shapes = [column.shape];
+    let velocity_after_bounce = |fold: bool| {
+        let params = SensingParams {
+            fold_at_walls: fold,
+            ..SensingParams::default()
+        };
+        let mut traffic = Traffic::new(std::slice::from_ref(&column), 0.0, 3).unwrap();
+        let mut sensing = Sensing::new(&params, &shapes, 0.3, 4)
+            .unwrap()
+            .with_walls(vec![Some(region)])
+            .unwrap();
+        sensing
+            .warm_up(&[column.position], &[column.velocity])
+            .unwrap();
+        let dt = 0.01;
+        for step in 1..=65 {
+            traffic.step(dt).unwrap();
+            sensing
+                .update(step as f64 * dt, traffic.positions())
+                .unwrap();
+        }
+        assert!(traffic.velocities()[0].y > 0.0, "the column bounced");
+        sensing.forecasts(0.65).unwrap()[0].v0.y
+    };
+    let (folded, paper) = (velocity_after_bounce(true), velocity_after_bounce(false));
+    assert!(folded > 1.5, "folded track: v_y = {folded}");
+    assert!(paper < -1.0, "the paper's filter: v_y = {paper}");
+
+    let e = Sensing::new(&SensingParams::default(), &shapes, 0.3, 4)
+        .unwrap()
+        .with_walls(vec![])
+        .unwrap_err();
+    assert!(e.to_string().contains("walls"), "{e}");
+}

@@ -3,7 +3,7 @@
 
 use trust_core::{Aabb, Forecast, ObstacleShape, Vec3};
 
-use super::integrate::{Integrand, SampleGrad, SampleState};
+use super::integrand::{Integrand, SampleGrad, SampleState};
 use super::smooth::SmoothedL1;
 
 /// The DDF violation `φ_o` of one forecast at `(p, t)` and its partial derivatives
@@ -261,7 +261,7 @@ impl<'a> DynamicObstacleTerm<'a> {
 
     /// Sets `flags[k]` for every node `k` (position `(x[k], y[k], z[k])`, time `t[k]`) that is
     /// not provably farther than the clearance plus
-    /// [`FILTER_MARGIN_M`](crate::costs::integrate::FILTER_MARGIN_M) from a forecast kept by
+    /// [`FILTER_MARGIN_M`](crate::costs::integrand::FILTER_MARGIN_M) from a forecast kept by
     /// the piece's broad phase (the rejection of [`outside_inflated`], column by column).
     #[expect(
         clippy::neg_cmp_op_on_partial_ord,
@@ -277,7 +277,7 @@ impl<'a> DynamicObstacleTerm<'a> {
     ) {
         let m = flags.len();
         let (x, y, z, t) = (&x[..m], &y[..m], &z[..m], &t[..m]);
-        let grow = self.clearance + crate::costs::integrate::FILTER_MARGIN_M;
+        let grow = self.clearance + crate::costs::integrand::FILTER_MARGIN_M;
         for &o in &self.near_piece {
             let f = &self.forecasts[o];
             let (p0, v0, t0) = (f.p0, f.v0, f.t0);

@@ -2,7 +2,7 @@
 
 use trust_core::{Limits, Vec3};
 
-use super::integrate::{Integrand, SampleGrad, SampleState};
+use super::integrand::{Integrand, SampleGrad, SampleState};
 use super::smooth::SmoothedL1;
 
 /// `φ = ‖x‖²/x_max² − 1` and `∂φ/∂x = 2x/x_max²` (paper eq. design-of-Id, for `x` = velocity or

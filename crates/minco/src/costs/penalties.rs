@@ -5,7 +5,7 @@ use trust_core::{Aabb, Forecast, Limits, StaticMap, Vec3};
 
 use super::dynamic::DynamicObstacleTerm;
 use super::feasibility::FeasibilityTerm;
-use super::integrate::{Integrand, SampleGrad, SampleState};
+use super::integrand::{Integrand, SampleGrad, SampleState};
 use super::static_map::StaticObstacleTerm;
 use super::{CostWeights, PenaltyParams};
 

@@ -3,7 +3,7 @@
 use trust_core::{Aabb, StaticMap, Vec3};
 use trust_geometry::Shape;
 
-use super::integrate::{Integrand, SampleGrad, SampleState};
+use super::integrand::{Integrand, SampleGrad, SampleState};
 use super::smooth::SmoothedL1;
 
 /// Static-map penalty `L_s = Σ_shapes f_max(c − d_shape(p)) + f_max(c − d_esdf(p)) +
@@ -109,7 +109,7 @@ impl<'a> StaticObstacleTerm<'a> {
 
     /// Sets `flags[k]` for every node `k` (position `(x[k], y[k], z[k])`) that is not provably
     /// farther than the clearance plus
-    /// [`FILTER_MARGIN_M`](crate::costs::integrate::FILTER_MARGIN_M) from a shape kept by the
+    /// [`FILTER_MARGIN_M`](crate::costs::integrand::FILTER_MARGIN_M) from a shape kept by the
     /// piece's broad phase (the rejection of [`beyond_clearance`], column by column) or whose
     /// ESDF lower bound ([`trust_geometry::Esdf::lower_bound`]) is below that distance.
     #[expect(
@@ -119,7 +119,7 @@ impl<'a> StaticObstacleTerm<'a> {
     pub(crate) fn flag_nodes(&self, x: &[f64], y: &[f64], z: &[f64], flags: &mut [bool]) {
         let m = flags.len();
         let (x, y, z) = (&x[..m], &y[..m], &z[..m]);
-        let grow = self.clearance + crate::costs::integrate::FILTER_MARGIN_M;
+        let grow = self.clearance + crate::costs::integrand::FILTER_MARGIN_M;
         if self.near_bounds {
             let b = self.map.bounds();
             let (lo, hi) = (b.min.add_scalar(grow), b.max.add_scalar(-grow));

@@ -52,14 +52,6 @@ impl Time {
         Ok(Time { sec, nanosec })
     }
 
-    /// A header stamped with this time in `frame`.
-    pub fn into_header(self, frame: &str) -> crate::msg::std_msgs::Header {
-        crate::msg::std_msgs::Header {
-            stamp: self,
-            frame_id: frame.to_owned(),
-        }
-    }
-
     /// Seconds since the epoch.
     pub fn as_seconds(&self) -> f64 {
         f64::from(self.sec) + f64::from(self.nanosec) * 1e-9

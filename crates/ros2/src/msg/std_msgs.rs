@@ -14,6 +14,18 @@ pub struct Header {
 }
 ros_message!(Header, "std_msgs", "Header");
 
+// Beside `Header`, not in `builtin_interfaces`: `std_msgs` uses `builtin_interfaces`, never the
+// other way round (no module cycle, tests/tests/tidy.rs).
+impl Time {
+    /// A header stamped with this time in `frame`.
+    pub fn into_header(self, frame: &str) -> Header {
+        Header {
+            stamp: self,
+            frame_id: frame.to_owned(),
+        }
+    }
+}
+
 /// `std_msgs/msg/ColorRGBA`, each channel in `[0, 1]`.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct ColorRGBA {

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use trust_core::{Aabb, Vec3};
 
 use crate::problem::Problems;
-use crate::scenario::sections::BoundsSpec;
+use crate::scenario::bounds::BoundsSpec;
 use crate::traffic::{ManeuverParams, Motion};
 
 /// Which generator, with its parameters.

@@ -96,6 +96,7 @@
 //! position_noise_m = 0.1
 //! dropout_probability = 0.0
 //! r_safe_margin_m = 0.1
+//! # static = "known"             # or { depth = { … } } | { lidar = { … } }: sensed (map_sensing)
 //! # [sensing.ekf]                # trust_predict::EkfParams
 //!
 //! [traffic]
@@ -137,9 +138,11 @@
 //! (`trust-sim validate`), which generates the layout without building the maps.
 
 pub use crate::files;
+mod bounds;
 pub(crate) mod generator;
 pub mod points;
 pub mod scale;
+mod scale_check;
 
 pub(crate) mod sections;
 mod validate;
@@ -151,9 +154,10 @@ use serde::{Deserialize, Serialize};
 use trust_core::Aabb;
 
 pub use crate::problem::Problem;
+pub use bounds::BoundsSpec;
 pub use generator::{DynamicForestParams, E1Params, E2Params, E3Params, E4Params, GeneratorSpec};
 pub use sections::{
-    BoundsSpec, Latency, MAX_CPU_SCALE, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec,
+    Latency, MAX_CPU_SCALE, Mission, MovingShapeKind, ObstacleSpec, PointCloudSpec,
     RandomEndpoints, RandomObstacles, SimSection, StaticSection, StaticShape, VehicleModel,
     VehicleSection, WorldSection, endpoint_draw_count,
 };

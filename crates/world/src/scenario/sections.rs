@@ -6,44 +6,11 @@ use serde::{Deserialize, Serialize};
 use trust_core::{Aabb, Limits, Vec3};
 use trust_geometry::{AaBox, Cylinder, Shape, Sphere};
 
+use super::bounds::BoundsSpec;
 use crate::problem::Problem;
 use crate::scenario::generator::GeneratorSpec;
 use crate::traffic::{Motion, MovingObstacle, MovingShape};
 use trust_vehicle::{QuadrotorParams, Se3Gains};
-
-/// An axis-aligned box `{ min = [x, y, z], max = [x, y, z] }`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BoundsSpec {
-    /// Lower corner (m).
-    pub min: [f64; 3],
-    /// Upper corner (m).
-    pub max: [f64; 3],
-}
-
-impl BoundsSpec {
-    /// The box, without checks.
-    pub fn aabb(&self) -> Aabb {
-        Aabb {
-            min: Vec3::from(self.min),
-            max: Vec3::from(self.max),
-        }
-    }
-
-    /// From a box.
-    pub fn from_aabb(a: &Aabb) -> Self {
-        BoundsSpec {
-            min: a.min.into(),
-            max: a.max.into(),
-        }
-    }
-
-    /// Finite corners with `min < max` on every axis.
-    pub fn is_valid(&self) -> bool {
-        self.min.iter().chain(&self.max).all(|x| x.is_finite())
-            && (0..3).all(|i| self.min[i] < self.max[i])
-    }
-}
 
 /// Section `[world]`: the bounds and an optional generator.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]

@@ -3,6 +3,7 @@
 use trust_core::{Aabb, Vec3};
 use trust_geometry::{MAX_VOXELS, checked_voxel_count};
 
+use super::scale::{esdf_dims, fmt_grid};
 use super::{Latency, MAX_CPU_SCALE, MovingShapeKind, PointCloudSpec, Problem, Scenario};
 use crate::problem::{Problems, fmt_bounds, fmt_count, fmt_num, fmt_vec};
 use crate::scenario::points::read_points_file;
@@ -553,44 +554,6 @@ impl<P> Scenario<P> {
             p.non_negative("sim.latency.seconds", seconds);
         }
     }
-}
-
-/// The grid [`esdf_dims`] counts, for a message: `nx x ny x nz = total`, every count readable
-/// ([`fmt_num`]) and as large as it is (not the placeholder `esdf_dims` clamps a huge count to).
-pub(crate) fn fmt_grid(bounds: &Aabb, resolution: f64) -> String {
-    let ext = bounds.extent();
-    let n: Vec<f64> = (0..3)
-        .map(|i| (ext[i] / resolution * (1.0 - 1e-12)).ceil().max(1.0))
-        .collect();
-    format!(
-        "{} x {} x {} = {}",
-        fmt_num(n[0]),
-        fmt_num(n[1]),
-        fmt_num(n[2]),
-        fmt_num(n[0] * n[1] * n[2])
-    )
-}
-
-/// Most voxels per axis [`esdf_dims`] reports: a larger count is reported as this one (far
-/// beyond `MAX_VOXELS` either way), so that the product of three stays within `u128`
-/// (`trust_geometry::checked_voxel_count` multiplies them unchecked; with the former
-/// placeholder `usize::MAX / 4` it overflowed, a panic in debug builds).
-const MAX_AXIS_VOXELS: usize = 1 << 40;
-
-/// Voxels per axis of an ESDF of `resolution` over `bounds`, as `Esdf::from_points` computes
-/// them (without allocating), each at most [`MAX_AXIS_VOXELS`].
-pub(crate) fn esdf_dims(bounds: &Aabb, resolution: f64) -> [usize; 3] {
-    let ext = bounds.extent();
-    let mut dims = [0usize; 3];
-    for i in 0..3 {
-        let n = (ext[i] / resolution * (1.0 - 1e-12)).ceil().max(1.0);
-        dims[i] = if n < MAX_AXIS_VOXELS as f64 {
-            n as usize
-        } else {
-            MAX_AXIS_VOXELS
-        };
-    }
-    dims
 }
 
 fn check_shape(p: &mut Problems, field: &str, s: &super::StaticShape) {

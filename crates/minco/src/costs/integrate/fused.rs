@@ -11,7 +11,8 @@
 //!   bounds the norm everywhere on the piece (convex hull) — and only if that bound exceeds the
 //!   limit, the squared norm at every node, computed column by column (vectorizable);
 //! - obstacles: positions and node times column by column, then per candidate obstacle a
-//!   squared-distance test against the inflated obstacle grown by [`FILTER_MARGIN_M`].
+//!   squared-distance test against the inflated obstacle grown by
+//!   [`FILTER_MARGIN_M`](crate::costs::integrand::FILTER_MARGIN_M).
 //!
 //! Every filter keeps a margin far above floating-point rounding, so a node it skips has a
 //! violation `≤ 0` for every term also when evaluated exactly as in the generic path.
@@ -28,10 +29,6 @@ use super::{
 };
 use crate::costs::PenaltyIntegrand;
 use crate::error::MincoError;
-
-/// Distance (m) by which the obstacle filters grow every obstacle beyond its clearance: far
-/// above the rounding of positions (≈ 1e-14 m at 100 m), far below any geometry.
-pub(crate) const FILTER_MARGIN_M: f64 = 1e-6;
 
 /// Relative margin of the speed and acceleration filters on squared norms.
 const LIMIT_FILTER_MARGIN: f64 = 1e-9;

@@ -1,0 +1,246 @@
+//! The static map as sensed (`[sensing.static]` other than `"known"`, issue 34): the vehicle's
+//! depth camera or LiDAR ray-casts the true static shapes from its pose at the sensor's rate,
+//! the scans go into a rolling-window `trust_sensing::LocalMap`, and the planner plans in the
+//! map it exports (unknown space free) while the simulator still judges collisions against
+//! the truth.
+//!
+//! * **When.** The first scan at `t = 0`, then one per sensor period (at the first physics step
+//!   at or after it); the window is re-centred on the vehicle before each scan.
+//! * **The planner's map.** Rebuilt at a planning cycle if a scan came in since the last one
+//!   (`LocalMap::to_static_map` over the world's bounds); shared with the manager's worker.
+//! * **Commitment.** The committed part of a plan and its braking must lie in observed free
+//!   voxels with the vehicle's radius as clearance ([`KnownFree`], FASTER's rule): the manager
+//!   consults it through `trust_manager::CommitCheck`. Two kinds of space count as known free
+//!   without a measurement, because the vehicle is physically there: at take-off the ball
+//!   around the start of radius `r + blind + voxel diagonal` (`r` the vehicle's radius, `blind`
+//!   the sensor's blind reach for it, `StaticSensor::blind_reach_m`: the first stretch of any
+//!   path has parts the sensor cannot see from the start, e.g. below and above the camera's 58°
+//!   vertical field within 0.54 m; FASTER's initial condition, the vehicle starts in known
+//!   free space), and at every scan the ball the vehicle's body fills, grown by a voxel
+//!   diagonal (the voxels its body touches; the commit check's own discretization: a voxel
+//!   within its clearance of the vehicle's voxel, `LocalMap::segment_known_free`). Without it
+//!   the camera's minimum depth (0.3 m) and vertical field leave the voxels round a hovering
+//!   vehicle unobserved, and a plan that sets off sideways, up or down is never committed.
+//! * **Heading.** A forward-looking camera must look where the vehicle goes: the commanded yaw
+//!   turns toward the direction of the best branch (main, else the best-ranked kept one) one
+//!   second ahead, else toward the goal, at most [`YAW_RATE_RAD_S`]. A known map keeps yaw 0.
+//! * **Moving obstacles** are not inserted into the map (the scans see the static truth only):
+//!   the obstacle trackers handle them, as with a known map.
+//! * **Cost.** The time of the scans, the insertions and the export is perception, not
+//!   planning: it is the cycle record's `map_ms`, not part of its `wall_ms`.
+//! * **Randomness.** The sensor noise comes from its own stream of the trial seed
+//!   (`mix_seed(seed, 5)`), so the same seed gives the same flight.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use trust_core::{StaticMap, Vec3};
+use trust_manager::CommitCheck;
+use trust_planner::AnyManager;
+use trust_sensing::{DepthCamera, Lidar, LocalMap, Pose, RaySensor, Scan, Truth};
+use trust_vehicle::VehicleState;
+use trust_world::World;
+use trust_world::map_sensing::StaticSensor;
+
+use crate::FlightError;
+
+/// The commanded yaw's largest rate while sensing (rad/s): 45°/s, PX4's default limit of the
+/// yaw rate in its autonomous modes (`MPC_YAWRAUTO_MAX`).
+pub const YAW_RATE_RAD_S: f64 = std::f64::consts::FRAC_PI_4;
+
+/// How far ahead along the best branch the camera looks (s).
+pub const LOOK_AHEAD_S: f64 = 1.0;
+
+/// The stream of the trial seed the static sensor's noise draws from ([`trust_world::mix_seed`];
+/// streams 1–4 are the world's `Seeds`).
+pub const NOISE_STREAM: u64 = 5;
+
+/// The online map of one flight and its sensor (module docs).
+pub struct MapSensing {
+    sensor: Box<dyn RaySensor>,
+    map: Arc<LocalMap>,
+    rng: ChaCha8Rng,
+    scan: Scan,
+    period_s: f64,
+    next_t: f64,
+    bounds: trust_core::Aabb,
+    planner_map: Arc<StaticMap>,
+    dirty: bool,
+    clearance_m: f64,
+    /// The radius of the ball round the vehicle that counts as free at each scan (m).
+    body_m: f64,
+    map_ms: f64,
+    /// The commanded yaw (rad).
+    yaw: f64,
+    /// The yaw it turns toward (rad).
+    target_yaw: f64,
+}
+
+impl MapSensing {
+    /// The map sensing of a flight through `world`; `None` for `[sensing.static] = "known"`.
+    ///
+    /// # Errors
+    /// [`FlightError::Sensing`] for invalid sensor or map parameters (`trust-sim validate`
+    /// reports them first) or a world whose static obstacles include a point cloud (not
+    /// ray-cast yet).
+    pub fn new(world: &World) -> Result<Option<Self>, FlightError> {
+        let scenario = world.scenario();
+        let Some((sensor, map_params)) = scenario.sensing.static_map.sensor() else {
+            return Ok(None);
+        };
+        let blind = sensor.blind_reach_m(world.vehicle_radius_m());
+        if world.static_points().is_some() {
+            return Err(FlightError::Sensing(trust_sensing::SensingError::Scan {
+                field: "sensing.static".into(),
+                problem: "a world with a static point cloud is not ray-cast yet; use \"known\""
+                    .into(),
+            }));
+        }
+        let sensor: Box<dyn RaySensor> = match sensor {
+            StaticSensor::Depth(p) => Box::new(DepthCamera::new(p)?),
+            StaticSensor::Lidar(p) => Box::new(Lidar::new(p)?),
+        };
+        let start = world.start();
+        let mut map = LocalMap::new(map_params, &start)?;
+        let radius = world.vehicle_radius_m();
+        map.assume_free(
+            &start,
+            radius + blind + 3f64.sqrt() * map_params.resolution_m,
+        );
+        let bounds = *world.bounds();
+        let planner_map = Arc::new(map.to_static_map(bounds)?);
+        let goal = world.goal() - start;
+        let yaw = 0.0;
+        Ok(Some(MapSensing {
+            period_s: 1.0 / sensor.rate_hz(),
+            sensor,
+            map: Arc::new(map),
+            rng: ChaCha8Rng::seed_from_u64(trust_world::mix_seed(scenario.seed, NOISE_STREAM)),
+            scan: Scan::default(),
+            next_t: 0.0,
+            bounds,
+            planner_map,
+            dirty: false,
+            clearance_m: radius,
+            body_m: radius + 3f64.sqrt() * map_params.resolution_m,
+            map_ms: 0.0,
+            yaw,
+            target_yaw: if goal.xy().norm() > 1e-9 {
+                goal.y.atan2(goal.x)
+            } else {
+                yaw
+            },
+        }))
+    }
+
+    /// Takes a scan from `vehicle`'s pose against the true static shapes if one is due at `t`
+    /// (see the module docs), into the map.
+    ///
+    /// # Errors
+    /// [`FlightError::Sensing`] for a pose the sensor rejects (non-finite, out of scale).
+    pub fn sense(
+        &mut self,
+        t: f64,
+        dt: f64,
+        vehicle: &VehicleState,
+        world: &World,
+    ) -> Result<(), FlightError> {
+        if t + 0.5 * dt < self.next_t {
+            return Ok(());
+        }
+        self.next_t += self.period_s;
+        let started = Instant::now();
+        let pose = Pose::new(vehicle.p, vehicle.attitude);
+        self.sensor.scan(
+            &pose,
+            &Truth::static_only(world.truth_map()),
+            &mut self.rng,
+            &mut self.scan,
+        )?;
+        let map = Arc::make_mut(&mut self.map);
+        map.recentre(&vehicle.p)?;
+        map.insert_scan(&self.scan)?;
+        map.assume_free(&vehicle.p, self.body_m);
+        self.dirty = true;
+        self.map_ms += started.elapsed().as_secs_f64() * 1e3;
+        Ok(())
+    }
+
+    /// The planner's map for a cycle: rebuilt if a scan came in since the last cycle.
+    ///
+    /// # Errors
+    /// [`FlightError::Sensing`] if the map cannot be exported.
+    pub fn planner_map(&mut self) -> Result<Arc<StaticMap>, FlightError> {
+        if self.dirty {
+            let started = Instant::now();
+            self.planner_map = Arc::new(self.map.to_static_map(self.bounds)?);
+            self.dirty = false;
+            self.map_ms += started.elapsed().as_secs_f64() * 1e3;
+        }
+        Ok(Arc::clone(&self.planner_map))
+    }
+
+    /// The map's time since the last call (ms): scans, insertions and exports.
+    pub fn take_map_ms(&mut self) -> f64 {
+        std::mem::take(&mut self.map_ms)
+    }
+
+    /// The commit check on the current map ([`KnownFree`]). Drop it (the manager's
+    /// `set_commit_check(None)`) before the next scan, or the scan copies the map.
+    pub fn commit_check(&self) -> Arc<dyn CommitCheck> {
+        Arc::new(KnownFree {
+            map: Arc::clone(&self.map),
+            clearance_m: self.clearance_m,
+        })
+    }
+
+    /// The online map.
+    pub fn map(&self) -> &LocalMap {
+        &self.map
+    }
+
+    /// Points the camera after a cycle: toward the best branch one [`LOOK_AHEAD_S`] ahead of
+    /// `t`, else toward `goal` (unchanged when the vehicle is above either).
+    pub fn aim(&mut self, t: f64, p: &Vec3, goal: &Vec3, manager: &AnyManager) {
+        let best = manager
+            .main()
+            .and_then(|id| manager.branches().iter().find(|b| b.id == id))
+            .or(manager.branches().first());
+        let ahead = best.map(|b| b.traj().position(t + LOOK_AHEAD_S) - p);
+        let toward = ahead.filter(|d| d.xy().norm() > 0.05).unwrap_or(goal - p);
+        if toward.xy().norm() > 0.05 {
+            self.target_yaw = toward.y.atan2(toward.x);
+        }
+    }
+
+    /// The commanded yaw after one physics step `dt`: turned toward the target at most
+    /// [`YAW_RATE_RAD_S`].
+    pub fn turn(&mut self, dt: f64) -> f64 {
+        let mut d = self.target_yaw - self.yaw;
+        d = (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        let step = YAW_RATE_RAD_S * dt;
+        self.yaw += d.clamp(-step, step);
+        self.yaw = (self.yaw + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        self.yaw
+    }
+}
+
+/// The commit check of a sensed map: a segment passes if every voxel within the vehicle's
+/// radius of it is observed free (`LocalMap::segment_known_free`).
+pub struct KnownFree {
+    map: Arc<LocalMap>,
+    clearance_m: f64,
+}
+
+impl CommitCheck for KnownFree {
+    fn name(&self) -> &str {
+        "known free"
+    }
+
+    fn segment_free(&self, a: &Vec3, b: &Vec3) -> bool {
+        self.map.segment_known_free(a, b, self.clearance_m)
+    }
+}

@@ -1,0 +1,126 @@
+//! Flying where the static map is not given (issue 34): a small scene sensed by a coarse depth
+//! camera, flown closed loop. The vehicle must arrive without touching the wall it only learns
+//! about on the way, and every cycle must log the online map's time.
+
+use std::path::Path;
+
+use trust_flight::map_sensing::MapSensing;
+use trust_flight::scenario::Scenario;
+use trust_flight::{FlightError, RunOptions, fly};
+use trust_runlog::{RunLog, Status};
+use trust_world::World;
+use trust_world::error::WorldError;
+
+/// A 10 × 6 × 3 m room, a full-height wall across most of it 4 m ahead of the start (the way
+/// round is its open end at y > 4), a 48 × 36 depth camera reaching 4 m into 0.15 m voxels, and
+/// a slow vehicle of radius 0.1 m.
+const SCENE: &str = r#"
+name = "unknown_small_wall"
+description = "A wall learnt on the way: 10 x 6 x 3 m, depth camera, known-free commitment."
+seed = 3
+time_limit_s = 30.0
+
+[world]
+bounds = { min = [0, 0, 0], max = [10, 6, 3] }
+
+[[static.shapes]]
+kind = "box"
+min = [4.0, 0.0, 0.0]
+max = [4.3, 4.0, 3.0]
+
+[mission]
+start = [1.0, 2.0, 1.5]
+goal = [8.0, 2.0, 1.5]
+goal_tolerance_m = 0.3
+
+[vehicle]
+radius_m = 0.1
+limits = { v_max = 1.5, a_max = 3.0 }
+
+[planner]
+name = "trust"
+
+[sensing]
+static = { depth = { width = 48, height = 36, max_depth_m = 4.0, rate_hz = 10.0, map = { resolution_m = 0.15 } } }
+"#;
+
+fn scene() -> Scenario {
+    Scenario::from_toml_str(SCENE, Path::new("unknown_map.rs")).expect("the scene parses")
+}
+
+#[test]
+fn a_wall_sensed_on_the_way_is_flown_round_without_contact() {
+    let s = scene();
+    assert!(s.validate().is_empty(), "{:?}", s.validate());
+    let world = World::build(&s).expect("world");
+    let dir = std::env::temp_dir().join(format!("trust-flight-unknown-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log_path = dir.join("run.jsonl");
+    let options = RunOptions {
+        log_path: Some(log_path.clone()),
+        ..RunOptions::default()
+    };
+    let flight = fly(
+        &world,
+        &trust_flight::scenario::resolve_planner(&s),
+        &options,
+        |_| {},
+    )
+    .expect("flight");
+    let outcome = &flight.summary.outcome;
+    assert_eq!(outcome.status, Status::Arrived, "{outcome:?}");
+    assert!(outcome.min_clearance_static_m > 0.0, "{outcome:?}");
+    let log = RunLog::read(&log_path).expect("log reads");
+    assert!(log.cycles.iter().all(|c| c.map_ms.is_some()));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_sensing_values_are_problems_naming_the_field_and_typed_errors_in_flight() {
+    let mut s = scene();
+    s.sensing.static_map = toml::from_str::<Wrap>("static = { depth = { rate_hz = 0.0 } }")
+        .expect("parses")
+        .s;
+    let problems = s.validate();
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.field == "sensing.static.depth.rate_hz"),
+        "{problems:?}"
+    );
+    assert!(rejected(&s), "a 0 Hz camera was accepted");
+    for bad in [
+        "static = { depth = { map = { resolution_m = -0.1 } } }",
+        "static = { depth = { map = { dims = [1, 10, 10] } } }",
+        "static = { lidar = { channels = 0 } }",
+        "static = { depth = { vfov_rad = 4.0 } }",
+    ] {
+        s.sensing.static_map = toml::from_str::<Wrap>(bad).expect("parses").s;
+        assert!(!s.validate().is_empty(), "{bad}");
+        assert!(rejected(&s), "{bad}");
+    }
+    // Known: no online map.
+    s.sensing.static_map = Default::default();
+    assert!(
+        MapSensing::new(&World::build(&s).expect("world"))
+            .unwrap()
+            .is_none()
+    );
+}
+
+/// Whether building the world or its online map refuses `s` with a typed error (never a panic).
+fn rejected(s: &Scenario) -> bool {
+    match World::build(s) {
+        Err(WorldError::Invalid { problems, .. }) => problems
+            .iter()
+            .any(|p| p.field.starts_with("sensing.static")),
+        Err(_) => false,
+        Ok(world) => matches!(MapSensing::new(&world), Err(FlightError::Sensing(_))),
+    }
+}
+
+#[derive(serde::Deserialize)]
+struct Wrap {
+    #[serde(rename = "static")]
+    s: trust_world::map_sensing::StaticSensing,
+}
