@@ -76,7 +76,9 @@ pub use report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackKind, FallbackReport, FrontendReport,
     GoalUnreachable, LimitExcess, Origin, RouteReason, STUB_FRACTION, StepReport, SwitchReason,
 };
-pub use routing::{RECHECK_S, ROUTE_WORK_PER_CYCLE, Router};
+pub use routing::{
+    IN_CYCLE_CHUNKS, RECHECK_S, ROUTE_DEADLINE_FRACTION, ROUTE_WORK_PER_CYCLE, Router,
+};
 pub use safety::{Hit, SafetyVerdict, Violation, assess_trajectory, check_trajectory};
 /// Why a goal cannot be reached ([`Event::GoalUnreachable`], [`GoalUnreachable`]).
 pub use trust_route::UnreachableCause;

@@ -25,7 +25,7 @@ use crate::safety::{
 use trust_route::{GlobalRoute, RoutePoint, RouteProgress, UnreachableCause};
 
 use crate::report::RouteReason;
-use crate::routing::{Router, SearchSlot, TakenBack, rerouted};
+use crate::routing::{ROUTE_DEADLINE_FRACTION, Router, SearchSlot, TakenBack, rerouted};
 
 mod worker;
 use worker::{Job, JobInput, JobOutput};
@@ -630,7 +630,12 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     fn awaiting_first_route(&self, measured: &State) -> bool {
         self.route.is_none()
             && matches!(self.route_search, Some((RouteReason::First, _)))
-            && measured.v.norm() <= REST_SPEED_FRACTION * self.limits.v_max
+            && self.at_rest(measured)
+    }
+
+    /// Whether the vehicle is at rest ([`REST_SPEED_FRACTION`] of its top speed).
+    fn at_rest(&self, measured: &State) -> bool {
+        measured.v.norm() <= REST_SPEED_FRACTION * self.limits.v_max
     }
 
     /// Sets the verdict for a goal outside the bounds or inside a static obstacle (kept with its
@@ -734,19 +739,30 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             }
         }
         let off_cycle = self.route_off_cycle(scene);
+        let at_rest = self.at_rest(measured);
         let Some((reason, SearchSlot::Here(search))) = self.route_search.as_mut() else {
             return;
         };
         let reason = *reason;
+        // A vehicle at rest waiting for its first route loses nothing by waiting one cycle
+        // more: with a map the threads can read, even the first slice is done between cycles.
+        let first_at_rest = reason == RouteReason::First && at_rest;
         let answer = match away_answer {
             Some(answer) => answer,
-            // The cycle that starts a search does its first slice (most routes are found
-            // there, before the vehicle has waited a cycle); with a map the threads can read,
-            // the later slices are done between cycles (sent away as the cycle ends), else
-            // each cycle does a slice itself.
-            None if started_now || !off_cycle => {
-                let work = router.work_per_cycle();
-                match spans.time(Span::Route, || search.advance(scene.map, work)) {
+            // The cycle that starts a search in flight does its first slice (most routes are
+            // found there, before the vehicle has flown a cycle on the old one); with a map
+            // the threads can read, the later slices are done between cycles (sent away as
+            // the cycle ends), else each cycle does a slice itself.
+            None if (started_now && !(first_at_rest && off_cycle)) || !off_cycle => {
+                let deadline = self.params.enforce_budget.then(|| {
+                    spans.started
+                        + Duration::from_secs_f64(
+                            ROUTE_DEADLINE_FRACTION * self.params.cycle_budget_ms * 1e-3,
+                        )
+                });
+                match spans.time(Span::Route, || {
+                    router.slice_in_cycle(search, scene.map, deadline)
+                }) {
                     RouteProgress::Pending => return,
                     answer => answer,
                 }

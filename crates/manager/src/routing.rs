@@ -10,7 +10,11 @@
 //! * a search ([`trust_route::RouteSearch`]) starts on the first cycle toward a goal (and
 //!   whenever the goal moves), on a stall, and on a re-check;
 //! * the cycle that starts a search does its first slice, at most [`Router::work_per_cycle`]
-//!   units (most routes are found there); a search that needs more goes on off the cycle's
+//!   units (most routes are found there), cut short at [`ROUTE_DEADLINE_FRACTION`] of the
+//!   cycle budget under a wall-clock deadline ([`Router::slice_in_cycle`]); a vehicle at rest
+//!   waiting for its first route leaves even that slice to the thread below (it holds its
+//!   place meanwhile, and a first cycle on a large map stays within its budget); a search
+//!   that needs more goes on off the cycle's
 //!   critical path: as a cycle ends the manager hands it to a thread of its own for
 //!   [`Router::work_off_cycle`] units, and the next cycle takes it back (it waits for it, so a
 //!   seed is one flight; the answer never depends on the slicing; in real time it takes the
@@ -123,6 +127,36 @@ impl Router {
         self
     }
 
+    /// A cycle's own slice of `search`: [`Router::work_per_cycle`] units, or with a wall-clock
+    /// `deadline` (real time, [`crate::ManagerParams::enforce_budget`]) the same work in
+    /// [`IN_CYCLE_CHUNKS`] chunks, stopping after the first chunk that ends past it. The search
+    /// resumes where it stopped (its answer never depends on the slicing), so the deadline only
+    /// moves work to the next slice; without one the work is the same on every machine.
+    pub fn slice_in_cycle(
+        &self,
+        search: &mut RouteSearch,
+        map: &StaticMap,
+        deadline: Option<Instant>,
+    ) -> RouteProgress {
+        let work = self.work_per_cycle;
+        let Some(deadline) = deadline else {
+            return search.advance(map, work);
+        };
+        let chunk = work.div_ceil(IN_CYCLE_CHUNKS).max(1);
+        let mut left = work;
+        loop {
+            let step = chunk.min(left);
+            let progress = search.advance(map, step);
+            left -= step;
+            if !matches!(progress, RouteProgress::Pending)
+                || left == 0
+                || Instant::now() >= deadline
+            {
+                return progress;
+            }
+        }
+    }
+
     /// Units of route-search work done between two cycles, off the cycle's critical path.
     pub fn work_off_cycle(&self) -> usize {
         self.work_off_cycle
@@ -146,6 +180,16 @@ impl Router {
 /// route arrives in about 8 cycles, a goal sealed in a 30 × 20 × 6 m box gets its verdict in
 /// about 10 (decision 0019).
 pub const ROUTE_WORK_PER_CYCLE: usize = 8_000;
+
+/// The chunks a cycle's own slice is cut into under a wall-clock deadline
+/// ([`Router::slice_in_cycle`]): 32, so the deadline is overrun by at most one chunk (250 units,
+/// 0.25–0.75 ms at 1–3 µs a unit, when the thread is not descheduled).
+pub const IN_CYCLE_CHUNKS: usize = 32;
+
+/// The share of the cycle budget a cycle's own route slice may take under a wall-clock
+/// deadline ([`crate::ManagerParams::enforce_budget`]): the route comes first in a cycle, the
+/// frontend and the solves need the rest ([`crate::SOLVE_DEADLINE_FRACTION`] of it).
+pub const ROUTE_DEADLINE_FRACTION: f64 = 0.3;
 
 /// Default [`Router::work_off_cycle`]: 24 000 units, 15–70 ms on a thread of its own between two
 /// cycles of a 100 ms period (a unit costs 0.6–3 µs), so a search never makes a cycle late at
@@ -250,5 +294,64 @@ pub(crate) fn rerouted(reason: RouteReason, route: &GlobalRoute) -> Event {
         reason,
         length_m: route.length(),
         vertex_count: route.points().len(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use trust_route::scenes::{E4_START_GOAL, e4_like};
+
+    fn ends() -> (Vec3, Vec3) {
+        let [s, g] = E4_START_GOAL;
+        (Vec3::from(s), Vec3::from(g))
+    }
+
+    fn finish(search: &mut RouteSearch, map: &StaticMap) -> RouteProgress {
+        loop {
+            match search.advance(map, ROUTE_WORK_OFF_CYCLE) {
+                RouteProgress::Pending => continue,
+                answer => return answer,
+            }
+        }
+    }
+
+    #[test]
+    fn a_passed_deadline_stops_the_slice_after_one_chunk_and_changes_no_answer() {
+        let map = e4_like(3, true).unwrap();
+        let (s, g) = ends();
+        let router = Router::new(RouteParams::default(), 0.3).unwrap();
+        let chunk = router.work_per_cycle().div_ceil(IN_CYCLE_CHUNKS);
+
+        let mut cut = router.start(&map, &s, &g).unwrap();
+        let first = router.slice_in_cycle(&mut cut, &map, Some(Instant::now()));
+        assert_eq!(first, RouteProgress::Pending);
+        assert_eq!(cut.work_done(), chunk);
+
+        let mut whole = router.start(&map, &s, &g).unwrap();
+        let unguarded = router.slice_in_cycle(&mut whole, &map, None);
+        if unguarded == RouteProgress::Pending {
+            assert_eq!(whole.work_done(), router.work_per_cycle());
+        }
+        let (a, b) = (finish(&mut cut, &map), finish(&mut whole, &map));
+        assert!(matches!(a, RouteProgress::Found(_)), "{a:?}");
+        assert_eq!(a, b);
+        assert_eq!(cut.work_done(), whole.work_done());
+    }
+
+    #[test]
+    fn a_far_deadline_does_the_whole_slice() {
+        let map = e4_like(3, true).unwrap();
+        let (s, g) = ends();
+        let router = Router::new(RouteParams::default(), 0.3)
+            .unwrap()
+            .with_work_per_cycle(3_000);
+        let far = Instant::now() + Duration::from_secs(3600);
+        let mut guarded = router.start(&map, &s, &g).unwrap();
+        let mut plain = router.start(&map, &s, &g).unwrap();
+        let a = router.slice_in_cycle(&mut guarded, &map, Some(far));
+        let b = router.slice_in_cycle(&mut plain, &map, None);
+        assert_eq!(a, b);
+        assert_eq!(guarded.work_done(), plain.work_done());
     }
 }
