@@ -33,6 +33,7 @@ use serde::{Deserialize, Serialize};
 use trust_flight::scenario::Scenario;
 use trust_planner::PlannerPreset;
 use trust_runlog::{StateRecord, Status};
+use trust_world::map_sensing::{DepthSpec, StaticSensing};
 use trust_world::scenario::{DynamicForestParams, GeneratorSpec, Latency, VehicleModel};
 use trust_world::{World, WorldError};
 
@@ -111,6 +112,11 @@ pub enum StaticMode {
     /// `known`: the planner is given the pillars' and bars' true shapes.
     #[default]
     Known,
+    /// `unknown`: the pillars and bars are not given; the vehicle's depth camera senses them
+    /// into an online map (`[sensing.static] = { depth = {} }`, the camera's defaults, unless the
+    /// scenario names its own sensor). The peers' "unknown" setting builds the map from a depth
+    /// or LiDAR point cloud as well.
+    Unknown,
 }
 
 impl FromStr for StaticMode {
@@ -119,16 +125,11 @@ impl FromStr for StaticMode {
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s.trim() {
             "known" => Ok(StaticMode::Known),
-            "unknown" => Err(ExperimentError::input(
-                "--static",
-                "`unknown`",
-                "`known`: the unknown-static mode (obstacles sensed from a point cloud, the \
-                 peers' \"unknown dynamic\" setting) is not implemented yet",
-            )),
+            "unknown" => Ok(StaticMode::Unknown),
             other => Err(ExperimentError::input(
                 "--static",
                 format!("`{other}`"),
-                "`known` (the only mode implemented)",
+                "`known` or `unknown`",
             )),
         }
     }
@@ -230,6 +231,12 @@ impl ForestConfig {
         match self.static_mode {
             // The generator's shapes are the planner's map (no point cloud).
             StaticMode::Known => s.static_map.point_cloud = None,
+            StaticMode::Unknown => {
+                s.static_map.point_cloud = None;
+                if s.sensing.static_map == StaticSensing::Known {
+                    s.sensing.static_map = StaticSensing::Depth(DepthSpec::default());
+                }
+            }
         }
         s.planner.name = planner;
         s.planner.frontend = None;
@@ -731,6 +738,7 @@ pub fn report_md(config: &ForestConfig, limits: &ScoreLimits, summary: &[ForestS
         config.seed,
         match config.static_mode {
             StaticMode::Known => "known",
+            StaticMode::Unknown => "unknown (depth camera, online map)",
         },
         limits.v_max,
         limits.a_max,
@@ -882,10 +890,9 @@ mod tests {
         let e = Tier::parse_list("extreme").unwrap_err().to_string();
         assert!(e.contains("--tier") && e.contains("extreme"), "{e}");
         assert_eq!("known".parse::<StaticMode>().unwrap(), StaticMode::Known);
-        let e = "unknown".parse::<StaticMode>().unwrap_err().to_string();
-        assert!(
-            e.contains("--static") && e.contains("not implemented yet"),
-            "{e}"
+        assert_eq!(
+            "unknown".parse::<StaticMode>().unwrap(),
+            StaticMode::Unknown
         );
         let e = "partial".parse::<StaticMode>().unwrap_err().to_string();
         assert!(e.contains("partial"), "{e}");

@@ -257,8 +257,8 @@ enum Cmd {
         /// The scenario (its generator must be `dynamic-forest`; the tier sets its count).
         #[arg(long, default_value = "scenarios/dynamic_forest.toml")]
         scenario: PathBuf,
-        /// What the planner knows of the static obstacles: known (their true shapes). The
-        /// unknown mode (a sensed point cloud) is not implemented yet.
+        /// What the planner knows of the static obstacles: known (their true shapes) or unknown
+        /// (sensed by the vehicle's depth camera into an online map).
         #[arg(long = "static", default_value = "known")]
         static_mode: String,
         /// Simulated time limit per flight (s), replacing the scenario's 100 s.

@@ -10,6 +10,7 @@ use trust_topo_prm::{UvdParams, VprmParams};
 use crate::ExperimentError;
 use trust_flight::scenario::Scenario;
 use trust_planner::{BackendSpec, CheckerSpec, FrontendSpec};
+use trust_world::map_sensing::{DepthSpec, StaticSensing};
 use trust_world::scenario::{Latency, MAX_CPU_SCALE, VehicleModel};
 
 /// An ablation: one component changed for every planner it concerns (the others fly as they
@@ -60,13 +61,17 @@ pub enum Variant {
     /// ticks (`sim.latency = { kind = "measured", cpu_scale = X }`). Machine-dependent: fly it
     /// with `--jobs 1` on a quiet machine.
     RealTime(f64),
+    /// `unknown`: the static map is not given; the vehicle's depth camera senses it into an
+    /// online map (`[sensing.static] = { depth = {} }`, the camera's defaults; issue 34). A
+    /// scenario that already senses it keeps its sensor.
+    Unknown,
 }
 
 impl Variant {
     /// Every variant name, for help texts.
     pub const NAMES: &'static str = "none, vprm, minco, uvd, no-pdc, no-ggs, no-history, \
                                      no-hysteresis, no-worker, perfect, quadrotor, mu=X, fault=X, \
-                                     explore=K, route, real-time, real-time=X";
+                                     explore=K, route, real-time, real-time=X, unknown";
 
     /// Applies the variant to `scenario` (whose planner preset is already chosen): replaces the
     /// preset's part it concerns, or the scenario section it sweeps.
@@ -137,6 +142,11 @@ impl Variant {
             Variant::Explore(k) => manager_overrides(planner).explore_period_cycles = Some(k),
             Variant::Route => planner.route.enabled = true,
             Variant::RealTime(x) => scenario.sim.latency = Latency::real_time(x),
+            Variant::Unknown => {
+                if scenario.sensing.static_map == StaticSensing::Known {
+                    scenario.sensing.static_map = StaticSensing::Depth(DepthSpec::default());
+                }
+            }
         }
         Ok(())
     }
@@ -169,6 +179,7 @@ impl fmt::Display for Variant {
             Variant::Route => f.write_str("route"),
             Variant::RealTime(x) if *x == 1.0 => f.write_str("real-time"),
             Variant::RealTime(x) => write!(f, "real-time={x}"),
+            Variant::Unknown => f.write_str("unknown"),
         }
     }
 }
@@ -201,6 +212,7 @@ impl FromStr for Variant {
             "perfect" => Variant::Perfect,
             "quadrotor" => Variant::Quadrotor,
             "real-time" => Variant::RealTime(1.0),
+            "unknown" => Variant::Unknown,
             t => match t.split_once('=') {
                 Some(("mu", v)) => Variant::Mu(number(v, "mu")?),
                 Some(("fault", v)) => Variant::Fault(number(v, "fault")?),
@@ -282,6 +294,7 @@ mod tests {
             "route",
             "real-time",
             "real-time=3",
+            "unknown",
         ] {
             let v: Variant = name.parse().unwrap();
             assert_eq!(v.to_string(), name);
@@ -336,6 +349,8 @@ mod tests {
             s.sensing.ekf.sigma_scale,
             2.0 * base.sensing.ekf.sigma_scale
         );
+        let (_, s) = resolved(Variant::Unknown);
+        assert!(matches!(s.sensing.static_map, StaticSensing::Depth(_)));
         let (r, s) = resolved(Variant::None);
         assert_eq!(r, base.planner.resolve());
         assert_eq!(s, base);
