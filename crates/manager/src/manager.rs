@@ -217,6 +217,9 @@ pub struct Manager<F, B, H> {
     branches: Vec<Branch>,
     main: Option<BranchId>,
     committed: Option<PolyTraj>,
+    /// The kind of fallback [`Manager::committed`] is, if it is one (`None` once a branch is
+    /// committed): the next fallback may continue it ([`Manager::fallback_options`]).
+    committed_fallback: Option<FallbackKind>,
     next_id: BranchId,
     cycle_count: u64,
     progress: ProgressMonitor,
@@ -284,6 +287,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             branches: Vec::new(),
             main: None,
             committed: None,
+            committed_fallback: None,
             next_id: 0,
             progress: ProgressMonitor::default(),
             route: None,
@@ -469,6 +473,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         self.branches.clear();
         self.main = None;
         self.committed = None;
+        self.committed_fallback = None;
     }
 
     /// Runs one cycle of Algorithm 1 at time `now` with the measured vehicle state (taken at
@@ -1349,6 +1354,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             match self.outside_known_free(&main.solution.traj, cycle) {
                 None => {
                     self.committed = Some(main.solution.traj.clone());
+                    self.committed_fallback = None;
                     self.main = Some(main.id);
                     return None;
                 }
@@ -1622,7 +1628,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         events: &mut Vec<Event>,
     ) -> Option<FallbackReport> {
         let hold_s = self.params.brake_hold();
-        let mut options = self.fallback_options(start, reanchored, rejected, hold_s);
+        let (mut options, continued) = self.fallback_options(start, reanchored, rejected, hold_s);
         // The options are judged against the forecasts grown for at most a quarter of the
         // horizon (the scene's forecasts already stop growing after `forecast_growth`, 0.25 s
         // by default; this cap matters when that is longer, e.g. the paper's growth for ever)
@@ -1641,7 +1647,8 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         };
         let (mut best, verdicts) = self.first_clear_fallback(&options, start, &judged);
         if best.as_ref().is_some_and(|(_, v)| v.violation.is_some())
-            && let Some(i) = self.widest_likely_fallback(&options, &verdicts, start, scene)
+            && let Some(i) =
+                self.widest_likely_fallback(&options, &verdicts, start, scene, continued)
         {
             // Reported against the forecasts (its shortfall is theirs).
             best = Some((i, verdicts[i]));
@@ -1656,6 +1663,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             min_margin_m: verdict.min_margin_m(),
         });
         self.committed = Some(traj);
+        self.committed_fallback = Some(along);
         Some(FallbackReport {
             along,
             collision_free,
@@ -1670,15 +1678,16 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     }
 
     /// The fallback's options, in the order they are tried: braking along the committed plan
-    /// (unless re-anchored) and along each rejected trajectory, braking straight, the rejected
-    /// trajectories flown as they are (evade), then the escapes and the dashes.
+    /// (unless re-anchored) and along each rejected trajectory, braking straight, the committed
+    /// evade, escape or dash flown on (unless re-anchored; its index is returned too), the
+    /// rejected trajectories flown as they are (evade), then the escapes and the dashes.
     fn fallback_options(
         &self,
         start: &State,
         reanchored: bool,
         rejected: &[(FallbackKind, PolyTraj)],
         hold_s: f64,
-    ) -> Vec<(FallbackKind, PolyTraj)> {
+    ) -> (Vec<(FallbackKind, PolyTraj)>, Option<usize>) {
         let a_max = self.limits.a_max;
         let mut options: Vec<(FallbackKind, PolyTraj)> = Vec::new();
         if let Some(plan) = self.committed.as_ref().filter(|_| !reanchored)
@@ -1693,6 +1702,21 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         }
         if let Ok(b) = brake_straight(start, a_max, hold_s) {
             options.push((FallbackKind::Straight, b));
+        }
+        // The manoeuvre the last fallback chose, flown on: chosen afresh every cycle from a
+        // new start, the options alternated (dash, evade, escape in turn in a room with a
+        // pacing person) and the vehicle went nowhere while the person came on.
+        let mut continued = None;
+        if let (Some(kind), Some(plan)) = (
+            self.committed_fallback,
+            self.committed.as_ref().filter(|_| !reanchored),
+        ) && matches!(
+            kind,
+            FallbackKind::Evade | FallbackKind::Escape | FallbackKind::Dash
+        ) && plan.t_end() > start.t
+        {
+            continued = Some(options.len());
+            options.push((kind, plan.clone()));
         }
         // Beyond the paper: the rejected trajectories flown as they are. Braking is the answer
         // to an obstacle ahead, not to one walking into a vehicle at rest (the suite's rooms with
@@ -1724,7 +1748,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         if let Ok(dashes) = dash_maneuvers(start, &directions, cruise_s, &self.limits, hold_s) {
             options.extend(dashes.into_iter().map(|t| (FallbackKind::Dash, t)));
         }
-        options
+        (options, continued)
     }
 
     /// The safety verdict on a fallback option from `start` to its end.
@@ -1800,6 +1824,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         verdicts: &[SafetyVerdict],
         start: &State,
         scene: &Scene<'_>,
+        continued: Option<usize>,
     ) -> Option<usize> {
         let likely: [Vec<Forecast>; 2] = [
             scene
@@ -1824,7 +1849,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             };
             // The clear option with the widest margin (the first clear one braked to rest
             // 3 cm outside a person's likely lane, and the person was not quite there).
-            let widest = options
+            let clear: Vec<(usize, f64)> = options
                 .iter()
                 .enumerate()
                 .filter(|(i, (kind, traj))| self.admissible_fallback(*kind, traj, &verdicts[*i]))
@@ -1832,10 +1857,21 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                     let v = self.assess_fallback(traj, start, &level);
                     v.violation.is_none().then(|| (i, v.min_margin_m()))
                 })
+                .collect();
+            let widest = clear
+                .iter()
+                .copied()
                 .fold(None, |acc: Option<(usize, f64)>, (i, m)| match acc {
                     Some((_, best)) if best >= m => acc,
                     _ => Some((i, m)),
                 });
+            // Hysteresis: the manoeuvre under way stays while it is nearly as wide.
+            let kept = continued.and_then(|c| clear.iter().find(|(i, _)| *i == c).copied());
+            if let (Some((c, mc)), Some((_, mw))) = (kept, widest)
+                && mc >= mw - FALLBACK_HYSTERESIS_M
+            {
+                return Some(c);
+            }
             if let Some((i, _)) = widest {
                 return Some(i);
             }
@@ -1843,6 +1879,11 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         None
     }
 }
+
+/// How much narrower (m) than the widest option the fallback manoeuvre under way may be and
+/// still be flown on ([`Manager`]'s fallback): about what a person walking at 1 m/s covers in
+/// one 0.1 s cycle.
+const FALLBACK_HYSTERESIS_M: f64 = 0.1;
 
 /// The fallback judges its options against the forecasts grown for this fraction of the horizon
 /// (1 s at 4 s) and then held ([`Manager`]'s fallback).

@@ -883,6 +883,48 @@ fn with_no_way_clear_of_the_forecasts_the_fallback_steps_out_of_the_likely_path(
     assert!(aside > 0.0, "{} came within {aside:.3} m", fallback.along);
 }
 
+/// The fallback's hysteresis: with no way clear of the forecasts, the next cycle flies on the
+/// manoeuvre the last one chose (from the state that manoeuvre predicted) while it stays clear
+/// of the likely path and nearly as wide as the best new one, instead of choosing afresh (a room
+/// with a pacing person: dash, evade and escape in turn, and the vehicle went nowhere).
+#[test]
+fn the_fallback_flies_on_the_manoeuvre_under_way() {
+    let map = open_air();
+    let mut m = blind_single_branch_at_room_limits();
+    let person = [Forecast::new(
+        ObstacleShape::Sphere,
+        Vec3::new(47.0, 0.0, 5.0),
+        Vec3::new(1.5, 0.0, 0.0),
+        0.0,
+        0.3,
+        1.5,
+        0.6,
+    )
+    .unwrap()];
+    let goal = Vec3::new(95.0, 0.0, 5.0);
+    let scene = Scene::new(&map, &person, 0.0).unwrap();
+    let start = State::at_rest(0.0, Vec3::new(50.0, 0.0, 5.0));
+    let first = m.step(0.0, &start, &goal, &scene).unwrap();
+    let first = first.fallback.expect("every branch collides");
+    assert!(!first.collision_free, "{first:?}");
+    let plan = m.plan().unwrap().clone();
+    let t = 0.1;
+    let on_plan = State {
+        t,
+        ..plan.state(t)
+    };
+    let scene = Scene::new(&map, &person, t).unwrap();
+    let second = m.step(t, &on_plan, &goal, &scene).unwrap();
+    let second = second.fallback.expect("still no branch");
+    assert_eq!(second.along, first.along);
+    let flown_on = m.plan().unwrap();
+    for k in 0..=20 {
+        let s = t + (plan.t_end() - t) * f64::from(k) / 20.0;
+        let gap = (flown_on.position(s) - plan.position(s)).norm();
+        assert!(gap < 1e-9, "{gap} m off the manoeuvre at t = {s}");
+    }
+}
+
 /// A frontend that never finds a path.
 struct Nothing;
 
