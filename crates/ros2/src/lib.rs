@@ -46,6 +46,7 @@
 #![warn(missing_docs)]
 
 pub mod cdr;
+pub mod cloud;
 pub mod convert;
 pub mod dds;
 pub mod dds_world;
@@ -54,6 +55,7 @@ pub mod heading;
 pub mod msg;
 pub mod node_core;
 pub mod params;
+pub mod sensing;
 #[doc(hidden)]
 pub mod test_support;
 pub mod tracker;
