@@ -209,7 +209,12 @@ pub fn encode_points(
         })
         .collect::<Result<Vec<_>, _>>()?;
     let spans: Vec<(usize, usize)> = (0..3)
-        .map(|i| (layout.offsets[i] as usize, layout.offsets[i] as usize + sizes[i]))
+        .map(|i| {
+            (
+                layout.offsets[i] as usize,
+                layout.offsets[i] as usize + sizes[i],
+            )
+        })
         .collect();
     for (i, &(a, b)) in spans.iter().enumerate() {
         if b > layout.point_step as usize {
@@ -320,8 +325,13 @@ mod tests {
             prop::bool::ANY,
         )
             .prop_map(|(f64s, order, gaps, tail, row_padding, height, big)| {
-                let datatypes =
-                    f64s.map(|b| if b { PointField::FLOAT64 } else { PointField::FLOAT32 });
+                let datatypes = f64s.map(|b| {
+                    if b {
+                        PointField::FLOAT64
+                    } else {
+                        PointField::FLOAT32
+                    }
+                });
                 let mut offsets = [0u32; 3];
                 let mut at = 4; // an intensity first
                 for (k, &axis) in order.iter().enumerate() {

@@ -940,12 +940,23 @@ mod tests {
             assert_eq!(map.state(&p), VoxelState::Occupied, "{p:?}");
         }
         for y in [11.55, 12.55, 13.55] {
-            assert_eq!(map.state(&Vec3::new(2.05, y, 3.05)), VoxelState::Free, "y {y}");
+            assert_eq!(
+                map.state(&Vec3::new(2.05, y, 3.05)),
+                VoxelState::Free,
+                "y {y}"
+            );
         }
-        assert_eq!(map.state(&Vec3::new(4.05, 12.05, 3.05)), VoxelState::Unknown);
+        assert_eq!(
+            map.state(&Vec3::new(4.05, 12.05, 3.05)),
+            VoxelState::Unknown
+        );
         let c = core.counters();
         assert_eq!(
-            (c.cloud_count, c.cloud_point_count, c.cloud_skipped_point_count),
+            (
+                c.cloud_count,
+                c.cloud_point_count,
+                c.cloud_skipped_point_count
+            ),
             (1, 2, 1)
         );
         assert_eq!((c.rejected_count, c.cloud_rejected_count), (1, 1));
@@ -1047,7 +1058,9 @@ mod tests {
         plain.cycle(at(0.0)).expect("cycle").expect("ran");
         let plan = plain.manager().plan().expect("a plan");
         let crossing = (0..1000)
-            .map(|k| plan.position(plan.t_start() + (plan.t_end() - plan.t_start()) * k as f64 / 1000.0))
+            .map(|k| {
+                plan.position(plan.t_start() + (plan.t_end() - plan.t_start()) * k as f64 / 1000.0)
+            })
             .find(|p| p.x > 6.0)
             .expect("it passes x = 6");
         assert!((crossing.y - 10.0).abs() < 1.0, "{crossing:?}");

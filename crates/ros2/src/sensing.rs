@@ -203,7 +203,7 @@ impl PoseHistory {
         let pose = |p: Vec3, q| Isometry3::from_parts(Translation3::from(p), q);
         if t > last.t {
             let ahead = t - last.t;
-            if !(ahead <= ahead_s) {
+            if ahead > ahead_s {
                 return Err(Ros2Error::invalid(
                     "cloud.header.stamp",
                     format!("{ahead} s after the latest odometry"),
@@ -212,14 +212,11 @@ impl PoseHistory {
             }
             return Ok(pose(last.p + last.v * ahead, last.q));
         }
-        if !(t >= first.t) {
+        if t < first.t {
             return Err(Ros2Error::invalid(
                 "cloud.header.stamp",
                 format!("{} s before the latest odometry", last.t - t),
-                format!(
-                    "a stamp within the odometry kept ({} s)",
-                    last.t - first.t
-                ),
+                format!("a stamp within the odometry kept ({} s)", last.t - first.t),
             ));
         }
         let i = self.poses.partition_point(|k| k.t <= t).max(1) - 1;
@@ -272,6 +269,9 @@ pub fn cloud_scan(
         .collect();
     (Scan { origin, rays }, skipped)
 }
+
+/// A cycle's map and commit check ([`CloudMap::for_cycle`]).
+pub type CycleMap = (Arc<StaticMap>, Arc<dyn CommitCheck>);
 
 /// The node's point-cloud state: the parameters, the poses, and the online map from the first
 /// odometry on.
@@ -410,9 +410,7 @@ impl CloudMap {
     ///
     /// # Errors
     /// [`Ros2Error::Sensing`] if the map cannot be exported.
-    pub fn for_cycle(
-        &mut self,
-    ) -> Result<Option<(Arc<StaticMap>, Arc<dyn CommitCheck>)>, Ros2Error> {
+    pub fn for_cycle(&mut self) -> Result<Option<CycleMap>, Ros2Error> {
         let Some(online) = self.online.as_mut() else {
             return Ok(None);
         };
@@ -437,7 +435,11 @@ mod tests {
         h.push(0.5, Vec3::new(0.5, 0.0, 1.0), q1, Vec3::new(1.0, 0.0, 0.0));
         let mid = h.at(0.25, 0.5).expect("between");
         assert_relative_eq!(mid.translation.vector, Vec3::new(0.25, 0.0, 1.0));
-        assert_relative_eq!(mid.rotation.euler_angles().2, FRAC_PI_2 / 2.0, epsilon = 1e-12);
+        assert_relative_eq!(
+            mid.rotation.euler_angles().2,
+            FRAC_PI_2 / 2.0,
+            epsilon = 1e-12
+        );
         let ahead = h.at(0.75, 0.5).expect("extrapolated");
         assert_relative_eq!(ahead.translation.vector, Vec3::new(0.75, 0.0, 1.0));
         assert_eq!(ahead.rotation, q1);

@@ -275,7 +275,10 @@ fn cyclone_point_clouds_decode_into_the_nodes_map_point_by_point() {
         peer_status.is_some_and(|s| s.success()),
         "the Cyclone DDS peer failed ({peer_status:?}); its log is above"
     );
-    assert_eq!(c.rejected_count, 0, "the node rejected messages of the peer");
+    assert_eq!(
+        c.rejected_count, 0,
+        "the node rejected messages of the peer"
+    );
     assert!(c.cloud_count >= 2, "{} clouds", c.cloud_count);
     // Each cloud has 3 points; each body cloud one NaN hole (3 points in 2 rows of 2), the
     // map clouds none.
@@ -288,7 +291,11 @@ fn cyclone_point_clouds_decode_into_the_nodes_map_point_by_point() {
         assert_eq!(map.state(&p), VoxelState::Occupied, "the point {p:?}");
         for f in [0.3, 0.5, 0.7, 0.85] {
             let q = start + (p - start) * f;
-            assert_eq!(map.state(&q), VoxelState::Free, "{f} of the way to {p:?}: {q:?}");
+            assert_eq!(
+                map.state(&q),
+                VoxelState::Free,
+                "{f} of the way to {p:?}: {q:?}"
+            );
         }
     }
 }
