@@ -394,8 +394,21 @@ impl DdsNode {
             warn(topics::TF, &Ros2Error::dds("publish tf", e));
         }
         if let Some((sub, name)) = &self.cloud {
-            // After the odometry: a cloud is placed by the odometry at its stamp.
-            drain(sub, name, warn, |m| core.on_cloud(&m));
+            // After the odometry: a cloud is placed by the odometry at its stamp. Only the
+            // newest waiting cloud is folded in; older ones are dropped and counted (a node
+            // behind its sensor catches up instead of mapping the past).
+            let mut newest = None;
+            let mut dropped = 0;
+            drain(sub, name, warn, |m| {
+                dropped += u64::from(newest.replace(m).is_some());
+                Ok(())
+            });
+            core.drop_clouds(dropped);
+            if let Some(m) = newest
+                && let Err(e) = core.on_cloud(&m)
+            {
+                warn(name, &e);
+            }
         }
         drain(&self.goal, topics::GOAL, warn, |m| core.on_goal(&m));
         drain(&self.obstacles, topics::OBSTACLES, warn, |m| {

@@ -61,6 +61,8 @@ pub struct NodeCounters {
     pub cloud_point_count: u64,
     /// Points of accepted clouds skipped: NaN or infinite, or at the sensor's origin.
     pub cloud_skipped_point_count: u64,
+    /// Clouds dropped unread because a newer one was waiting ([`NodeCore::drop_clouds`]).
+    pub cloud_dropped_count: u64,
 }
 
 /// The messages of one planning cycle.
@@ -268,6 +270,11 @@ impl NodeCore {
         self.counters.cloud_point_count += inserted as u64;
         self.counters.cloud_skipped_point_count += skipped as u64;
         Ok(())
+    }
+
+    /// Counts `n` clouds dropped unread (the DDS layer folds only the newest waiting one).
+    pub fn drop_clouds(&mut self, n: u64) {
+        self.counters.cloud_dropped_count += n;
     }
 
     fn insert_cloud(&mut self, msg: &PointCloud2) -> Result<(usize, usize), Ros2Error> {

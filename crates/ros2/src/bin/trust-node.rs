@@ -115,7 +115,7 @@ fn main() -> Result<()> {
     let c = core.counters();
     eprintln!(
         "trust-node: {} cycles, {} odometry, {} goals, {} obstacle messages, {} clouds ({} \
-         points, {} skipped), {} rejected",
+         points, {} skipped; {} dropped behind newer), {} rejected",
         c.cycle_count,
         c.odom_count,
         c.goal_count,
@@ -123,6 +123,7 @@ fn main() -> Result<()> {
         c.cloud_count,
         c.cloud_point_count,
         c.cloud_skipped_point_count,
+        c.cloud_dropped_count,
         c.rejected_count
     );
     Ok(())
