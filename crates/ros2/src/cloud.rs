@@ -393,6 +393,60 @@ mod tests {
         }
     }
 
+    /// Any header values over a short data buffer: mostly malformed.
+    fn arbitrary_cloud() -> impl Strategy<Value = PointCloud2> {
+        let field = (
+            prop_oneof![Just("x"), Just("y"), Just("z"), Just("rgb")],
+            prop_oneof![0u32..40, Just(u32::MAX - 3)],
+            0u8..10,
+            0u32..3,
+        )
+            .prop_map(|(name, offset, datatype, count)| PointField {
+                name: name.into(),
+                offset,
+                datatype,
+                count,
+            });
+        (
+            prop_oneof![0u32..5, Just(u32::MAX)],
+            prop_oneof![0u32..5, Just(u32::MAX)],
+            prop::collection::vec(field, 0..6),
+            prop::bool::ANY,
+            prop_oneof![0u32..40, Just(u32::MAX)],
+            prop_oneof![0u32..200, Just(u32::MAX)],
+            prop::collection::vec(prop::num::u8::ANY, 0..300),
+        )
+            .prop_map(
+                |(height, width, fields, is_bigendian, point_step, row_step, data)| PointCloud2 {
+                    header: header(),
+                    height,
+                    width,
+                    fields,
+                    is_bigendian,
+                    point_step,
+                    row_step,
+                    data,
+                    is_dense: false,
+                },
+            )
+    }
+
+    proptest! {
+        #[test]
+        fn any_cloud_decodes_or_is_a_typed_error_never_a_panic(msg in arbitrary_cloud()) {
+            match decode_points(&msg) {
+                Ok(d) => {
+                    prop_assert!(d.points.iter().all(|p| p.iter().all(|c| c.is_finite())));
+                    prop_assert_eq!(
+                        d.points.len() + d.skipped_count,
+                        msg.width as usize * msg.height as usize
+                    );
+                }
+                Err(e) => prop_assert!(matches!(e, Ros2Error::Invalid { .. }), "{e}"),
+            }
+        }
+    }
+
     fn field_of(e: &Ros2Error) -> String {
         match e {
             Ros2Error::Invalid { field, .. } => field.clone(),
