@@ -219,6 +219,8 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "trust-runlog",
                 "trust-flight",
                 "trust-flightstack",
+                // The node's online map from point clouds (`trust_ros2::sensing`).
+                "trust-sensing",
             ]),
         ),
         (

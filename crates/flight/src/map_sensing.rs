@@ -28,6 +28,9 @@
 //!   the obstacle trackers handle them, as with a known map.
 //! * **Cost.** The time of the scans, the insertions and the export is perception, not
 //!   planning: it is the cycle record's `map_ms`, not part of its `wall_ms`.
+//! * **Shared.** The map half ([`OnlineMap`]: the take-off ball, the insertion re-centred on
+//!   the vehicle with its body's ball, the export, the commit check) serves any source of scans:
+//!   the ROS 2 node feeds it point clouds (`trust_ros2::sensing`).
 //! * **Randomness.** The sensor noise comes from its own stream of the trial seed
 //!   (`mix_seed(seed, 5)`), so the same seed gives the same flight.
 
@@ -60,11 +63,24 @@ pub const NOISE_STREAM: u64 = 5;
 /// The online map of one flight and its sensor (module docs).
 pub struct MapSensing {
     sensor: Box<dyn RaySensor>,
-    map: Arc<LocalMap>,
+    online: OnlineMap,
     rng: ChaCha8Rng,
     scan: Scan,
     period_s: f64,
     next_t: f64,
+    /// The commanded yaw (rad).
+    yaw: f64,
+    /// The yaw it turns toward (rad).
+    target_yaw: f64,
+}
+
+/// The map half of [`MapSensing`], shared with any other source of scans (the ROS 2 node's
+/// point clouds, `trust_ros2`): a `LocalMap` started round the vehicle's first position with
+/// the take-off ball known free, fed scans re-centred on the vehicle with its body's ball known
+/// free after each, the planner's map exported when a scan came in since the last export, and
+/// the known-free commit check on it. Times its own work (`take_map_ms`).
+pub struct OnlineMap {
+    map: Arc<LocalMap>,
     bounds: trust_core::Aabb,
     planner_map: Arc<StaticMap>,
     dirty: bool,
@@ -72,10 +88,93 @@ pub struct MapSensing {
     /// The radius of the ball round the vehicle that counts as free at each scan (m).
     body_m: f64,
     map_ms: f64,
-    /// The commanded yaw (rad).
-    yaw: f64,
-    /// The yaw it turns toward (rad).
-    target_yaw: f64,
+}
+
+impl OnlineMap {
+    /// A map of `params` centred on `start` (the vehicle's position), exported over `bounds`
+    /// (the world's), for a vehicle of radius `radius_m` whose sensor cannot see within
+    /// `blind_reach_m` of it (`StaticSensor::blind_reach_m`): the ball round `start` of radius
+    /// `radius_m + blind_reach_m + voxel diagonal` starts known free, and after each scan the
+    /// ball of `radius_m + voxel diagonal` round the vehicle (module docs).
+    ///
+    /// # Errors
+    /// `SensingError` for invalid map parameters, a `start` out of scale or a map that cannot
+    /// be exported.
+    pub fn new(
+        params: trust_sensing::LocalMapParams,
+        start: &Vec3,
+        bounds: trust_core::Aabb,
+        radius_m: f64,
+        blind_reach_m: f64,
+    ) -> Result<Self, trust_sensing::SensingError> {
+        let mut map = LocalMap::new(params, start)?;
+        let diagonal = 3f64.sqrt() * params.resolution_m;
+        map.assume_free(start, radius_m + blind_reach_m + diagonal);
+        let planner_map = Arc::new(map.to_static_map(bounds)?);
+        Ok(OnlineMap {
+            map: Arc::new(map),
+            bounds,
+            planner_map,
+            dirty: false,
+            clearance_m: radius_m,
+            body_m: radius_m + diagonal,
+            map_ms: 0.0,
+        })
+    }
+
+    /// Re-centres the window on `vehicle` (the vehicle's position at the scan), folds `scan`
+    /// in, and marks the vehicle's body ball known free.
+    ///
+    /// # Errors
+    /// `SensingError` for a non-finite or out-of-scale position or a malformed scan (the map
+    /// is unchanged by a malformed scan).
+    pub fn insert(
+        &mut self,
+        scan: &Scan,
+        vehicle: &Vec3,
+    ) -> Result<trust_sensing::ScanUpdate, trust_sensing::SensingError> {
+        let started = Instant::now();
+        let map = Arc::make_mut(&mut self.map);
+        map.recentre(vehicle)?;
+        let update = map.insert_scan(scan)?;
+        map.assume_free(vehicle, self.body_m);
+        self.dirty = true;
+        self.map_ms += started.elapsed().as_secs_f64() * 1e3;
+        Ok(update)
+    }
+
+    /// The planner's map for a cycle: rebuilt if a scan came in since the last call.
+    ///
+    /// # Errors
+    /// `SensingError` if the map cannot be exported.
+    pub fn planner_map(&mut self) -> Result<Arc<StaticMap>, trust_sensing::SensingError> {
+        if self.dirty {
+            let started = Instant::now();
+            self.planner_map = Arc::new(self.map.to_static_map(self.bounds)?);
+            self.dirty = false;
+            self.map_ms += started.elapsed().as_secs_f64() * 1e3;
+        }
+        Ok(Arc::clone(&self.planner_map))
+    }
+
+    /// The map's time since the last call (ms): insertions and exports.
+    pub fn take_map_ms(&mut self) -> f64 {
+        std::mem::take(&mut self.map_ms)
+    }
+
+    /// The commit check on the current map ([`KnownFree`]). Drop it (the manager's
+    /// `set_commit_check(None)`) before the next scan, or the scan copies the map.
+    pub fn commit_check(&self) -> Arc<dyn CommitCheck> {
+        Arc::new(KnownFree {
+            map: Arc::clone(&self.map),
+            clearance_m: self.clearance_m,
+        })
+    }
+
+    /// The online map.
+    pub fn map(&self) -> &LocalMap {
+        &self.map
+    }
 }
 
 impl MapSensing {
@@ -103,29 +202,22 @@ impl MapSensing {
             StaticSensor::Lidar(p) => Box::new(Lidar::new(p)?),
         };
         let start = world.start();
-        let mut map = LocalMap::new(map_params, &start)?;
-        let radius = world.vehicle_radius_m();
-        map.assume_free(
+        let online = OnlineMap::new(
+            map_params,
             &start,
-            radius + blind + 3f64.sqrt() * map_params.resolution_m,
-        );
-        let bounds = *world.bounds();
-        let planner_map = Arc::new(map.to_static_map(bounds)?);
+            *world.bounds(),
+            world.vehicle_radius_m(),
+            blind,
+        )?;
         let goal = world.goal() - start;
         let yaw = 0.0;
         Ok(Some(MapSensing {
             period_s: 1.0 / sensor.rate_hz(),
             sensor,
-            map: Arc::new(map),
+            online,
             rng: ChaCha8Rng::seed_from_u64(trust_world::mix_seed(scenario.seed, NOISE_STREAM)),
             scan: Scan::default(),
             next_t: 0.0,
-            bounds,
-            planner_map,
-            dirty: false,
-            clearance_m: radius,
-            body_m: radius + 3f64.sqrt() * map_params.resolution_m,
-            map_ms: 0.0,
             yaw,
             target_yaw: if goal.xy().norm() > 1e-9 {
                 goal.y.atan2(goal.x)
@@ -159,12 +251,8 @@ impl MapSensing {
             &mut self.rng,
             &mut self.scan,
         )?;
-        let map = Arc::make_mut(&mut self.map);
-        map.recentre(&vehicle.p)?;
-        map.insert_scan(&self.scan)?;
-        map.assume_free(&vehicle.p, self.body_m);
-        self.dirty = true;
-        self.map_ms += started.elapsed().as_secs_f64() * 1e3;
+        self.online.map_ms += started.elapsed().as_secs_f64() * 1e3;
+        self.online.insert(&self.scan, &vehicle.p)?;
         Ok(())
     }
 
@@ -173,32 +261,23 @@ impl MapSensing {
     /// # Errors
     /// [`FlightError::Sensing`] if the map cannot be exported.
     pub fn planner_map(&mut self) -> Result<Arc<StaticMap>, FlightError> {
-        if self.dirty {
-            let started = Instant::now();
-            self.planner_map = Arc::new(self.map.to_static_map(self.bounds)?);
-            self.dirty = false;
-            self.map_ms += started.elapsed().as_secs_f64() * 1e3;
-        }
-        Ok(Arc::clone(&self.planner_map))
+        Ok(self.online.planner_map()?)
     }
 
     /// The map's time since the last call (ms): scans, insertions and exports.
     pub fn take_map_ms(&mut self) -> f64 {
-        std::mem::take(&mut self.map_ms)
+        self.online.take_map_ms()
     }
 
     /// The commit check on the current map ([`KnownFree`]). Drop it (the manager's
     /// `set_commit_check(None)`) before the next scan, or the scan copies the map.
     pub fn commit_check(&self) -> Arc<dyn CommitCheck> {
-        Arc::new(KnownFree {
-            map: Arc::clone(&self.map),
-            clearance_m: self.clearance_m,
-        })
+        self.online.commit_check()
     }
 
     /// The online map.
     pub fn map(&self) -> &LocalMap {
-        &self.map
+        self.online.map()
     }
 
     /// Points the camera after a cycle: toward the best branch one [`LOOK_AHEAD_S`] ahead of

@@ -17,12 +17,19 @@ that fail a check.
 
     peer.py --domain N [--px4] [--sim-time START] [--timeout S]
     peer.py --domain N --observe-world START [--timeout S]
+    peer.py --domain N --cloud "x,y,z;x,y,z;..." [--timeout S]
 
 With `--sim-time START` the peer is also the node's clock (the node runs with
 `--use-sim-time`): it publishes `/clock` from START s on and stamps its messages with it; every
 stamp the node publishes must follow that clock. With `--observe-world START` it publishes
 nothing and checks a `trust-sim dds-world` flight whose clock starts at START s: `/clock`, the
-world's odometry, and the node's `/tf` and `trajectory` on the world's clock.
+world's odometry, and the node's `/tf` and `trajectory` on the world's clock. With `--cloud
+POINTS` it publishes odometry and the points given (in the map frame) as two PointCloud2
+messages of layouts unlike the node's own encoder: the first half in `map`, FLOAT32
+little-endian after an `intensity` field; the second half in `base_link` (moved into the body
+frame here, by the odometry's pose), FLOAT64 big-endian in a 2-row organized cloud with NaN
+holes and padded rows. It publishes them for 3 s after the node's first `/tf` (discovery
+done); the test then checks the node's map.
 
 Exit status 0 when every check passed, 1 on a failed check or a timeout (the reason on stderr).
 Run it restricted to loopback: CYCLONEDDS_URI (see `crates/ros2/tests/cyclone_interop.rs`).
@@ -30,6 +37,7 @@ Run it restricted to loopback: CYCLONEDDS_URI (see `crates/ros2/tests/cyclone_in
 
 import argparse
 import math
+import struct
 import sys
 import time
 from dataclasses import dataclass, field
@@ -293,6 +301,34 @@ class TrajectorySetpoint(IdlStruct, typename=dds("px4_msgs", "TrajectorySetpoint
 
 
 # --- the scene the peer sends (inside scenarios/quickstart.toml's 40 x 20 x 10 m world) ---------
+
+# --- sensor_msgs (PointField.msg, PointCloud2.msg) -------------------------------------------
+
+
+@dataclass
+class PointField(IdlStruct, typename=dds("sensor_msgs", "PointField")):
+    name: str = ""
+    offset: t.uint32 = 0
+    datatype: t.uint8 = 0
+    count: t.uint32 = 0
+
+
+@dataclass
+class PointCloud2(IdlStruct, typename=dds("sensor_msgs", "PointCloud2")):
+    header: Header = field(default_factory=Header)
+    height: t.uint32 = 0
+    width: t.uint32 = 0
+    fields: t.sequence[PointField] = field(default_factory=list)
+    is_bigendian: bool = False
+    point_step: t.uint32 = 0
+    row_step: t.uint32 = 0
+    data: t.sequence[t.uint8] = field(default_factory=list)
+    is_dense: bool = False
+
+
+# PointField.msg's datatype constants.
+FLOAT32, FLOAT64 = 7, 8
+
 
 WORLD, BODY = "map", "base_link"
 START = (2.0, 10.0, 3.0)
@@ -634,6 +670,8 @@ def main():
                     help="publish /clock from START s (the node runs with --use-sim-time)")
     ap.add_argument("--observe-world", type=float, metavar="START",
                     help="only observe a trust-sim dds-world flight whose clock starts at START s")
+    ap.add_argument("--cloud", metavar="POINTS",
+                    help="publish these map-frame points (x,y,z;...) as point clouds")
     ap.add_argument("--timeout", type=float, default=40.0)
     args = ap.parse_args()
     global CLOCK
@@ -652,6 +690,8 @@ def main():
 
     if args.observe_world is not None:
         return observe_world(args, reader, best_effort, reliable)
+    if args.cloud is not None:
+        return publish_clouds(args, writer, reader, best_effort, reliable)
 
     clock_w = writer("clock", Clock, reliable) if args.sim_time is not None else None
     odom_w = writer("odom", Odometry, best_effort)
@@ -784,6 +824,78 @@ def observe_world(args, reader, best_effort, reliable):
         return 1
     print(f"peer: FAILED: within {args.timeout} s {clocks} /clock, {tf_matched} tf matched, "
           f"{trajectories} trajectories", file=sys.stderr)
+    return 1
+
+
+def cloud_message(frame, stamp, rows, f64, big_endian, row_padding):
+    """A PointCloud2 of `rows` (lists of (x, y, z), NaN for a hole) built from the message
+    definition: an `intensity` FLOAT32 at offset 0, then x, y, z (FLOAT64 or FLOAT32) after a
+    4-byte gap, point_step rounded up to 8, `row_padding` bytes after each row."""
+    size = 8 if f64 else 4
+    kind = FLOAT64 if f64 else FLOAT32
+    offsets = {"x": 8, "y": 8 + size, "z": 8 + 2 * size}
+    point_step = (8 + 3 * size + 7) // 8 * 8
+    width = len(rows[0])
+    row_step = width * point_step + row_padding
+    order = ">" if big_endian else "<"
+    data = bytearray(row_step * len(rows))
+    for r, row in enumerate(rows):
+        for c, (x, y, z) in enumerate(row):
+            at = r * row_step + c * point_step
+            struct.pack_into(order + "f", data, at, 1.0)  # intensity
+            for name, v in (("x", x), ("y", y), ("z", z)):
+                struct.pack_into(order + ("d" if f64 else "f"), data, at + offsets[name], v)
+    fields = [PointField(name="intensity", offset=0, datatype=FLOAT32, count=1)] + [
+        PointField(name=n, offset=offsets[n], datatype=kind, count=1) for n in ("z", "x", "y")]
+    dense = all(all(math.isfinite(v) for v in p) for row in rows for p in row)
+    return PointCloud2(header=Header(stamp=stamp, frame_id=frame), height=len(rows), width=width,
+                       fields=fields, is_bigendian=big_endian, point_step=point_step, row_step=row_step,
+                       data=list(data), is_dense=dense)
+
+
+def to_body(p):
+    """A map-frame point in the body frame of the odometry sent (at START, yaw ODOM_YAW)."""
+    dx, dy, dz = (p[0] - START[0], p[1] - START[1], p[2] - START[2])
+    c, s = math.cos(ODOM_YAW), math.sin(ODOM_YAW)
+    return (c * dx + s * dy, -s * dx + c * dy, dz)
+
+
+def publish_clouds(args, writer, reader, best_effort, reliable):
+    """--cloud: odometry at START (yaw ODOM_YAW) and the points as two clouds (module docs),
+    every 0.1 s, for 3 s after the node's first /tf."""
+    points = [tuple(float(c) for c in p.split(",")) for p in args.cloud.split(";") if p]
+    check(len(points) >= 2 and all(len(p) == 3 for p in points), f"--cloud {args.cloud!r}: x,y,z;x,y,z...")
+    half = len(points) // 2
+    in_map, in_body = points[:half], [to_body(p) for p in points[half:]]
+    width = (len(in_body) + 1) // 2
+    nan = (math.nan, math.nan, math.nan)
+    body_rows = [in_body[:width], in_body[width:] + [nan] * (2 * width - len(in_body))]
+    odom_w = writer("odom", Odometry, best_effort)
+    cloud_w = writer("cloud", PointCloud2, best_effort)
+    tf_r = reader("tf", TFMessage, reliable)
+    seen_tf = None
+    sent = 0
+    deadline = time.monotonic() + args.timeout
+    while time.monotonic() < deadline:
+        stamp = now_stamp()
+        odom = Odometry(header=Header(stamp=stamp, frame_id=WORLD), child_frame_id=BODY)
+        odom.pose.pose.position = Point(*START)
+        odom.pose.pose.orientation = Quaternion(*ODOM_Q)
+        odom_w.write(odom)
+        # The clouds after their odometry, stamped as it: the node places them by that pose.
+        time.sleep(0.01)
+        cloud_w.write(cloud_message(WORLD, stamp, [in_map], f64=False, big_endian=False, row_padding=0))
+        cloud_w.write(cloud_message(BODY, stamp, body_rows, f64=True, big_endian=True, row_padding=5))
+        sent += 1
+        if seen_tf is None and tf_r.take(N=10):
+            seen_tf = time.monotonic()
+            print("peer: the node's /tf received: discovery done", file=sys.stderr)
+        if seen_tf is not None and time.monotonic() - seen_tf > 3.0:
+            print(f"peer: {sent} pairs of clouds sent ({len(in_map)} map-frame points FLOAT32 LE, "
+                  f"{len(in_body)} body-frame points FLOAT64 BE in 2 rows)", file=sys.stderr)
+            return 0
+        time.sleep(0.09)
+    print(f"peer: FAILED: no /tf from the node within {args.timeout} s", file=sys.stderr)
     return 1
 
 

@@ -20,6 +20,7 @@ use crate::msg::builtin_interfaces::Time;
 use crate::msg::geometry_msgs::PoseStamped;
 use crate::msg::nav_msgs::{Odometry, Path};
 use crate::msg::rosgraph_msgs::Clock;
+use crate::msg::sensor_msgs::PointCloud2;
 use crate::msg::tf2_msgs::TFMessage;
 use crate::msg::trajectory_msgs::MultiDOFJointTrajectory;
 use crate::msg::trust_msgs::{MovingObstacleArray, PlannerEvent};
@@ -52,6 +53,8 @@ pub mod topics {
     pub const TF: &str = "/tf";
     /// In with `use_sim_time` (out of `trust-sim dds-world`): `rosgraph_msgs/Clock`, absolute.
     pub const CLOCK: &str = "/clock";
+    /// In with `[cloud]` (its `topic`; this is the default): `sensor_msgs/PointCloud2`.
+    pub const CLOUD: &str = "cloud";
 }
 
 /// `px4_msgs/msg/TrajectorySetpoint` as a ROS message: the flight stack's struct
@@ -84,6 +87,14 @@ pub fn input_qos() -> QosProfile {
     QosProfile::subscription_default()
         .durability(Durability::Volatile)
         .history(History::KeepLast { depth: 10 })
+}
+
+/// Point clouds: best effort, volatile, keep last 5 (rclcpp's `SensorDataQoS`; a reliable
+/// writer matches too).
+pub fn cloud_qos() -> QosProfile {
+    QosProfile::subscription_default()
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 5 })
 }
 
 /// `/tf`: reliable, volatile, keep last 100, as tf2's `TransformBroadcaster` (RViz's and
@@ -120,6 +131,9 @@ pub struct DdsOptions {
     /// ROS time from [`topics::CLOCK`] instead of the system clock
     /// (`NodeParams::use_sim_time`).
     pub use_sim_time: bool,
+    /// Subscribe to point clouds on this topic (`NodeParams::cloud`'s `topic`); `None`: no
+    /// cloud input.
+    pub cloud_topic: Option<String>,
 }
 
 impl Default for DdsOptions {
@@ -130,16 +144,18 @@ impl Default for DdsOptions {
             px4: false,
             publish_tf: true,
             use_sim_time: false,
+            cloud_topic: None,
         }
     }
 }
 
 impl DdsOptions {
-    /// The defaults with `params`'s `publish_tf` and `use_sim_time`.
+    /// The defaults with `params`'s `publish_tf`, `use_sim_time` and cloud topic.
     pub fn for_params(params: &crate::NodeParams) -> Self {
         DdsOptions {
             publish_tf: params.publish_tf,
             use_sim_time: params.use_sim_time,
+            cloud_topic: params.cloud.as_ref().map(|c| c.topic.clone()),
             ..DdsOptions::default()
         }
     }
@@ -241,6 +257,8 @@ pub struct DdsNode {
     odom: Subscription<Odometry>,
     goal: Subscription<PoseStamped>,
     obstacles: Subscription<MovingObstacleArray>,
+    /// With `[cloud]`: the point clouds and their topic.
+    cloud: Option<(Subscription<PointCloud2>, String)>,
     trajectory: Publisher<MultiDOFJointTrajectory>,
     path: Publisher<Path>,
     setpoint: SetpointOut,
@@ -285,6 +303,10 @@ impl DdsNode {
         let odom = subscription(&mut node, topics::ODOM, input_qos())?;
         let goal = subscription(&mut node, topics::GOAL, input_qos())?;
         let obstacles = subscription(&mut node, topics::OBSTACLES, input_qos())?;
+        let cloud = match &options.cloud_topic {
+            Some(name) => Some((subscription(&mut node, name, cloud_qos())?, name.clone())),
+            None => None,
+        };
         let trajectory = publisher(&mut node, topics::TRAJECTORY, plan_qos())?;
         let path = publisher(&mut node, topics::PATH, plan_qos())?;
         let setpoint = if options.px4 {
@@ -323,6 +345,7 @@ impl DdsNode {
             odom,
             goal,
             obstacles,
+            cloud,
             trajectory,
             path,
             setpoint,
@@ -369,6 +392,23 @@ impl DdsNode {
             && let Err(e) = tf.publish(m)
         {
             warn(topics::TF, &Ros2Error::dds("publish tf", e));
+        }
+        if let Some((sub, name)) = &self.cloud {
+            // After the odometry: a cloud is placed by the odometry at its stamp. Only the
+            // newest waiting cloud is folded in; older ones are dropped and counted (a node
+            // behind its sensor catches up instead of mapping the past).
+            let mut newest = None;
+            let mut dropped = 0;
+            drain(sub, name, warn, |m| {
+                dropped += u64::from(newest.replace(m).is_some());
+                Ok(())
+            });
+            core.drop_clouds(dropped);
+            if let Some(m) = newest
+                && let Err(e) = core.on_cloud(&m)
+            {
+                warn(name, &e);
+            }
         }
         drain(&self.goal, topics::GOAL, warn, |m| core.on_goal(&m));
         drain(&self.obstacles, topics::OBSTACLES, warn, |m| {

@@ -8,6 +8,12 @@
 //! writes the flight's run log (`trust_runlog`, contract `run-log-v1`): a `state` record every
 //! physics step, a `cycle` record per `events` message of the node, the `outcome`.
 //!
+//! With `[sensing.static]` other than `"known"` the world also ray-casts the scenario's sensor
+//! (depth camera or LiDAR, `trust_flight::map_sensing`'s, its noise from the same seed stream)
+//! from the vehicle at the sensor's rate and publishes each scan on `cloud` as a
+//! `sensor_msgs/PointCloud2` in `body_frame` ([`scan_cloud`]), stamped as the odometry of the same
+//! step; a node with `[cloud]` then flies the scenario on the map it senses.
+//!
 //! Not yet as `trust-sim run`: no sensor noise or dropouts (the node's tracker gets the true
 //! centres), no `[clock]` model (the node's real cycle times apply), the `cycle` records carry
 //! only what `trust_msgs/PlannerEvent` has (`main` is `null`, `branches` 0).
@@ -19,11 +25,14 @@ use trust_core::Vec3;
 use trust_flight::{Clearances, Tally};
 use trust_flightstack::frame::wrap_angle;
 use trust_runlog::{CycleRecord, LogWriter, Outcome, Record, StateRecord, Status};
+use trust_sensing::{DepthCamera, Lidar, Pose, RaySensor, ReturnKind, Scan, Truth};
 use trust_vehicle::{ControlledQuadrotor, PerfectTracking, Reference, Vehicle, VehicleState};
 use trust_world::World;
+use trust_world::map_sensing::StaticSensor;
 use trust_world::scenario::VehicleModel;
 use trust_world::traffic::MovingShape;
 
+use crate::cloud::{CloudLayout, encode_points};
 use crate::convert::unit_quaternion;
 use crate::dds::{self, input_qos, plan_qos, system_time, topics};
 use crate::error::Ros2Error;
@@ -32,6 +41,7 @@ use crate::msg::builtin_interfaces::Time;
 use crate::msg::geometry_msgs::{Point, PoseStamped, Quaternion, Vector3};
 use crate::msg::nav_msgs::Odometry;
 use crate::msg::rosgraph_msgs::Clock;
+use crate::msg::sensor_msgs::PointCloud2;
 use crate::msg::trajectory_msgs::MultiDOFJointTrajectory;
 use crate::msg::trust_msgs::{MovingObstacle, MovingObstacleArray, PlannerEvent};
 
@@ -58,6 +68,8 @@ pub struct DdsWorldOptions {
     /// writes, so that a node on either clock works (the world runs in real time; when it lags
     /// behind, its stamps still say when its messages left).
     pub clock_start_s: Option<f64>,
+    /// The vehicle's body frame: the frame of the sensor's clouds.
+    pub body_frame: String,
 }
 
 impl Default for DdsWorldOptions {
@@ -68,6 +80,7 @@ impl Default for DdsWorldOptions {
             obstacles_period_s: 0.1,
             wait_for_plan_s: 60.0,
             clock_start_s: None,
+            body_frame: "base_link".into(),
         }
     }
 }
@@ -190,6 +203,105 @@ pub fn reference_at(traj: &MultiDOFJointTrajectory, now: f64) -> Option<Referenc
     Some(Reference { p, v, a, j, yaw })
 }
 
+/// A scan as the cloud a sensor driver on the vehicle would publish, in the body frame of the
+/// vehicle at `position` with `attitude`, one point per ray in the scan's order (`FLOAT32`
+/// x, y, z, PCL's 16-byte point, one row): a hit at its range; a ray without a return at twice
+/// the sensor's range `range_m`, beyond the node's `max_range_m` when that is the sensor's range,
+/// so the node clears space along it up to that range and marks nothing (a depth driver would
+/// send NaN and lose that evidence); an invalid ray as NaN.
+///
+/// # Errors
+/// [`Ros2Error::Invalid`] for a cloud too large for `PointCloud2`'s `u32` sizes.
+pub fn scan_cloud(
+    scan: &Scan,
+    position: &Vec3,
+    attitude: &nalgebra::UnitQuaternion<f64>,
+    range_m: f64,
+    header: crate::msg::std_msgs::Header,
+) -> Result<PointCloud2, Ros2Error> {
+    let to_body = attitude.inverse();
+    let points: Vec<Vec3> = scan
+        .rays
+        .iter()
+        .map(|r| {
+            let range = match r.kind {
+                ReturnKind::Hit => r.range,
+                ReturnKind::NoReturn => 2.0 * range_m,
+                ReturnKind::Invalid => return Vec3::repeat(f64::NAN),
+            };
+            to_body * (scan.origin + r.direction * range - position)
+        })
+        .collect();
+    encode_points(header, &points, &CloudLayout::default())
+}
+
+/// The scenario's static sensor, ray-cast from the vehicle every period (module docs).
+struct CloudSource {
+    sensor: Box<dyn RaySensor>,
+    rng: rand_chacha::ChaCha8Rng,
+    scan: Scan,
+    period_s: f64,
+    next_t: f64,
+    range_m: f64,
+}
+
+impl CloudSource {
+    /// The sensor of `world`'s `[sensing.static]`; `None` for `"known"`.
+    fn new(world: &World) -> Result<Option<Self>, Ros2Error> {
+        use rand::SeedableRng;
+        let Some((sensor, _)) = world.scenario().sensing.static_map.sensor() else {
+            return Ok(None);
+        };
+        let (boxed, range_m): (Box<dyn RaySensor>, f64) = match sensor {
+            StaticSensor::Depth(p) => (Box::new(DepthCamera::new(p)?), p.max_depth_m),
+            StaticSensor::Lidar(p) => (Box::new(Lidar::new(p)?), p.max_range_m),
+        };
+        Ok(Some(CloudSource {
+            period_s: 1.0 / sensor.rate_hz(),
+            sensor: boxed,
+            rng: rand_chacha::ChaCha8Rng::seed_from_u64(trust_world::mix_seed(
+                world.scenario().seed,
+                trust_flight::map_sensing::NOISE_STREAM,
+            )),
+            scan: Scan::default(),
+            next_t: 0.0,
+            range_m,
+        }))
+    }
+
+    /// The cloud at simulated time `t` if a scan is due (`dt`: the step), else `None`.
+    fn due(
+        &mut self,
+        t: f64,
+        dt: f64,
+        vehicle: &VehicleState,
+        world: &World,
+        header: crate::msg::std_msgs::Header,
+    ) -> Result<Option<PointCloud2>, Ros2Error> {
+        if t + 0.5 * dt < self.next_t {
+            return Ok(None);
+        }
+        while self.next_t <= t + 0.5 * dt {
+            self.next_t += self.period_s;
+        }
+        let pose = Pose::new(vehicle.p, vehicle.attitude);
+        self.sensor.scan(
+            &pose,
+            &Truth::static_only(world.truth_map()),
+            &mut self.rng,
+            &mut self.scan,
+        )?;
+        scan_cloud(
+            &self.scan,
+            &vehicle.p,
+            &vehicle.attitude,
+            self.range_m,
+            header,
+        )
+        .map(Some)
+    }
+}
+
 /// The world's DDS side: its node, the node's inputs it writes, what it reads back.
 struct Ports {
     /// Kept alive while its publishers and subscriptions are used.
@@ -200,12 +312,19 @@ struct Ports {
     odom: ros2_client::Publisher<Odometry>,
     goal_pub: ros2_client::Publisher<PoseStamped>,
     obstacles: ros2_client::Publisher<MovingObstacleArray>,
+    /// With a sensed static map: the sensor's clouds and their frame.
+    cloud: Option<(ros2_client::Publisher<PointCloud2>, String)>,
     trajectory: ros2_client::Subscription<MultiDOFJointTrajectory>,
     events: ros2_client::Subscription<PlannerEvent>,
 }
 
 impl Ports {
-    fn new(domain_id: u16, frame: &str, goal: Vec3) -> Result<Self, Ros2Error> {
+    fn new(
+        domain_id: u16,
+        frame: &str,
+        goal: Vec3,
+        cloud_frame: Option<&str>,
+    ) -> Result<Self, Ros2Error> {
         let context = ros2_client::Context::with_options(
             ros2_client::ContextOptions::new().domain_id(domain_id),
         )
@@ -222,6 +341,13 @@ impl Ports {
             odom: dds::publisher(&mut node, topics::ODOM, input_qos())?,
             goal_pub: dds::publisher(&mut node, topics::GOAL, plan_qos())?,
             obstacles: dds::publisher(&mut node, topics::OBSTACLES, input_qos())?,
+            cloud: match cloud_frame {
+                Some(f) => Some((
+                    dds::publisher(&mut node, topics::CLOUD, dds::cloud_qos())?,
+                    f.to_owned(),
+                )),
+                None => None,
+            },
             trajectory: dds::subscription(&mut node, topics::TRAJECTORY, plan_qos())?,
             events: dds::subscription(
                 &mut node,
@@ -273,6 +399,25 @@ impl Ports {
                     ..Default::default()
                 },
             });
+        }
+        Ok(())
+    }
+
+    /// The sensor's cloud at simulated time `t`, if one is due, stamped `now` (as the
+    /// odometry of the step).
+    fn publish_cloud(
+        &self,
+        source: Option<&mut CloudSource>,
+        (t, dt): (f64, f64),
+        now: Time,
+        vehicle: &VehicleState,
+        world: &World,
+    ) -> Result<(), Ros2Error> {
+        let (Some(source), Some((publisher, frame))) = (source, &self.cloud) else {
+            return Ok(());
+        };
+        if let Some(cloud) = source.due(t, dt, vehicle, world, now.into_header(frame))? {
+            let _ = publisher.publish(cloud);
         }
         Ok(())
     }
@@ -350,7 +495,13 @@ pub fn fly(
         }
     };
     let clock = SimClock::new(options.clock_start_s)?;
-    let ports = Ports::new(domain_id, &options.world_frame, world.goal())?;
+    let mut sensor = CloudSource::new(world)?;
+    let ports = Ports::new(
+        domain_id,
+        &options.world_frame,
+        world.goal(),
+        sensor.as_ref().map(|_| options.body_frame.as_str()),
+    )?;
 
     // Before take-off: hover at the start until the node's first plan; the simulated time runs
     // with the wall clock.
@@ -369,13 +520,9 @@ pub fn fly(
         if slow {
             next_slow = t + options.obstacles_period_s;
         }
-        ports.publish_inputs(
-            world,
-            clock.at(t)?,
-            vehicle.state(),
-            traffic.positions(),
-            slow,
-        )?;
+        let now = clock.at(t)?;
+        ports.publish_inputs(world, now, vehicle.state(), traffic.positions(), slow)?;
+        ports.publish_cloud(sensor.as_mut(), (t, dt), now, vehicle.state(), world)?;
         std::thread::sleep(StdDuration::from_secs_f64(dt));
         plan = ports.latest_trajectory();
     }
@@ -430,12 +577,14 @@ pub fn fly(
         if slow {
             next_obstacles += options.obstacles_period_s;
         }
-        ports.publish_inputs(
-            world,
-            clock.at(takeoff + t)?,
+        let now = clock.at(takeoff + t)?;
+        ports.publish_inputs(world, now, vehicle.state(), traffic.positions(), slow)?;
+        ports.publish_cloud(
+            sensor.as_mut(),
+            (takeoff + t, dt),
+            now,
             vehicle.state(),
-            traffic.positions(),
-            slow,
+            world,
         )?;
         if let Some(m) = ports.latest_trajectory() {
             plan = Some(m);
@@ -553,6 +702,36 @@ mod tests {
             accelerations: vec![Twist::default()],
             time_from_start: Duration::from_seconds(t).expect("duration"),
         }
+    }
+
+    #[test]
+    fn a_scan_becomes_a_body_frame_cloud_the_node_decodes_back_into_the_world() {
+        use trust_sensing::RayMeasurement;
+        let p = Vec3::new(2.0, 10.0, 3.0);
+        let q = nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+        let ray = |d: Vec3, range, kind| RayMeasurement {
+            direction: d.normalize(),
+            range,
+            kind,
+        };
+        let scan = Scan {
+            origin: p,
+            rays: vec![
+                ray(Vec3::new(1.0, 0.0, 0.0), 4.0, ReturnKind::Hit),
+                ray(Vec3::new(0.0, 1.0, 1.0), 10.0, ReturnKind::NoReturn),
+                ray(Vec3::new(0.0, 0.0, 1.0), 0.0, ReturnKind::Invalid),
+            ],
+        };
+        let header = Time { sec: 5, nanosec: 0 }.into_header("base_link");
+        let cloud = scan_cloud(&scan, &p, &q, 10.0, header).expect("encodes");
+        assert_eq!((cloud.width, cloud.height, cloud.is_dense), (3, 1, false));
+        let decoded = crate::cloud::decode_points(&cloud).expect("decodes");
+        assert_eq!(decoded.skipped_count, 1, "the invalid ray is NaN");
+        let world: Vec<Vec3> = decoded.points.iter().map(|b| q * b + p).collect();
+        // FLOAT32 on the wire: within a few µm.
+        assert_relative_eq!(world[0], Vec3::new(6.0, 10.0, 3.0), epsilon = 1e-5);
+        let far = Vec3::new(0.0, 1.0, 1.0).normalize() * 20.0 + p;
+        assert_relative_eq!(world[1], far, epsilon = 1e-5);
     }
 
     #[test]

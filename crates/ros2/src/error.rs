@@ -31,6 +31,9 @@ pub enum Ros2Error {
     /// A flight-stack conversion (PX4 setpoint) failed.
     #[error("flight stack: {0}")]
     FlightStack(#[from] trust_flightstack::FlightStackError),
+    /// The online map rejected its parameters, a position or a scan.
+    #[error("online map: {0}")]
+    Sensing(#[from] trust_sensing::SensingError),
     /// CDR encoding or decoding failed.
     #[error("CDR: {0}")]
     Cdr(String),

@@ -8,7 +8,10 @@
 //! (`trajectory_msgs/MultiDOFJointTrajectory`), `path`, `setpoint` (or PX4's
 //! `TrajectorySetpoint` on `/fmu/in/trajectory_setpoint`), `markers`, `events` and `/tf` (the
 //! odometry as `map → base_link`), with a yaw per [`heading`]; with `use_sim_time` its ROS time
-//! is `/clock`'s. Topics, frames, QoS and parameters: `docs/ros2.md`.
+//! is `/clock`'s. With `[cloud]` in its parameters it also subscribes to a point cloud
+//! (`sensor_msgs/PointCloud2`, decoded by [`cloud`]) and plans in the online map built from
+//! it, committing only to observed free space, as the simulator's unknown-map mode
+//! ([`sensing`]). Topics, frames, QoS and parameters: `docs/ros2.md`.
 //!
 //! Use it to fly the planner on a ROS 2 vehicle or in a ROS 2 simulator. DDS comes from
 //! `ros2-client` (pure Rust over RustDDS): the binary `trust-node` builds with cargo alone and
@@ -46,6 +49,7 @@
 #![warn(missing_docs)]
 
 pub mod cdr;
+pub mod cloud;
 pub mod convert;
 pub mod dds;
 pub mod dds_world;
@@ -54,6 +58,7 @@ pub mod heading;
 pub mod msg;
 pub mod node_core;
 pub mod params;
+pub mod sensing;
 #[doc(hidden)]
 pub mod test_support;
 pub mod tracker;

@@ -1,5 +1,6 @@
 //! [`NodeCore`]: the node without DDS. Messages go in ([`NodeCore::on_odometry`],
-//! [`NodeCore::on_goal`], [`NodeCore::on_obstacles`]); a cycle at a clock value the caller gives
+//! [`NodeCore::on_goal`], [`NodeCore::on_obstacles`], with `[cloud]` [`NodeCore::on_cloud`]);
+//! a cycle at a clock value the caller gives
 //! ([`NodeCore::cycle`]) runs the planner and returns the messages to publish; setpoints are
 //! sampled from the committed plan at any clock value ([`NodeCore::setpoint`],
 //! [`NodeCore::px4_setpoint`]). No clock is read inside and nothing is sent, so every step is
@@ -25,11 +26,13 @@ use crate::heading::{Heading, yaw_of};
 use crate::msg::builtin_interfaces::Time;
 use crate::msg::geometry_msgs::PoseStamped;
 use crate::msg::nav_msgs::{Odometry, Path};
+use crate::msg::sensor_msgs::PointCloud2;
 use crate::msg::tf2_msgs::{TFMessage, TransformStamped};
 use crate::msg::trajectory_msgs::MultiDOFJointTrajectory;
 use crate::msg::trust_msgs::{MovingObstacleArray, PlannerEvent};
 use crate::msg::visualization_msgs::MarkerArray;
 use crate::params::{NodeParams, NodeSetup};
+use crate::sensing::CloudMap;
 use crate::tracker::{Tracker, observation};
 
 /// What the node counted since it started.
@@ -49,6 +52,17 @@ pub struct NodeCounters {
     pub idle_count: u64,
     /// Cycles skipped because the odometry was older than `odom_timeout_s`.
     pub stale_count: u64,
+    /// Point clouds accepted into the online map (`[cloud]`).
+    pub cloud_count: u64,
+    /// Point clouds rejected (another frame, a stamp outside the odometry, a malformed
+    /// cloud); each is also in `rejected_count`.
+    pub cloud_rejected_count: u64,
+    /// Points of accepted clouds inserted as rays.
+    pub cloud_point_count: u64,
+    /// Points of accepted clouds skipped: NaN or infinite, or at the sensor's origin.
+    pub cloud_skipped_point_count: u64,
+    /// Clouds dropped unread because a newer one was waiting ([`NodeCore::drop_clouds`]).
+    pub cloud_dropped_count: u64,
 }
 
 /// The messages of one planning cycle.
@@ -79,6 +93,8 @@ pub struct NodeCore {
     heading: Heading,
     /// The latest accepted odometry as the world-to-body transform.
     odom_transform: Option<TransformStamped>,
+    /// With `[cloud]`: the online map the planner plans in.
+    cloud: Option<CloudMap>,
     counters: NodeCounters,
 }
 
@@ -100,6 +116,14 @@ impl NodeCore {
             ));
         }
         let tracker = Tracker::new(setup.ekf, r, params.obstacle_timeout_s);
+        let cloud = match &params.cloud {
+            Some(c) => Some(CloudMap::new(
+                c.clone(),
+                *setup.map.bounds(),
+                setup.vehicle_radius_m,
+            )?),
+            None => None,
+        };
         Ok(NodeCore {
             clock: Clock {
                 origin_s: origin.as_seconds(),
@@ -112,6 +136,7 @@ impl NodeCore {
             forecasts: Vec::new(),
             heading: Heading::new(params.yaw)?,
             odom_transform: None,
+            cloud,
             counters: NodeCounters::default(),
             params,
         })
@@ -142,6 +167,12 @@ impl NodeCore {
         self.goal
     }
 
+    /// The online map built from the point clouds (`[cloud]`), once the first odometry
+    /// started it; `None` without `[cloud]`.
+    pub fn online_map(&self) -> Option<&trust_sensing::LocalMap> {
+        self.cloud.as_ref()?.map()
+    }
+
     /// Counts a rejected message and passes its error on.
     fn rejected<T>(&mut self, r: Result<T, Ros2Error>) -> Result<T, Ros2Error> {
         if r.is_err() {
@@ -160,6 +191,10 @@ impl NodeCore {
             Ok((state, q, odometry_transform(msg, &self.params.body_frame)?))
         });
         let (state, q, transform) = self.rejected(r)?;
+        if let Some(cloud) = &mut self.cloud {
+            let r = cloud.observe_odometry(state.t, state.p, q, state.v);
+            self.rejected(r)?;
+        }
         self.odom = Some(state);
         self.heading.observe_vehicle(yaw_of(&q));
         self.odom_transform = Some(transform);
@@ -217,6 +252,51 @@ impl NodeCore {
         self.tracker.observe(t, &observations)
     }
 
+    /// Folds a point cloud into the online map ([`crate::sensing`]: its points decoded by
+    /// [`crate::cloud::decode_points`], placed by its frame and the odometry at its stamp).
+    ///
+    /// # Errors
+    /// [`Ros2Error::Invalid`] naming the field: the node has no `[cloud]` section, a frame
+    /// other than the world, body or sensor frame, a stamp outside the odometry kept, a
+    /// malformed cloud; [`Ros2Error::Sensing`] if the map rejects the scan. The cloud is
+    /// ignored and counted (`rejected_count`, `cloud_rejected_count`).
+    pub fn on_cloud(&mut self, msg: &PointCloud2) -> Result<(), Ros2Error> {
+        let r = self.insert_cloud(msg);
+        if r.is_err() {
+            self.counters.cloud_rejected_count += 1;
+        }
+        let (inserted, skipped) = self.rejected(r)?;
+        self.counters.cloud_count += 1;
+        self.counters.cloud_point_count += inserted as u64;
+        self.counters.cloud_skipped_point_count += skipped as u64;
+        Ok(())
+    }
+
+    /// Counts `n` clouds dropped unread (the DDS layer folds only the newest waiting one).
+    pub fn drop_clouds(&mut self, n: u64) {
+        self.counters.cloud_dropped_count += n;
+    }
+
+    fn insert_cloud(&mut self, msg: &PointCloud2) -> Result<(usize, usize), Ros2Error> {
+        let Some(cloud) = &mut self.cloud else {
+            return Err(Ros2Error::invalid(
+                "cloud",
+                "a point cloud",
+                "a [cloud] section in the node's parameters",
+            ));
+        };
+        let t = self.clock.node_time(&msg.header.stamp);
+        let decoded = crate::cloud::decode_points(msg)?;
+        let (inserted, at_origin) = cloud.insert(
+            &msg.header.frame_id,
+            (&self.params.world_frame, &self.params.body_frame),
+            t,
+            self.params.odom_timeout_s,
+            &decoded.points,
+        )?;
+        Ok((inserted, decoded.skipped_count + at_origin))
+    }
+
     /// One planning cycle at ROS time `now`: the latest odometry, extrapolated at its velocity
     /// to `now`, is the measured state; the tracks' forecasts at `now` and the map are the
     /// scene; `Manager::step` plans toward the goal. `Ok(None)` (nothing to publish) without a
@@ -251,8 +331,28 @@ impl NodeCore {
             a: odom.a,
         };
         self.forecasts = self.tracker.forecasts(t)?;
-        let scene = Scene::new(&self.map, &self.forecasts, t)?;
-        let report = self.manager.step(t, &measured, &goal, &scene)?;
+        // With `[cloud]`: plan in the online map, commit only to observed free space (as
+        // `trust_flight`'s unknown-map mode).
+        let sensed = match &mut self.cloud {
+            Some(cloud) => cloud.for_cycle()?,
+            None => None,
+        };
+        let map = match &sensed {
+            Some((map, check)) => {
+                self.manager.share_map(Arc::clone(map));
+                self.manager.set_commit_check(Some(Arc::clone(check)));
+                Arc::clone(map)
+            }
+            None => Arc::clone(&self.map),
+        };
+        drop(sensed);
+        let scene = Scene::new(&map, &self.forecasts, t)?;
+        let stepped = self.manager.step(t, &measured, &goal, &scene);
+        if self.cloud.is_some() {
+            // The check holds the map: drop it before the next cloud, or that copies the map.
+            self.manager.set_commit_check(None);
+        }
+        let report = stepped?;
         self.counters.cycle_count += 1;
         let p = &self.params;
         let (trajectory, path) = match self.manager.plan() {
@@ -789,5 +889,187 @@ mod tests {
             .expect("valid");
         core.cycle(at(2.0)).expect("cycle").expect("ran");
         assert!(core.tracker.is_empty());
+    }
+
+    fn cloud_core(cloud: crate::sensing::CloudParams) -> NodeCore {
+        let setup = NodeSetup::from_scenario(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../scenarios/quickstart.toml"),
+        )
+        .expect("quickstart");
+        let params = NodeParams {
+            cloud: Some(cloud),
+            ..NodeParams::default()
+        };
+        NodeCore::new(setup, params, ORIGIN).expect("valid")
+    }
+
+    fn cloud(t: f64, frame: &str, points: &[Vec3]) -> PointCloud2 {
+        crate::cloud::encode_points(
+            at(t).into_header(frame),
+            points,
+            &crate::cloud::CloudLayout::default(),
+        )
+        .expect("valid layout")
+    }
+
+    #[test]
+    fn a_body_frame_cloud_is_placed_by_the_odometry_at_its_stamp() {
+        use trust_sensing::VoxelState;
+        let mut core = cloud_core(crate::sensing::CloudParams::default());
+        assert!(core.online_map().is_none(), "no odometry yet");
+        let e = core
+            .on_cloud(&cloud(0.0, "base_link", &[Vec3::new(4.0, 0.0, 0.0)]))
+            .expect_err("before any odometry");
+        assert_eq!(field_of(&e), "cloud.header.stamp");
+        // Facing north (yaw 90°), 1 m/s forward: from (2.05, 10.05) at 0 s to (2.05, 10.25)
+        // at 0.2 s. (Voxel centres: 0.1 m voxels.)
+        for (t, y) in [(0.0, 10.05), (0.2, 10.25)] {
+            let mut m = odom(t, [2.05, y, 3.05]);
+            m.pose.pose.orientation = Quaternion::from_yaw(FRAC_PI_2);
+            m.twist.twist.linear = Vector3 {
+                x: 1.0,
+                y: 0.0,
+                z: 0.0,
+            };
+            core.on_odometry(&m).expect("valid");
+        }
+        // At 0.1 s the vehicle is at (2.05, 10.15, 3.05): body x is world +y, body y world −x.
+        let nan = Vec3::new(f64::NAN, 0.0, 0.0);
+        core.on_cloud(&cloud(
+            0.1,
+            "base_link",
+            &[Vec3::new(4.0, 0.0, 0.0), Vec3::new(4.0, 1.0, 0.0), nan],
+        ))
+        .expect("valid");
+        let map = core.online_map().expect("started");
+        for p in [Vec3::new(2.05, 14.15, 3.05), Vec3::new(1.05, 14.15, 3.05)] {
+            assert_eq!(map.state(&p), VoxelState::Occupied, "{p:?}");
+        }
+        for y in [11.55, 12.55, 13.55] {
+            assert_eq!(
+                map.state(&Vec3::new(2.05, y, 3.05)),
+                VoxelState::Free,
+                "y {y}"
+            );
+        }
+        assert_eq!(
+            map.state(&Vec3::new(4.05, 12.05, 3.05)),
+            VoxelState::Unknown
+        );
+        let c = core.counters();
+        assert_eq!(
+            (
+                c.cloud_count,
+                c.cloud_point_count,
+                c.cloud_skipped_point_count
+            ),
+            (1, 2, 1)
+        );
+        assert_eq!((c.rejected_count, c.cloud_rejected_count), (1, 1));
+
+        // Another frame: rejected, counted, the map unchanged.
+        let e = core
+            .on_cloud(&cloud(0.1, "camera", &[Vec3::new(0.0, 0.0, 6.0)]))
+            .expect_err("unknown frame");
+        assert_eq!(field_of(&e), "cloud.header.frame_id");
+        assert!(e.to_string().contains("base_link"), "{e}");
+        // Too far past the odometry (odom_timeout_s 0.5 s).
+        let e = core
+            .on_cloud(&cloud(0.9, "map", &[Vec3::new(2.05, 16.05, 3.05)]))
+            .expect_err("stale");
+        assert_eq!(field_of(&e), "cloud.header.stamp");
+        let c = core.counters();
+        assert_eq!((c.cloud_count, c.cloud_rejected_count), (1, 3));
+    }
+
+    #[test]
+    fn a_sensor_frame_cloud_goes_through_the_mount_and_a_node_without_cloud_refuses_one() {
+        use trust_sensing::VoxelState;
+        // An optical frame (z forward, x right, y down) 0.1 m ahead of the body.
+        let params = crate::sensing::CloudParams {
+            sensor_frame: Some("camera".into()),
+            sensor_translation_m: [0.1, 0.0, 0.0],
+            sensor_rpy_rad: [-FRAC_PI_2, 0.0, -FRAC_PI_2],
+            ..crate::sensing::CloudParams::default()
+        };
+        let mut core = cloud_core(params);
+        let mut m = odom(0.0, [2.05, 10.05, 3.05]);
+        m.pose.pose.orientation = Quaternion::from_yaw(FRAC_PI_2);
+        core.on_odometry(&m).expect("valid");
+        // 4 m ahead of the camera and 1 m to its right: the body's (4.1, −1, 0), facing north.
+        core.on_cloud(&cloud(0.0, "camera", &[Vec3::new(1.0, 0.0, 4.0)]))
+            .expect("valid");
+        let map = core.online_map().expect("started");
+        assert_eq!(
+            map.state(&Vec3::new(3.05, 14.15, 3.05)),
+            VoxelState::Occupied
+        );
+        // The ray starts at the camera, 0.1 m north of the vehicle.
+        assert_eq!(map.state(&Vec3::new(2.55, 12.15, 3.05)), VoxelState::Free);
+
+        let mut plain = core_without_cloud();
+        let e = plain
+            .on_cloud(&cloud(0.0, "map", &[Vec3::new(1.0, 0.0, 4.0)]))
+            .expect_err("no [cloud]");
+        assert_eq!(field_of(&e), "cloud");
+        assert_eq!(plain.counters().cloud_rejected_count, 1);
+        assert!(plain.online_map().is_none());
+    }
+
+    fn core_without_cloud() -> NodeCore {
+        core()
+    }
+
+    #[test]
+    fn with_a_cloud_the_planner_plans_in_the_sensed_map_not_the_scenarios() {
+        let mut core = cloud_core(crate::sensing::CloudParams::default());
+        core.on_odometry(&odom(0.0, [2.0, 10.0, 3.0]))
+            .expect("valid");
+        core.on_goal(&goal([38.0, 10.0, 3.0])).expect("valid");
+        // A wall across the way at x = 6.05, y in [8, 12], z in [1, 5], seen in the map frame.
+        let wall: Vec<Vec3> = (0..41)
+            .flat_map(|i| (0..41).map(move |k| (i, k)))
+            .map(|(i, k)| Vec3::new(6.05, 8.0 + 0.1 * f64::from(i), 1.0 + 0.1 * f64::from(k)))
+            .collect();
+        core.on_cloud(&cloud(0.0, "map", &wall)).expect("valid");
+        assert_eq!(core.counters().cloud_point_count, wall.len() as u64);
+        core.cycle(at(0.0)).expect("cycle").expect("ran");
+        let main = core.manager().main().expect("a main branch");
+        let branch = core
+            .manager()
+            .branches()
+            .iter()
+            .find(|b| b.id == main)
+            .expect("main");
+        let traj = branch.traj();
+        // The main branch goes round the sensed wall (vehicle radius 0.5 m), which the
+        // scenario's map does not have.
+        let mut t = traj.t_start();
+        while t <= traj.t_end() {
+            let p = traj.position(t);
+            if (5.0..7.0).contains(&p.x) {
+                assert!(
+                    !(7.4..12.6).contains(&p.y) || !(0.4..5.6).contains(&p.z),
+                    "through the wall at t {t}: {p:?}"
+                );
+            }
+            t += 0.02;
+        }
+        // Without the cloud the same cycle flies straight through x = 6.
+        let mut plain = core_without_cloud();
+        plain
+            .on_odometry(&odom(0.0, [2.0, 10.0, 3.0]))
+            .expect("valid");
+        plain.on_goal(&goal([38.0, 10.0, 3.0])).expect("valid");
+        plain.cycle(at(0.0)).expect("cycle").expect("ran");
+        let plan = plain.manager().plan().expect("a plan");
+        let crossing = (0..1000)
+            .map(|k| {
+                plan.position(plan.t_start() + (plan.t_end() - plan.t_start()) * k as f64 / 1000.0)
+            })
+            .find(|p| p.x > 6.0)
+            .expect("it passes x = 6");
+        assert!((crossing.y - 10.0).abs() < 1.0, "{crossing:?}");
     }
 }

@@ -13,6 +13,7 @@ use trust_world::{Scenario, World};
 
 use crate::error::Ros2Error;
 use crate::heading::YawMode;
+use crate::sensing::CloudParams;
 
 /// `[node]` parameters (all optional; defaults below).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -46,6 +47,10 @@ pub struct NodeParams {
     /// system clock, as ROS's `use_sim_time` parameter: stamps, cycles and setpoints follow it.
     /// Default `false`; `trust-node --use-sim-time` sets it.
     pub use_sim_time: bool,
+    /// `[cloud]`: subscribe to a `sensor_msgs/PointCloud2` and plan in the online map built
+    /// from it, committing only to observed free space ([`crate::sensing`]). Default none: the
+    /// planner plans in the scenario's map.
+    pub cloud: Option<CloudParams>,
 }
 
 impl Default for NodeParams {
@@ -61,6 +66,7 @@ impl Default for NodeParams {
             yaw: YawMode::default(),
             publish_tf: true,
             use_sim_time: false,
+            cloud: None,
         }
     }
 }
@@ -113,7 +119,11 @@ impl NodeParams {
                 "a rate in [2, 1000] Hz",
             ));
         }
-        self.yaw.validate()
+        self.yaw.validate()?;
+        match &self.cloud {
+            Some(c) => c.validate(),
+            None => Ok(()),
+        }
     }
 }
 

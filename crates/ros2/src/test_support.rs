@@ -33,14 +33,26 @@ pub fn quickstart_core(origin: Time) -> Result<NodeCore, Ros2Error> {
 /// # Errors
 /// As [`quickstart_core`] and [`DdsNode::new`].
 pub fn quickstart_dds_node(domain: u16) -> Result<(NodeCore, DdsNode), Ros2Error> {
+    quickstart_dds_node_with(domain, NodeParams::default())
+}
+
+/// As [`quickstart_dds_node`] with `params` (its DDS options from them).
+///
+/// # Errors
+/// As [`quickstart_dds_node`].
+pub fn quickstart_dds_node_with(
+    domain: u16,
+    params: NodeParams,
+) -> Result<(NodeCore, DdsNode), Ros2Error> {
     let origin = Time {
         sec: system_time().sec,
         nanosec: 0,
     };
-    let core = quickstart_core(origin)?;
+    let options = DdsOptions::for_params(&params);
+    let core = NodeCore::new(NodeSetup::from_scenario(&quickstart())?, params, origin)?;
     let context = Context::with_options(ContextOptions::new().domain_id(domain))
         .map_err(|e| Ros2Error::dds("create DDS participant", e))?;
-    let node = DdsNode::new(&context, &DdsOptions::default())?;
+    let node = DdsNode::new(&context, &options)?;
     Ok((core, node))
 }
 

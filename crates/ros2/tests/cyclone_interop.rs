@@ -4,7 +4,9 @@
 //! for a node with `--use-sim-time`, `/clock`) and checks every message type the node publishes
 //! field by field; a field laid out differently on the two sides fails here, where the loopback
 //! test (ros2-client on both ends) cannot see it. The last test observes a `dds-world` flight
-//! (`trust_ros2::dds_world::fly`) and decodes its `/clock`.
+//! (`trust_ros2::dds_world::fly`) and decodes its `/clock`; another has the peer publish point
+//! clouds (`sensor_msgs/PointCloud2`, two layouts of its own) to a node in this process and
+//! checks the node's online map point by point.
 //!
 //! The Python interpreter is `$TRUST_CYCLONE_PYTHON` (else `python3`). Without the `cyclonedds`
 //! module the tests are skipped, unless `TRUST_REQUIRE_CYCLONE` is set (CI: `.ci/run` installs
@@ -57,10 +59,10 @@ fn cyclone_python() -> Option<PathBuf> {
     None
 }
 
-/// A domain id in 21..=220 of this process and test (`k` < 4): parallel test processes, and
+/// A domain id in 21..=220 of this process and test (`k` < 5): parallel test processes, and
 /// the tests of this one, do not meet.
 fn domain_id(k: u32) -> u16 {
-    ((std::process::id() % 50) * 4 + 21 + k) as u16
+    ((std::process::id() % 40) * 5 + 21 + k) as u16
 }
 
 /// Waits for `child` at most `limit`, killing it after that (`None`).
@@ -198,4 +200,102 @@ fn cyclone_decodes_the_world_clock_and_the_node_follows_it() {
             assert_eq!(outcome.status, trust_runlog::Status::Arrived, "{outcome:?}");
         },
     );
+}
+
+/// Points (map frame, voxel centres of the node's 0.1 m map) the peer publishes as clouds, all
+/// within the map's window round the peer's vehicle at (2, 10, 3) and in directions apart (no
+/// ray passes another's point). The first half goes in `map`, the rest in `base_link`.
+const CLOUD_POINTS: [[f64; 3]; 6] = [
+    [6.05, 10.05, 3.05],
+    [2.05, 14.05, 3.05],
+    [5.05, 7.05, 2.05],
+    [-1.95, 10.05, 3.05],
+    [2.05, 6.05, 4.05],
+    [-0.95, 13.05, 1.55],
+];
+
+/// The peer (Cyclone DDS) publishes odometry and the points of [`CLOUD_POINTS`] as two
+/// `PointCloud2` of layouts the node never writes (FLOAT32 little-endian after an intensity in
+/// `map`; FLOAT64 big-endian, fields listed z, x, y, an organized 2-row cloud with a NaN hole
+/// and padded rows, in `base_link`, moved there by the peer from the odometry's pose). The node
+/// (`[cloud]`, in this process) must hold an occupied voxel at every point and free voxels
+/// along the ray from the vehicle to it, the NaN hole skipped, nothing rejected.
+#[test]
+fn cyclone_point_clouds_decode_into_the_nodes_map_point_by_point() {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use trust_core::Vec3;
+    use trust_sensing::VoxelState;
+
+    let Some(python) = cyclone_python() else {
+        return;
+    };
+    let domain = domain_id(4);
+    let params = trust_ros2::NodeParams {
+        cloud: Some(trust_ros2::sensing::CloudParams::default()),
+        ..trust_ros2::NodeParams::default()
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    let node_stop = Arc::clone(&stop);
+    let node = std::thread::spawn(move || {
+        let (mut core, mut node) =
+            trust_ros2::test_support::quickstart_dds_node_with(domain, params)
+                .expect("quickstart node with [cloud]");
+        node.run(&mut core, &node_stop, &mut |what, e| {
+            eprintln!("node warning ({what}): {e}");
+        });
+        core
+    });
+    let points: Vec<String> = CLOUD_POINTS
+        .iter()
+        .map(|p| format!("{},{},{}", p[0], p[1], p[2]))
+        .collect();
+    let mut peer = Command::new(&python)
+        .arg(crate_dir().join("interop/peer.py"))
+        .args([
+            "--domain",
+            &domain.to_string(),
+            "--timeout",
+            &PEER_TIMEOUT_S.to_string(),
+            "--cloud",
+            &points.join(";"),
+        ])
+        .env("CYCLONEDDS_URI", CYCLONE_LOOPBACK)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start the Cyclone DDS peer");
+    let peer_status = wait_at_most(&mut peer, Duration::from_secs(PEER_TIMEOUT_S + 20));
+    let peer_log = stderr_of(&mut peer);
+    stop.store(true, Ordering::Relaxed);
+    let core = node.join().expect("the node's thread");
+    let c = core.counters();
+    eprintln!("domain {domain}\n--- peer ---\n{peer_log}--- node ---\n{c:?}");
+    assert!(
+        peer_status.is_some_and(|s| s.success()),
+        "the Cyclone DDS peer failed ({peer_status:?}); its log is above"
+    );
+    assert_eq!(
+        c.rejected_count, 0,
+        "the node rejected messages of the peer"
+    );
+    assert!(c.cloud_count >= 2, "{} clouds", c.cloud_count);
+    // Each cloud has 3 points; each body cloud one NaN hole (3 points in 2 rows of 2), the
+    // map clouds none.
+    assert_eq!(c.cloud_point_count, 3 * c.cloud_count, "3 points a cloud");
+    assert!((1..c.cloud_count).contains(&c.cloud_skipped_point_count));
+    let map = core.online_map().expect("started by the odometry");
+    let start = Vec3::new(2.0, 10.0, 3.0);
+    for p in CLOUD_POINTS {
+        let p = Vec3::new(p[0], p[1], p[2]);
+        assert_eq!(map.state(&p), VoxelState::Occupied, "the point {p:?}");
+        for f in [0.3, 0.5, 0.7, 0.85] {
+            let q = start + (p - start) * f;
+            assert_eq!(
+                map.state(&q),
+                VoxelState::Free,
+                "{f} of the way to {p:?}: {q:?}"
+            );
+        }
+    }
 }

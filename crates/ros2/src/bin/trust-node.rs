@@ -114,8 +114,17 @@ fn main() -> Result<()> {
     });
     let c = core.counters();
     eprintln!(
-        "trust-node: {} cycles, {} odometry, {} goals, {} obstacle messages, {} rejected",
-        c.cycle_count, c.odom_count, c.goal_count, c.obstacles_count, c.rejected_count
+        "trust-node: {} cycles, {} odometry, {} goals, {} obstacle messages, {} clouds ({} \
+         points, {} skipped; {} dropped behind newer), {} rejected",
+        c.cycle_count,
+        c.odom_count,
+        c.goal_count,
+        c.obstacles_count,
+        c.cloud_count,
+        c.cloud_point_count,
+        c.cloud_skipped_point_count,
+        c.cloud_dropped_count,
+        c.rejected_count
     );
     Ok(())
 }
