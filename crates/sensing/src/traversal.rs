@@ -112,11 +112,6 @@ impl VoxelTraversal {
 }
 
 impl VoxelTraversal {
-    /// The current voxel (the first one before any step).
-    pub(crate) fn key(&self) -> VoxelKey {
-        self.key
-    }
-
     /// Moves to the next voxel; returns the axis stepped and the step (±1), `None` at the end.
     pub(crate) fn step(&mut self) -> Option<(usize, i64)> {
         // The axis whose next face comes first, among those with steps left.
