@@ -286,16 +286,22 @@ impl Esdf {
                 expected: count,
             });
         }
-        if let Some(i) = distances
-            .iter()
-            .position(|d| d.is_nan() || *d == f64::NEG_INFINITY)
-        {
+        // One pass for the check and the count (the position only for the error).
+        let (mut occupied_count, mut bad) = (0usize, false);
+        for &d in &distances {
+            occupied_count += usize::from(d < 0.0);
+            bad |= d.is_nan() | (d == f64::NEG_INFINITY);
+        }
+        if bad {
+            let i = distances
+                .iter()
+                .position(|d| d.is_nan() || *d == f64::NEG_INFINITY)
+                .unwrap_or(0);
             return Err(GeometryError::non_finite(
                 format!("distances[{i}]"),
                 distances[i],
             ));
         }
-        let occupied_count = distances.iter().filter(|&&d| d < 0.0).count();
         let (coarse, coarse_dims) = coarse_minima(&distances, dims);
         Ok(Self {
             origin,
