@@ -754,7 +754,7 @@ mod tests {
                     for x in 0..dims[0] {
                         let d = esdf.distances()[voxel_index(dims, x, y, z)];
                         let own = |v: usize| v / COARSE_BLOCK;
-                        let below = |v: usize| (v % COARSE_BLOCK == 0 && v > 0).then(|| v / COARSE_BLOCK - 1);
+                        let below = |v: usize| (v.is_multiple_of(COARSE_BLOCK) && v > 0).then(|| v / COARSE_BLOCK - 1);
                         for cz in [Some(own(z)), below(z)].into_iter().flatten() {
                             for cy in [Some(own(y)), below(y)].into_iter().flatten() {
                                 for cx in [Some(own(x)), below(x)].into_iter().flatten() {
