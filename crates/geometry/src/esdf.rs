@@ -286,16 +286,22 @@ impl Esdf {
                 expected: count,
             });
         }
-        if let Some(i) = distances
-            .iter()
-            .position(|d| d.is_nan() || *d == f64::NEG_INFINITY)
-        {
+        // One pass for the check and the count (the position only for the error).
+        let (mut occupied_count, mut bad) = (0usize, false);
+        for &d in &distances {
+            occupied_count += usize::from(d < 0.0);
+            bad |= d.is_nan() | (d == f64::NEG_INFINITY);
+        }
+        if bad {
+            let i = distances
+                .iter()
+                .position(|d| d.is_nan() || *d == f64::NEG_INFINITY)
+                .unwrap_or(0);
             return Err(GeometryError::non_finite(
                 format!("distances[{i}]"),
                 distances[i],
             ));
         }
-        let occupied_count = distances.iter().filter(|&&d| d < 0.0).count();
         let (coarse, coarse_dims) = coarse_minima(&distances, dims);
         Ok(Self {
             origin,
@@ -605,21 +611,27 @@ fn coarse_minima(distances: &[f64], dims: [usize; 3]) -> (Vec<f64>, [usize; 3]) 
         let below = (v.is_multiple_of(COARSE_BLOCK) && b > 0).then(|| b - 1);
         (own, below)
     };
+    // Per row, the minimum over each block's extended x-range first (one comparison per voxel),
+    // then into the (at most four) blocks of the row's y and z.
+    let mut row_min = vec![f64::INFINITY; cd[0]];
     for z in 0..dims[2] {
         let (bz, bz2) = blocks(z, cd[2]);
         for y in 0..dims[1] {
             let (by, by2) = blocks(y, cd[1]);
-            let row = voxel_index(dims, 0, y, z);
-            for x in 0..dims[0] {
-                let d = distances[row + x];
-                let (bx, bx2) = blocks(x, cd[0]);
-                for &cz in [Some(bz), bz2].iter().flatten() {
-                    for &cy in [Some(by), by2].iter().flatten() {
-                        for &cx in [Some(bx), bx2].iter().flatten() {
-                            let k = voxel_index(cd, cx, cy, cz);
-                            if d < coarse[k] {
-                                coarse[k] = d;
-                            }
+            let row = &distances[voxel_index(dims, 0, y, z)..][..dims[0]];
+            for (cx, m) in row_min.iter_mut().enumerate() {
+                let lo = cx * COARSE_BLOCK;
+                let hi = (lo + COARSE_BLOCK + 1).min(dims[0]);
+                *m = row[lo..hi]
+                    .iter()
+                    .fold(f64::INFINITY, |a, &d| if d < a { d } else { a });
+            }
+            for &cz in [Some(bz), bz2].iter().flatten() {
+                for &cy in [Some(by), by2].iter().flatten() {
+                    let k = voxel_index(cd, 0, cy, cz);
+                    for (c, &m) in coarse[k..k + cd[0]].iter_mut().zip(&row_min) {
+                        if m < *c {
+                            *c = m;
                         }
                     }
                 }
@@ -727,6 +739,34 @@ mod tests {
                 prop_assert!((esdf.distances()[i] - expect).abs() < 1e-12);
                 prop_assert_eq!(esdf.distances()[i] < 0.0, occ[i]);
             }
+        }
+
+        /// The row-wise coarse minima equal the per-voxel definition (each voxel into its own
+        /// block and, on a block's low face, the block below).
+        #[test]
+        fn coarse_minima_match_the_definition(dims in dims_strategy(), density in 0.0f64..0.6, seed in any::<u64>()) {
+            let occ = random_occupancy(dims, density, seed);
+            let esdf = Esdf::from_occupancy(Vec3::zeros(), 0.5, dims, &occ).unwrap();
+            let (coarse, cd) = coarse_minima(esdf.distances(), dims);
+            let mut expect = vec![f64::INFINITY; cd[0] * cd[1] * cd[2]];
+            for z in 0..dims[2] {
+                for y in 0..dims[1] {
+                    for x in 0..dims[0] {
+                        let d = esdf.distances()[voxel_index(dims, x, y, z)];
+                        let own = |v: usize| v / COARSE_BLOCK;
+                        let below = |v: usize| (v.is_multiple_of(COARSE_BLOCK) && v > 0).then(|| v / COARSE_BLOCK - 1);
+                        for cz in [Some(own(z)), below(z)].into_iter().flatten() {
+                            for cy in [Some(own(y)), below(y)].into_iter().flatten() {
+                                for cx in [Some(own(x)), below(x)].into_iter().flatten() {
+                                    let k = voxel_index(cd, cx, cy, cz);
+                                    expect[k] = expect[k].min(d);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            prop_assert_eq!(coarse, expect);
         }
 
         /// The coarse grid bounds the interpolant from below, at points and over boxes, inside

@@ -3,14 +3,16 @@
 //! Only occupancy changes move the field, and only within the truncation distance `R` of the
 //! voxel that changed; so an update recomputes the *exact* truncated field in the box `T` of the
 //! changed voxels grown by `R`, from the sites in `T` grown by `R` once more (every site within
-//! `R` of a voxel of `T` lies there). The transform is the separable one of Felzenszwalb &
-//! Huttenlocher (2012), through `trust_geometry::edt_1d_with_scratch`, restricted to the lines
-//! that reach `T`. The inside distance of an occupied voxel (to the nearest non-occupied one) is
-//! a local search instead: surfaces seen by a sensor are thin, so it is almost always one voxel
-//! (a free face neighbour). The result equals a full recomputation voxel for voxel (property
-//! test).
-
-use trust_geometry::{EdtScratch, edt_1d_with_scratch};
+//! `R` of a voxel of `T` lies there). The transform is separable (Felzenszwalb & Huttenlocher
+//! 2012: `D(q) = min_j D_xy(q + j e_z) + j²`, and so on per axis), and truncated: a site farther
+//! than `R` along one axis is farther than `R` in all, so each 1-D pass is the minimum over the
+//! `2R + 1` offsets `|j| ≤ R` only. That form runs along whole rows of `T` at once (contiguous
+//! memory, one `min` per offset and voxel, no gathers), skips rows without a site within reach,
+//! and keeps squared distances in `f32` (integers up to `3 · 64²`, exact). Values above `R²`
+//! stand for "beyond the truncation", which is all the field reads of them. The inside distance
+//! of an occupied voxel (to the nearest non-occupied one) is a local search instead: surfaces
+//! seen by a sensor are thin, so it is almost always one voxel (a free face neighbour). The
+//! result equals a full recomputation voxel for voxel (property test).
 
 use crate::ring::Ring;
 use crate::traversal::VoxelKey;
@@ -26,10 +28,15 @@ pub(crate) struct DistanceField {
     pub dist: Vec<f64>,
     /// Voxels recomputed so far (for reports and benches).
     pub recomputed_count: u64,
-    outside: Vec<f64>,
-    line: Vec<f64>,
-    out: Vec<f64>,
-    scratch: EdtScratch,
+    /// Pass buffers: after the x pass (`T_x × S_y × S_z`), after the y pass (`T_x × T_y × S_z`),
+    /// a row of the z pass, and one row of occupancy.
+    pass_x: Vec<f32>,
+    pass_y: Vec<f32>,
+    row: Vec<f32>,
+    occ_row: Vec<bool>,
+    /// Whether a row of `pass_x` / `pass_y` holds a value within reach.
+    live_x: Vec<bool>,
+    live_y: Vec<bool>,
 }
 
 /// A box of voxel keys, inclusive on both ends.
@@ -80,10 +87,12 @@ impl DistanceField {
             r,
             dist: vec![r as f64 * res; slots],
             recomputed_count: 0,
-            outside: Vec::new(),
-            line: Vec::new(),
-            out: Vec::new(),
-            scratch: EdtScratch::default(),
+            pass_x: Vec::new(),
+            pass_y: Vec::new(),
+            row: Vec::new(),
+            occ_row: Vec::new(),
+            live_x: Vec::new(),
+            live_y: Vec::new(),
         }
     }
 
@@ -101,146 +110,148 @@ impl DistanceField {
         let Some(s) = t.grown_within(self.r, ring) else {
             return;
         };
-        let mut outside = std::mem::take(&mut self.outside);
-        self.transform(ring, occupied, &s, &t, false, &mut outside);
-        let sd = [s.len(0), s.len(1), s.len(2)];
-        let r = self.r as f64;
+        let r = self.r;
+        let far = (r * r) as f32;
+        let (tx, ty, tz) = (t.len(0), t.len(1), t.len(2));
+        let (sx, sy, sz) = (s.len(0), s.len(1), s.len(2));
+        let d = ring.dims;
+        // Offsets of `T` inside `S`.
+        let (ox, oy, oz) = (
+            (t.lo[0] - s.lo[0]) as usize,
+            (t.lo[1] - s.lo[1]) as usize,
+            (t.lo[2] - s.lo[2]) as usize,
+        );
+        let xs: Vec<usize> = (s.lo[0]..=s.hi[0]).map(|x| ring.axis_slot(0, x)).collect();
+
+        // Pass x: for x in T, every (y, z) of S, the squared distance to the nearest occupied
+        // voxel of the row within `r` (+inf if none).
+        self.pass_x.clear();
+        self.pass_x.resize(tx * sy * sz, f32::INFINITY);
+        self.live_x.clear();
+        self.live_x.resize(sy * sz, false);
+        self.occ_row.resize(sx, false);
+        for lz in 0..sz {
+            let slot_z = ring.axis_slot(2, s.lo[2] + lz as i64);
+            for ly in 0..sy {
+                let slot_y = ring.axis_slot(1, s.lo[1] + ly as i64);
+                let row = d[0] * (slot_y + d[1] * slot_z);
+                let mut any = false;
+                for (o, &slot_x) in self.occ_row.iter_mut().zip(&xs) {
+                    *o = occupied[row + slot_x];
+                    any |= *o;
+                }
+                if !any {
+                    continue;
+                }
+                let out = &mut self.pass_x[tx * (ly + sy * lz)..][..tx];
+                let mut live = false;
+                // Forward: the last site at or before x; backward: the next at or after.
+                let mut last = i64::MIN / 2;
+                for lx in 0..ox + tx {
+                    if self.occ_row[lx] {
+                        last = lx as i64;
+                    }
+                    if lx >= ox && lx as i64 - last <= r {
+                        let g = (lx as i64 - last) as f32;
+                        out[lx - ox] = g * g;
+                        live = true;
+                    }
+                }
+                let mut next = i64::MAX / 2;
+                for lx in (ox..sx).rev() {
+                    if self.occ_row[lx] {
+                        next = lx as i64;
+                    }
+                    if lx < ox + tx && next - lx as i64 <= r {
+                        let g = (next - lx as i64) as f32;
+                        let o = &mut out[lx - ox];
+                        if g * g < *o {
+                            *o = g * g;
+                        }
+                        live = true;
+                    }
+                }
+                self.live_x[ly + sy * lz] = live;
+            }
+        }
+
+        // Pass y: for (x, y) in T, every z of S: min over |j| <= r of pass_x(y + j) + j².
+        self.pass_y.clear();
+        self.pass_y.resize(tx * ty * sz, f32::INFINITY);
+        self.live_y.clear();
+        self.live_y.resize(ty * sz, false);
+        for lz in 0..sz {
+            for iy in 0..ty {
+                let ly = oy + iy;
+                let out = &mut self.pass_y[tx * (iy + ty * lz)..][..tx];
+                let mut live = false;
+                let lo = ly.saturating_sub(r as usize);
+                let hi = (ly + r as usize).min(sy - 1);
+                for src in lo..=hi {
+                    if !self.live_x[src + sy * lz] {
+                        continue;
+                    }
+                    live = true;
+                    let j = src as f32 - ly as f32;
+                    let add = j * j;
+                    let input = &self.pass_x[tx * (src + sy * lz)..][..tx];
+                    min_plus(out, input, add);
+                }
+                self.live_y[iy + ty * lz] = live;
+            }
+        }
+
+        // Pass z and the field: for (x, y, z) in T, min over |j| <= r of pass_y(z + j) + j².
+        let rf = r as f64;
         let res = ring.res;
-        let xs: Vec<usize> = (t.lo[0]..=t.hi[0]).map(|x| ring.axis_slot(0, x)).collect();
-        for z in t.lo[2]..=t.hi[2] {
-            let sz = ring.axis_slot(2, z);
-            let lz = (z - s.lo[2]) as usize;
-            for y in t.lo[1]..=t.hi[1] {
-                let sy = ring.axis_slot(1, y);
-                let ly = (y - s.lo[1]) as usize;
-                let row = ring.dims[0] * (sy + ring.dims[1] * sz);
-                let lrow = sd[0] * (ly + sd[1] * lz);
-                for (ix, &sx) in xs.iter().enumerate() {
-                    let l = lrow + (t.lo[0] - s.lo[0]) as usize + ix;
-                    let d_occ = outside[l].sqrt().min(r);
-                    let d_free = if occupied[row + sx] {
+        self.row.resize(tx, f32::INFINITY);
+        for iz in 0..tz {
+            let z = t.lo[2] + iz as i64;
+            let lz = oz + iz;
+            let slot_z = ring.axis_slot(2, z);
+            for iy in 0..ty {
+                let y = t.lo[1] + iy as i64;
+                let slot_y = ring.axis_slot(1, y);
+                let row = d[0] * (slot_y + d[1] * slot_z);
+                self.row.fill(f32::INFINITY);
+                let lo = lz.saturating_sub(r as usize);
+                let hi = (lz + r as usize).min(sz - 1);
+                for src in lo..=hi {
+                    if !self.live_y[iy + ty * src] {
+                        continue;
+                    }
+                    let j = src as f32 - lz as f32;
+                    let input = &self.pass_y[tx * (iy + ty * src)..][..tx];
+                    min_plus(&mut self.row, input, j * j);
+                }
+                for (ix, &dsq) in self.row.iter().enumerate() {
+                    let slot = row + xs[ox + ix];
+                    let d_occ = if dsq <= far {
+                        f64::from(dsq).sqrt().min(rf)
+                    } else {
+                        rf
+                    };
+                    let d_free = if occupied[slot] {
                         let k = [t.lo[0] + ix as i64, y, z];
-                        inside_sq(ring, occupied, &k, self.r).sqrt().min(r)
+                        inside_sq(ring, occupied, &k, self.r).sqrt().min(rf)
                     } else {
                         0.0
                     };
-                    self.dist[row + sx] = res * (d_occ - d_free);
+                    self.dist[slot] = res * (d_occ - d_free);
                 }
             }
         }
-        self.recomputed_count += (t.len(0) * t.len(1) * t.len(2)) as u64;
-        self.outside = outside;
+        self.recomputed_count += (tx * ty * tz) as u64;
     }
+}
 
-    /// The squared distance transform (voxel units) over the box `s`, exact on the lines that
-    /// reach `t`: to the occupied voxels (`inside == false`) or to the non-occupied ones and the
-    /// outside of the window (`inside == true`). `buf` gets `s`'s layout (x fastest).
-    fn transform(
-        &mut self,
-        ring: &Ring,
-        occupied: &[bool],
-        s: &KeyBox,
-        t: &KeyBox,
-        inside: bool,
-        buf: &mut Vec<f64>,
-    ) {
-        let sd = [s.len(0), s.len(1), s.len(2)];
-        buf.clear();
-        buf.resize(sd[0] * sd[1] * sd[2], f64::INFINITY);
-        let (wl, wh) = (ring.low, ring.high());
-        // Border sites just outside the window, for the inside transform, on the axes where
-        // the box reaches the window's faces.
-        let border =
-            |i: usize| -> (bool, bool) { (inside && s.lo[i] == wl[i], inside && s.hi[i] == wh[i]) };
-        let xs: Vec<usize> = (s.lo[0]..=s.hi[0]).map(|x| ring.axis_slot(0, x)).collect();
-        // Pass 1, along x, on every line of `s`: distance to the nearest site on the line.
-        let (bx_lo, bx_hi) = border(0);
-        for lz in 0..sd[2] {
-            let sz = ring.axis_slot(2, s.lo[2] + lz as i64);
-            for ly in 0..sd[1] {
-                let sy = ring.axis_slot(1, s.lo[1] + ly as i64);
-                let row = ring.dims[0] * (sy + ring.dims[1] * sz);
-                let base = sd[0] * (ly + sd[1] * lz);
-                let line = &mut buf[base..base + sd[0]];
-                // Forward sweep: distance to the last site at or before x.
-                let mut last: Option<i64> = bx_lo.then_some(-1);
-                for (lx, &sx) in xs.iter().enumerate() {
-                    if occupied[row + sx] != inside {
-                        last = Some(lx as i64);
-                    }
-                    if let Some(p) = last {
-                        let d = (lx as i64 - p) as f64;
-                        line[lx] = d * d;
-                    }
-                }
-                // Backward sweep: the next site at or after x.
-                let mut next: Option<i64> = bx_hi.then_some(sd[0] as i64);
-                for lx in (0..sd[0]).rev() {
-                    if line[lx] == 0.0 {
-                        next = Some(lx as i64);
-                    } else if let Some(p) = next {
-                        let d = (p - lx as i64) as f64;
-                        line[lx] = line[lx].min(d * d);
-                    }
-                }
-            }
-        }
-        // Passes 2 (along y) and 3 (along z), only on the lines that reach `t`.
-        let tx = ((t.lo[0] - s.lo[0]) as usize, (t.hi[0] - s.lo[0]) as usize);
-        let ty = ((t.lo[1] - s.lo[1]) as usize, (t.hi[1] - s.lo[1]) as usize);
-        let (by_lo, by_hi) = border(1);
-        for lz in 0..sd[2] {
-            for lx in tx.0..=tx.1 {
-                let base = lx + sd[0] * sd[1] * lz;
-                self.line_pass(buf, base, sd[0], sd[1], by_lo, by_hi);
-            }
-        }
-        let (bz_lo, bz_hi) = border(2);
-        for ly in ty.0..=ty.1 {
-            for lx in tx.0..=tx.1 {
-                let base = lx + sd[0] * ly;
-                self.line_pass(buf, base, sd[0] * sd[1], sd[2], bz_lo, bz_hi);
-            }
-        }
-    }
-
-    /// One 1-D transform of the `n` values of `buf` at `base + k * stride`, with border sites
-    /// (value 0) one step before the first and after the last value when asked.
-    fn line_pass(
-        &mut self,
-        buf: &mut [f64],
-        base: usize,
-        stride: usize,
-        n: usize,
-        border_lo: bool,
-        border_hi: bool,
-    ) {
-        let pad = usize::from(border_lo);
-        let len = n + pad + usize::from(border_hi);
-        self.line.clear();
-        if border_lo {
-            self.line.push(0.0);
-        }
-        let (mut all_zero, mut all_inf) = (true, true);
-        for k in 0..n {
-            let v = buf[base + k * stride];
-            all_zero &= v == 0.0;
-            all_inf &= v == f64::INFINITY;
-            self.line.push(v);
-        }
-        if border_hi {
-            self.line.push(0.0);
-        }
-        // Lines the transform leaves unchanged.
-        if all_zero || (all_inf && !border_lo && !border_hi) {
-            return;
-        }
-        self.out.clear();
-        self.out.resize(len, 0.0);
-        edt_1d_with_scratch(&self.line, &mut self.out, &mut self.scratch);
-        for k in 0..n {
-            buf[base + k * stride] = self.out[k + pad];
-        }
+/// `out[i] = min(out[i], input[i] + add)` (one step of a truncated 1-D distance pass; written so
+/// that it vectorizes).
+#[inline]
+fn min_plus(out: &mut [f32], input: &[f32], add: f32) {
+    for (o, &v) in out.iter_mut().zip(input) {
+        let c = v + add;
+        *o = if c < *o { c } else { *o };
     }
 }
 
