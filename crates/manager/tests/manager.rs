@@ -909,10 +909,7 @@ fn the_fallback_flies_on_the_manoeuvre_under_way() {
     assert!(!first.collision_free, "{first:?}");
     let plan = m.plan().unwrap().clone();
     let t = 0.1;
-    let on_plan = State {
-        t,
-        ..plan.state(t)
-    };
+    let on_plan = State { t, ..plan.state(t) };
     let scene = Scene::new(&map, &person, t).unwrap();
     let second = m.step(t, &on_plan, &goal, &scene).unwrap();
     let second = second.fallback.expect("still no branch");

@@ -537,11 +537,16 @@ impl LocalMap {
     }
 
     /// True if every point within `clearance` of the segment `[a, b]` lies in known free voxels:
-    /// every voxel the segment passes (3-D DDA) and every voxel within `ceil(clearance /
-    /// resolution)` voxels of one of them per axis is [`VoxelState::Free`] (conservative: a cube
-    /// around each voxel). False for non-finite input, a NaN clearance, a segment leaving the
-    /// window, or a clearance above 16 voxels (the check would cost too much; ask the distance
-    /// field instead). A negative clearance counts as 0.
+    /// every voxel the segment passes (3-D DDA) and every voxel the ball of radius `clearance`
+    /// around a point of one of them can reach — those whose box lies nearer than `clearance`
+    /// to that voxel's box (per axis `max(|d| − 1, 0)` voxels apart) — is
+    /// [`VoxelState::Free`]. Exact for the ball at voxel level (conservative: a point's ball is
+    /// checked wherever in its voxel the point lies), and no more: a cube of `ceil(clearance /
+    /// resolution)` voxels per axis also asked for its corners, 1.7 × the clearance away, which a
+    /// hovering vehicle's camera does not see (its vertical field misses the space beside and
+    /// below it within half a metre). False for non-finite input, a NaN clearance, a segment
+    /// leaving the window, or a clearance above 16 voxels (the check would cost too much; ask
+    /// the distance field instead). A negative clearance counts as 0.
     pub fn segment_known_free(&self, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
         if clearance.is_nan() {
             return false;
@@ -551,20 +556,16 @@ impl LocalMap {
             return false;
         }
         let res = self.ring.res;
-        let c = (clearance.max(0.0) / res).ceil();
-        if c > 16.0 {
+        let r = clearance.max(0.0) / res;
+        if r > 16.0 {
             return false;
         }
-        let c = c as i64;
+        let offsets = ball_offsets(r);
         for k in VoxelTraversal::unchecked(a, b, res) {
-            for dz in -c..=c {
-                for dy in -c..=c {
-                    for dx in -c..=c {
-                        let q = [k[0] + dx, k[1] + dy, k[2] + dz];
-                        if self.state_of_key(&q) != VoxelState::Free {
-                            return false;
-                        }
-                    }
+            for d in &offsets {
+                let q = [k[0] + d[0], k[1] + d[1], k[2] + d[2]];
+                if self.state_of_key(&q) != VoxelState::Free {
+                    return false;
                 }
             }
         }
@@ -688,6 +689,27 @@ impl LocalMap {
     }
 }
 
+/// The voxel offsets a ball of radius `r` voxels around a point of voxel 0 can reach: voxel 0
+/// and every `d` whose box lies nearer than `r` to voxel 0's (`Σ max(|dᵢ| − 1, 0)² < r²`),
+/// nearest first (an unknown voxel is usually found next to the segment).
+fn ball_offsets(r: f64) -> Vec<[i64; 3]> {
+    let c = r.floor() as i64 + 1;
+    let gap = |d: i64| (d.abs() - 1).max(0) as f64;
+    let mut out: Vec<([i64; 3], f64)> = Vec::new();
+    for dz in -c..=c {
+        for dy in -c..=c {
+            for dx in -c..=c {
+                let g2 = gap(dx).powi(2) + gap(dy).powi(2) + gap(dz).powi(2);
+                if (dx, dy, dz) == (0, 0, 0) || g2 < r * r {
+                    out.push(([dx, dy, dz], (dx * dx + dy * dy + dz * dz) as f64));
+                }
+            }
+        }
+    }
+    out.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+    out.into_iter().map(|(d, _)| d).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -774,6 +796,48 @@ mod tests {
                     })
                     .collect(),
             })
+    }
+
+    /// A map of 0.1 m voxels with only the ball of `radius` round a voxel centre known free.
+    fn ball_known(radius: f64) -> (LocalMap, Vec3) {
+        let params = LocalMapParams {
+            dims: [24, 24, 24],
+            ..LocalMapParams::default()
+        };
+        let mut map = LocalMap::new(params, &Vec3::zeros()).unwrap();
+        let c = map
+            .ring
+            .center(&voxel_key(&Vec3::new(0.02, 0.03, 0.01), 0.1));
+        map.assume_free(&c, radius);
+        (map, c)
+    }
+
+    #[test]
+    fn the_clearance_is_a_ball_not_a_cube() {
+        // Every voxel a 0.3 m ball round a point of the centre voxel reaches has its centre
+        // within √19 voxels (0.436 m): known free, although the cube's corners (0.52 m) are not.
+        let (map, c) = ball_known(0.45);
+        assert!(map.segment_known_free(&c, &c, 0.3));
+        assert_ne!(map.state_of_key(&[3, 3, 3]), VoxelState::Free);
+        // A voxel the ball reaches, (3, 3, 0) voxels away (its box 0.28 m off), unknown: refused.
+        let (map, c) = ball_known(0.4);
+        assert!(!map.segment_known_free(&c, &c, 0.3));
+        assert!(map.segment_known_free(&c, &c, 0.2));
+    }
+
+    #[test]
+    fn ball_offsets_are_those_the_ball_can_reach() {
+        assert_eq!(ball_offsets(0.0), vec![[0, 0, 0]]);
+        assert_eq!(ball_offsets(0.5).len(), 27);
+        let three = ball_offsets(3.0);
+        assert!(three.contains(&[3, 3, 0]) && three.contains(&[3, 2, 2]));
+        assert!(!three.contains(&[4, 0, 0]) && !three.contains(&[3, 3, 2]));
+        assert!(!three.contains(&[3, 3, 3]));
+        // Symmetric, centre first.
+        assert_eq!(three[0], [0, 0, 0]);
+        for d in &three {
+            assert!(three.contains(&[-d[0], d[1], -d[2]]));
+        }
     }
 
     proptest! {
