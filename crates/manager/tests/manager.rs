@@ -842,6 +842,22 @@ fn the_fallback_steps_out_of_a_faster_obstacles_path() {
     );
 }
 
+/// A person coming at 1.5 m/s from 3 m behind a vehicle at rest at (50, 0, 5), with 0.3 m of
+/// body and 1.5 m of margin: every way out touches the forecast, and fleeing straight ahead of it
+/// does so last.
+fn person_with_no_way_round() -> Forecast {
+    Forecast::new(
+        ObstacleShape::Sphere,
+        Vec3::new(47.0, 0.0, 5.0),
+        Vec3::new(1.5, 0.0, 0.0),
+        0.0,
+        0.3,
+        1.5,
+        0.6,
+    )
+    .unwrap()
+}
+
 /// Issue 19 (a holdout room: a person pacing across it faster than the vehicle; 6 of 60
 /// flights collided): a vehicle in a faster obstacle's lane whose forecast's margins leave no
 /// way out of it in time. Every option touches the forecast, and "collides latest" fled along
@@ -851,18 +867,7 @@ fn the_fallback_steps_out_of_a_faster_obstacles_path() {
 fn with_no_way_clear_of_the_forecasts_the_fallback_steps_out_of_the_likely_path() {
     let map = open_air();
     let mut m = blind_single_branch_at_room_limits();
-    // 0.3 m of body and 1.5 m of margin, coming at 1.5 m/s from 3 m away: every way out
-    // touches the forecast, and fleeing straight ahead of it does so last.
-    let person = [Forecast::new(
-        ObstacleShape::Sphere,
-        Vec3::new(47.0, 0.0, 5.0),
-        Vec3::new(1.5, 0.0, 0.0),
-        0.0,
-        0.3,
-        1.5,
-        0.6,
-    )
-    .unwrap()];
+    let person = [person_with_no_way_round()];
     let scene = Scene::new(&map, &person, 0.0).unwrap();
     let start = State::at_rest(0.0, Vec3::new(50.0, 0.0, 5.0));
     let r = m
@@ -891,16 +896,7 @@ fn with_no_way_clear_of_the_forecasts_the_fallback_steps_out_of_the_likely_path(
 fn the_fallback_flies_on_the_manoeuvre_under_way() {
     let map = open_air();
     let mut m = blind_single_branch_at_room_limits();
-    let person = [Forecast::new(
-        ObstacleShape::Sphere,
-        Vec3::new(47.0, 0.0, 5.0),
-        Vec3::new(1.5, 0.0, 0.0),
-        0.0,
-        0.3,
-        1.5,
-        0.6,
-    )
-    .unwrap()];
+    let person = [person_with_no_way_round()];
     let goal = Vec3::new(95.0, 0.0, 5.0);
     let scene = Scene::new(&map, &person, 0.0).unwrap();
     let start = State::at_rest(0.0, Vec3::new(50.0, 0.0, 5.0));
