@@ -758,7 +758,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             // found there, before the vehicle has flown a cycle on the old one); with a map
             // the threads can read, the later slices are done between cycles (sent away as
             // the cycle ends), else each cycle does a slice itself.
-            None if (started_now && !(first_at_rest && off_cycle)) || !off_cycle => {
+            None if !off_cycle || (started_now && !first_at_rest) => {
                 let deadline = self.params.enforce_budget.then(|| {
                     spans.started
                         + Duration::from_secs_f64(
