@@ -523,6 +523,17 @@ mod tests {
         m
     }
 
+    /// The cycles at 0 and 0.1 s with the vehicle at rest at `m`'s pose: at rest the manager
+    /// holds its place in the first cycle while the first route is searched on its thread; the
+    /// second flies toward the goal. Returns the second cycle's output.
+    fn past_the_route_wait(core: &mut NodeCore, m: &Odometry) -> CycleOutput {
+        core.cycle(at(0.0)).expect("cycle").expect("ran");
+        let mut later = m.clone();
+        later.header.stamp = at(0.1);
+        core.on_odometry(&later).expect("valid");
+        core.cycle(at(0.1)).expect("cycle").expect("ran")
+    }
+
     fn field_of(e: &Ros2Error) -> &str {
         match e {
             Ros2Error::Invalid { field, .. } => field,
@@ -533,10 +544,10 @@ mod tests {
     #[test]
     fn odometry_and_goal_give_a_trajectory_sampling_the_managers_plan() {
         let mut core = core();
-        core.on_odometry(&odom(0.0, [2.0, 10.0, 3.0]))
-            .expect("valid");
+        let m = odom(0.0, [2.0, 10.0, 3.0]);
+        core.on_odometry(&m).expect("valid");
         core.on_goal(&goal([38.0, 10.0, 3.0])).expect("valid");
-        let out = core.cycle(at(0.0)).expect("cycle").expect("a cycle ran");
+        let out = past_the_route_wait(&mut core, &m);
         let traj = out.trajectory.expect("a plan");
         let plan = core.manager().plan().expect("committed plan").clone();
         assert_eq!(traj.header.frame_id, "map");
@@ -617,7 +628,7 @@ mod tests {
         m.pose.pose.orientation = Quaternion::from_yaw(FRAC_PI_2);
         core.on_odometry(&m).expect("valid");
         core.on_goal(&goal([20.0, 9.0, 3.0])).expect("valid");
-        let out = core.cycle(at(0.0)).expect("cycle").expect("ran");
+        let out = past_the_route_wait(&mut core, &m);
         let plan = core.manager().plan().expect("a plan").clone();
         // The plan starts at rest: its first sample holds the vehicle's heading.
         let traj = out.trajectory.expect("a trajectory");
@@ -1024,8 +1035,8 @@ mod tests {
     #[test]
     fn with_a_cloud_the_planner_plans_in_the_sensed_map_not_the_scenarios() {
         let mut core = cloud_core(crate::sensing::CloudParams::default());
-        core.on_odometry(&odom(0.0, [2.0, 10.0, 3.0]))
-            .expect("valid");
+        let m = odom(0.0, [2.0, 10.0, 3.0]);
+        core.on_odometry(&m).expect("valid");
         core.on_goal(&goal([38.0, 10.0, 3.0])).expect("valid");
         // A wall across the way at x = 6.05, y in [8, 12], z in [1, 5], seen in the map frame.
         let wall: Vec<Vec3> = (0..41)
@@ -1034,7 +1045,7 @@ mod tests {
             .collect();
         core.on_cloud(&cloud(0.0, "map", &wall)).expect("valid");
         assert_eq!(core.counters().cloud_point_count, wall.len() as u64);
-        core.cycle(at(0.0)).expect("cycle").expect("ran");
+        past_the_route_wait(&mut core, &m);
         let main = core.manager().main().expect("a main branch");
         let branch = core
             .manager()
@@ -1058,11 +1069,9 @@ mod tests {
         }
         // Without the cloud the same cycle flies straight through x = 6.
         let mut plain = core_without_cloud();
-        plain
-            .on_odometry(&odom(0.0, [2.0, 10.0, 3.0]))
-            .expect("valid");
+        plain.on_odometry(&m).expect("valid");
         plain.on_goal(&goal([38.0, 10.0, 3.0])).expect("valid");
-        plain.cycle(at(0.0)).expect("cycle").expect("ran");
+        past_the_route_wait(&mut plain, &m);
         let plan = plain.manager().plan().expect("a plan");
         let crossing = (0..1000)
             .map(|k| {
