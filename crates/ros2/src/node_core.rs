@@ -579,7 +579,7 @@ mod tests {
         );
         let path = out.path.expect("a path");
         assert_eq!(path.poses.len(), traj.points.len());
-        assert_eq!(out.event.cycle_count, 1);
+        assert_eq!(out.event.cycle_count, 2);
         assert!(out.event.has_plan);
         assert!(
             out.markers.markers.iter().any(|m| m.ns == "branches"),
