@@ -496,6 +496,13 @@ def match_path_yaws(state, stamp, kind, yaws):
         state["yaws_matched"] = True
 
 
+def holds_in_place(first, last):
+    """A plan that ends where it starts, short of the goal: the node's first cycles at rest hold
+    the vehicle's place while its first route is searched (decoded and checked all the same, but
+    not yet the plan toward the goal the peer waits for)."""
+    return dist(last, first) < 0.1 and dist(last, GOAL) >= 1.0
+
+
 def check_trajectory(m, state):
     check_header(m.header, "trajectory")
     check(list(m.joint_names) == [BODY], f"trajectory.joint_names = {m.joint_names}, expected [{BODY!r}]")
@@ -513,6 +520,8 @@ def check_trajectory(m, state):
     first = xyz(m.points[0].transforms[0].translation)
     last = xyz(m.points[-1].transforms[0].translation)
     check(dist(first, START) < 1.0, f"trajectory starts at {first}, the vehicle is at {START}")
+    if holds_in_place(first, last):
+        return None
     check(dist(last, GOAL) < 1.0, f"trajectory ends at {last}, the goal is {GOAL}")
     return f"{len(m.points)} points from {fmt(first)} to {fmt(last)} in {last_t:.2f} s"
 
@@ -528,6 +537,8 @@ def check_path(m, state):
     match_path_yaws(state, m.header.stamp, "path_yaws", yaws)
     first, last = xyz(m.poses[0].pose.position), xyz(m.poses[-1].pose.position)
     check(dist(first, START) < 1.0, f"path starts at {first}, the vehicle is at {START}")
+    if holds_in_place(first, last):
+        return None
     check(dist(last, GOAL) < 1.0, f"path ends at {last}, the goal is {GOAL}")
     return f"{len(m.poses)} poses from {fmt(first)} to {fmt(last)}"
 
@@ -743,6 +754,8 @@ def main():
                 except CheckFailed as e:
                     print(f"peer: FAILED {name}: {e}", file=sys.stderr)
                     return 1
+                if summary is None:
+                    continue
                 if name not in passed:
                     print(f"peer: {name} ok: {summary}", file=sys.stderr)
                 passed[name] = summary
