@@ -759,12 +759,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             // the threads can read, the later slices are done between cycles (sent away as
             // the cycle ends), else each cycle does a slice itself.
             None if !off_cycle || (started_now && !first_at_rest) => {
-                let deadline = self.params.enforce_budget.then(|| {
-                    spans.started
-                        + Duration::from_secs_f64(
-                            ROUTE_DEADLINE_FRACTION * self.params.cycle_budget_ms * 1e-3,
-                        )
-                });
+                let deadline = deadline_at(spans.started, &self.params, ROUTE_DEADLINE_FRACTION);
                 match spans.time(Span::Route, || {
                     router.slice_in_cycle(search, scene.map, deadline)
                 }) {
@@ -2217,9 +2212,14 @@ fn dropped_collision(id: Option<BranchId>, verdict: &SafetyVerdict, limits: &Lim
 
 /// The solves' deadline of work started at `started` ([`ManagerParams::enforce_budget`]).
 fn deadline_from(started: Instant, params: &ManagerParams) -> Option<Instant> {
-    params.enforce_budget.then(|| {
-        started + Duration::from_secs_f64(SOLVE_DEADLINE_FRACTION * params.cycle_budget_ms * 1e-3)
-    })
+    deadline_at(started, params, SOLVE_DEADLINE_FRACTION)
+}
+
+/// `started` plus `fraction` of the cycle budget, with [`ManagerParams::enforce_budget`].
+fn deadline_at(started: Instant, params: &ManagerParams, fraction: f64) -> Option<Instant> {
+    params
+        .enforce_budget
+        .then(|| started + Duration::from_secs_f64(fraction * params.cycle_budget_ms * 1e-3))
 }
 
 /// Everything a parallel solve needs, shared read-only.
