@@ -42,7 +42,10 @@ use rand_chacha::ChaCha8Rng;
 use trust_core::{StaticMap, Vec3};
 use trust_manager::CommitCheck;
 use trust_planner::AnyManager;
-use trust_sensing::{DepthCamera, Lidar, LocalMap, Pose, RaySensor, Scan, Truth};
+use trust_sensing::{
+    DEFAULT_MEMORY_CELL_M, DepthCamera, Lidar, LocalMap, MapMemory, Pose, RaySensor, Scan, Truth,
+    ViewBand,
+};
 use trust_vehicle::VehicleState;
 use trust_world::World;
 use trust_world::map_sensing::StaticSensor;
@@ -81,6 +84,11 @@ pub struct MapSensing {
 /// the known-free commit check on it. Times its own work (`take_map_ms`).
 pub struct OnlineMap {
     map: Arc<LocalMap>,
+    /// What the window has seen, kept for the flight (folded every [`FOLD_EVERY_SCANS`]).
+    memory: Arc<MapMemory>,
+    /// The sensor's view, for the route's map (`None`: the route plans on the planner's map).
+    view: Option<ViewBand>,
+    scans: usize,
     bounds: trust_core::Aabb,
     planner_map: Arc<StaticMap>,
     dirty: bool,
@@ -111,8 +119,13 @@ impl OnlineMap {
         let diagonal = 3f64.sqrt() * params.resolution_m;
         map.assume_free(start, radius_m + blind_reach_m + diagonal);
         let planner_map = Arc::new(map.to_static_map(bounds)?);
+        let mut memory = MapMemory::new(&bounds, DEFAULT_MEMORY_CELL_M)?;
+        memory.fold(&map);
         Ok(OnlineMap {
             map: Arc::new(map),
+            memory: Arc::new(memory),
+            view: None,
+            scans: 0,
             bounds,
             planner_map,
             dirty: false,
@@ -138,6 +151,10 @@ impl OnlineMap {
         map.recentre(vehicle)?;
         let update = map.insert_scan(scan)?;
         map.assume_free(vehicle, self.body_m);
+        self.scans += 1;
+        if self.scans.is_multiple_of(FOLD_EVERY_SCANS) {
+            Arc::make_mut(&mut self.memory).fold(map);
+        }
         self.dirty = true;
         self.map_ms += started.elapsed().as_secs_f64() * 1e3;
         Ok(update)
@@ -168,7 +185,29 @@ impl OnlineMap {
         Arc::new(KnownFree {
             map: Arc::clone(&self.map),
             clearance_m: self.clearance_m,
+            route: self.view.map(|view| RouteView {
+                memory: Arc::clone(&self.memory),
+                near: Arc::clone(&self.planner_map),
+                view,
+                keep_m: self.clearance_m + 2.0 * self.memory.cell_m(),
+            }),
         })
+    }
+
+    /// Gives the route a map of its own ([`MapMemory::route_map`]): what was seen beyond the
+    /// window, and the unknown space `view` cannot see from the vehicle blocked.
+    ///
+    /// # Errors
+    /// `SensingError` for an invalid band.
+    pub fn with_view(mut self, view: ViewBand) -> Result<Self, trust_sensing::SensingError> {
+        view.validate()?;
+        self.view = Some(view);
+        Ok(self)
+    }
+
+    /// What the window has seen, kept for the flight.
+    pub fn memory(&self) -> &MapMemory {
+        &self.memory
     }
 
     /// The online map.
@@ -197,6 +236,7 @@ impl MapSensing {
                     .into(),
             }));
         }
+        let band = view_band(&sensor);
         let sensor: Box<dyn RaySensor> = match sensor {
             StaticSensor::Depth(p) => Box::new(DepthCamera::new(p)?),
             StaticSensor::Lidar(p) => Box::new(Lidar::new(p)?),
@@ -208,7 +248,8 @@ impl MapSensing {
             *world.bounds(),
             world.vehicle_radius_m(),
             blind,
-        )?;
+        )?
+        .with_view(band)?;
         let goal = world.goal() - start;
         let yaw = 0.0;
         Ok(Some(MapSensing {
@@ -308,10 +349,51 @@ impl MapSensing {
 }
 
 /// The commit check of a sensed map: a segment passes if every voxel within the vehicle's
-/// radius of it is observed free (`LocalMap::segment_known_free`).
+/// radius of it is observed free (`LocalMap::segment_known_free`); with a view band the route
+/// is searched on the memory's route map ([`MapMemory::route_map`]).
 pub struct KnownFree {
     map: Arc<LocalMap>,
     clearance_m: f64,
+    route: Option<RouteView>,
+}
+
+/// What [`KnownFree::route_map`] builds the route's map from.
+struct RouteView {
+    memory: Arc<MapMemory>,
+    near: Arc<StaticMap>,
+    view: ViewBand,
+    keep_m: f64,
+}
+
+/// How many scans between two folds of the window into the memory: 8 (0.27 s at the camera's
+/// 30 Hz, 0.8 s at the LiDAR's 10 Hz; a pass over the window costs about 2 ms), well within
+/// the time the window holds what it saw (its half width at the vehicle's speed).
+pub const FOLD_EVERY_SCANS: usize = 8;
+
+/// The margin inside the sensor's vertical field kept by the route's view band (rad): 3°, for
+/// the vehicle's tilt in flight and the cells' extent.
+pub const VIEW_MARGIN_RAD: f64 = 0.05;
+
+/// Farthest the route's view band holds (m): unknown space beyond stays free for the route (a
+/// LiDAR's 100 m would make the band's blocks cost more than the route they shape).
+pub const VIEW_REACH_CAP_M: f64 = 15.0;
+
+/// The elevations a sensor sees (turning about the vertical axis) and how far, for the route.
+pub fn view_band(sensor: &StaticSensor) -> ViewBand {
+    let (lo, hi, reach) = match sensor {
+        StaticSensor::Depth(p) => (-0.5 * p.vfov_rad, 0.5 * p.vfov_rad, p.max_depth_m),
+        StaticSensor::Lidar(p) => (p.min_elevation_rad, p.max_elevation_rad, p.max_range_m),
+    };
+    let (lo, hi) = if hi - lo > 2.0 * VIEW_MARGIN_RAD {
+        (lo + VIEW_MARGIN_RAD, hi - VIEW_MARGIN_RAD)
+    } else {
+        (lo, hi)
+    };
+    ViewBand {
+        min_elevation_rad: lo,
+        max_elevation_rad: hi,
+        reach_m: reach.min(VIEW_REACH_CAP_M),
+    }
 }
 
 impl CommitCheck for KnownFree {
@@ -321,5 +403,14 @@ impl CommitCheck for KnownFree {
 
     fn segment_free(&self, a: &Vec3, b: &Vec3) -> bool {
         self.map.segment_known_free(a, b, self.clearance_m)
+    }
+
+    fn route_map(&self, from: &Vec3, goal: &Vec3) -> Option<Arc<StaticMap>> {
+        let r = self.route.as_ref()?;
+        let window = self.map.window();
+        r.memory
+            .route_map(&r.near, &window, from, goal, &r.view, r.keep_m)
+            .ok()
+            .map(Arc::new)
     }
 }

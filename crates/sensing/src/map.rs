@@ -687,6 +687,25 @@ impl LocalMap {
     pub fn distance_slots(&self) -> &[f64] {
         &self.field.dist
     }
+
+    /// Calls `visit(key, occupied)` for every observed voxel of the window (x fastest), for
+    /// maps that outlive it ([`crate::MapMemory::fold`]).
+    pub(crate) fn for_each_known(&self, mut visit: impl FnMut(&VoxelKey, bool)) {
+        let d = self.ring.dims;
+        let (lo, hi) = (self.ring.low, self.ring.high());
+        for z in lo[2]..=hi[2] {
+            let sz = self.ring.axis_slot(2, z);
+            for y in lo[1]..=hi[1] {
+                let row = d[0] * (self.ring.axis_slot(1, y) + d[1] * sz);
+                for x in lo[0]..=hi[0] {
+                    let slot = row + self.ring.axis_slot(0, x);
+                    if self.voxels[slot].known {
+                        visit(&[x, y, z], self.occupied[slot]);
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// The voxel offsets a ball of radius `r` voxels around a point of voxel 0 can reach: voxel 0
