@@ -160,7 +160,7 @@ enum Cmd {
         /// perfect, quadrotor, mu=X, fault=X, explore=K, route (a global route on the static map;
         /// without it every planner aims at the final goal, the paper's setting), real-time or
         /// real-time=X (each cycle's measured wall time, times X, is charged: use `--jobs 1` on a
-        /// quiet machine).
+        /// quiet machine), unknown (the static map is not given: a depth camera senses it).
         #[arg(long, default_value = "none")]
         variant: String,
         /// Output directory.
