@@ -44,7 +44,6 @@ use trust_manager::CommitCheck;
 use trust_planner::AnyManager;
 use trust_sensing::{
     DEFAULT_MEMORY_CELL_M, DepthCamera, Lidar, LocalMap, MapMemory, Pose, RaySensor, Scan, Truth,
-    ViewBand,
 };
 use trust_vehicle::VehicleState;
 use trust_world::World;
@@ -84,10 +83,11 @@ pub struct MapSensing {
 /// the known-free commit check on it. Times its own work (`take_map_ms`).
 pub struct OnlineMap {
     map: Arc<LocalMap>,
-    /// What the window has seen, kept for the flight (folded every [`FOLD_EVERY_SCANS`]).
-    memory: Arc<MapMemory>,
-    /// The sensor's view, for the route's map (`None`: the route plans on the planner's map).
-    view: Option<ViewBand>,
+    /// The surfaces seen, kept for the flight, when the route has a map of its own
+    /// ([`OnlineMap::with_route_memory`]).
+    memory: Option<Arc<MapMemory>>,
+    /// The sensor's range (m), for the route's map.
+    range_m: f64,
     scans: usize,
     bounds: trust_core::Aabb,
     planner_map: Arc<StaticMap>,
@@ -119,12 +119,10 @@ impl OnlineMap {
         let diagonal = 3f64.sqrt() * params.resolution_m;
         map.assume_free(start, radius_m + blind_reach_m + diagonal);
         let planner_map = Arc::new(map.to_static_map(bounds)?);
-        let mut memory = MapMemory::new(&bounds, DEFAULT_MEMORY_CELL_M)?;
-        memory.fold(&map);
         Ok(OnlineMap {
             map: Arc::new(map),
-            memory: Arc::new(memory),
-            view: None,
+            memory: None,
+            range_m: 0.0,
             scans: 0,
             bounds,
             planner_map,
@@ -151,9 +149,13 @@ impl OnlineMap {
         map.recentre(vehicle)?;
         let update = map.insert_scan(scan)?;
         map.assume_free(vehicle, self.body_m);
-        self.scans += 1;
-        if self.scans.is_multiple_of(FOLD_EVERY_SCANS) {
-            Arc::make_mut(&mut self.memory).fold(map);
+        if let Some(memory) = self.memory.as_mut() {
+            let memory = Arc::make_mut(memory);
+            memory.record(scan);
+            self.scans += 1;
+            if self.scans == 1 || self.scans.is_multiple_of(FOLD_EVERY_SCANS) {
+                memory.fold(map);
+            }
         }
         self.dirty = true;
         self.map_ms += started.elapsed().as_secs_f64() * 1e3;
@@ -185,29 +187,42 @@ impl OnlineMap {
         Arc::new(KnownFree {
             map: Arc::clone(&self.map),
             clearance_m: self.clearance_m,
-            route: self.view.map(|view| RouteView {
-                memory: Arc::clone(&self.memory),
+            route: self.memory.as_ref().map(|memory| RouteView {
+                memory: Arc::clone(memory),
                 near: Arc::clone(&self.planner_map),
-                view,
-                keep_m: self.clearance_m + 2.0 * self.memory.cell_m(),
+                keep_m: self.body_m + self.clearance_m + ROUTE_KEEP_M,
+                reach_m: ROUTE_BLOCKED_REACH * self.range_m,
             }),
         })
     }
 
-    /// Gives the route a map of its own ([`MapMemory::route_map`]): what was seen beyond the
-    /// window, and the unknown space `view` cannot see from the vehicle blocked.
+    /// Gives the route a map of its own ([`MapMemory::route_map`]): the window with the
+    /// unknown space within [`ROUTE_BLOCKED_REACH`] of the sensor's range `range_m` of the
+    /// vehicle blocked, and beyond the window every surface the sensor has returned, remembered
+    /// for the flight in cells of [`DEFAULT_MEMORY_CELL_M`]. Without it the route searches the
+    /// planner's map (the window only, unknown free). For scans of the static world only: a
+    /// moving obstacle's returns would be remembered as walls.
     ///
     /// # Errors
-    /// `SensingError` for an invalid band.
-    pub fn with_view(mut self, view: ViewBand) -> Result<Self, trust_sensing::SensingError> {
-        view.validate()?;
-        self.view = Some(view);
+    /// `SensingError` for a range that is not positive and finite.
+    pub fn with_route_memory(mut self, range_m: f64) -> Result<Self, trust_sensing::SensingError> {
+        if !(range_m.is_finite() && range_m > 0.0) {
+            return Err(trust_sensing::SensingError::OutOfRange {
+                field: "route_memory.range_m".into(),
+                value: range_m,
+                expected: "finite and > 0",
+            });
+        }
+        let mut memory = MapMemory::new(&self.bounds, DEFAULT_MEMORY_CELL_M)?;
+        memory.fold(&self.map);
+        self.memory = Some(Arc::new(memory));
+        self.range_m = range_m;
         Ok(self)
     }
 
-    /// What the window has seen, kept for the flight.
-    pub fn memory(&self) -> &MapMemory {
-        &self.memory
+    /// The surfaces seen, kept for the flight ([`OnlineMap::with_route_memory`]).
+    pub fn memory(&self) -> Option<&MapMemory> {
+        self.memory.as_deref()
     }
 
     /// The online map.
@@ -236,7 +251,10 @@ impl MapSensing {
                     .into(),
             }));
         }
-        let band = view_band(&sensor);
+        let range = match &sensor {
+            StaticSensor::Depth(p) => p.max_depth_m,
+            StaticSensor::Lidar(p) => p.max_range_m,
+        };
         let sensor: Box<dyn RaySensor> = match sensor {
             StaticSensor::Depth(p) => Box::new(DepthCamera::new(p)?),
             StaticSensor::Lidar(p) => Box::new(Lidar::new(p)?),
@@ -249,7 +267,7 @@ impl MapSensing {
             world.vehicle_radius_m(),
             blind,
         )?
-        .with_view(band)?;
+        .with_route_memory(range)?;
         let goal = world.goal() - start;
         let yaw = 0.0;
         Ok(Some(MapSensing {
@@ -349,8 +367,8 @@ impl MapSensing {
 }
 
 /// The commit check of a sensed map: a segment passes if every voxel within the vehicle's
-/// radius of it is observed free (`LocalMap::segment_known_free`); with a view band the route
-/// is searched on the memory's route map ([`MapMemory::route_map`]).
+/// radius of it is observed free (`LocalMap::segment_known_free`); with a route memory the
+/// route is searched on its own map ([`MapMemory::route_map`]).
 pub struct KnownFree {
     map: Arc<LocalMap>,
     clearance_m: f64,
@@ -361,40 +379,26 @@ pub struct KnownFree {
 struct RouteView {
     memory: Arc<MapMemory>,
     near: Arc<StaticMap>,
-    view: ViewBand,
+    /// Unknown space within this of the vehicle is its own place (m).
     keep_m: f64,
+    /// Unknown space beyond this stays free for the route (m).
+    reach_m: f64,
 }
 
-/// How many scans between two folds of the window into the memory: 8 (0.27 s at the camera's
-/// 30 Hz, 0.8 s at the LiDAR's 10 Hz; a pass over the window costs about 2 ms), well within
-/// the time the window holds what it saw (its half width at the vehicle's speed).
-pub const FOLD_EVERY_SCANS: usize = 8;
+/// How many scans between two folds of the window into the memory: 4 (0.13 s at the
+/// camera's 30 Hz, 0.4 s at the LiDAR's 10 Hz; a pass over the window costs a few
+/// milliseconds), well within the time the window holds what it saw.
+pub const FOLD_EVERY_SCANS: usize = 4;
 
-/// The margin inside the sensor's vertical field kept by the route's view band (rad): 3°, for
-/// the vehicle's tilt in flight and the cells' extent.
-pub const VIEW_MARGIN_RAD: f64 = 0.05;
+/// Unknown space the route may cross round the vehicle beyond its body and clearance (m): a
+/// camera's view is a pyramid from its lens, narrower than the route's clearance within the
+/// first metre, and the route must get out of it.
+pub const ROUTE_KEEP_M: f64 = 1.0;
 
-/// Farthest the route's view band holds (m): unknown space beyond stays free for the route (a
-/// LiDAR's 100 m would make the band's blocks cost more than the route they shape).
-pub const VIEW_REACH_CAP_M: f64 = 15.0;
-
-/// The elevations a sensor sees (turning about the vertical axis) and how far, for the route.
-pub fn view_band(sensor: &StaticSensor) -> ViewBand {
-    let (lo, hi, reach) = match sensor {
-        StaticSensor::Depth(p) => (-0.5 * p.vfov_rad, 0.5 * p.vfov_rad, p.max_depth_m),
-        StaticSensor::Lidar(p) => (p.min_elevation_rad, p.max_elevation_rad, p.max_range_m),
-    };
-    let (lo, hi) = if hi - lo > 2.0 * VIEW_MARGIN_RAD {
-        (lo + VIEW_MARGIN_RAD, hi - VIEW_MARGIN_RAD)
-    } else {
-        (lo, hi)
-    };
-    ViewBand {
-        min_elevation_rad: lo,
-        max_elevation_rad: hi,
-        reach_m: reach.min(VIEW_REACH_CAP_M),
-    }
-}
+/// How far round the vehicle the route treats unknown space as blocked, as a fraction of the
+/// sensor's range: 0.6 (6 m for the D435's 10 m), so that what the sensor sees reaches past it
+/// and the route leaves through seen space.
+pub const ROUTE_BLOCKED_REACH: f64 = 0.6;
 
 impl CommitCheck for KnownFree {
     fn name(&self) -> &str {
@@ -407,9 +411,9 @@ impl CommitCheck for KnownFree {
 
     fn route_map(&self, from: &Vec3, goal: &Vec3) -> Option<Arc<StaticMap>> {
         let r = self.route.as_ref()?;
-        let window = self.map.window();
+        let near = (*r.near).clone();
         r.memory
-            .route_map(&r.near, &window, from, goal, &r.view, r.keep_m)
+            .route_map(near, &self.map.window(), from, goal, r.keep_m, r.reach_m)
             .ok()
             .map(Arc::new)
     }
