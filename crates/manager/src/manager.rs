@@ -787,9 +787,6 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         // No route on the sensed policy's own map (its blocks of unseen space may close every
         // way from here) is no verdict: the search starts again on the scene's map.
         if !matches!(answer, RouteProgress::Found(_)) && self.route_map.take().is_some() {
-            if std::env::var_os("TRUST_DEBUG_ROUTE").is_some() {
-                eprintln!("t={:.2} route map answer {:?}", measured.t, answer);
-            }
             match router.start(scene.map, &measured.p, &goal) {
                 Ok(search) => {
                     self.route_search = Some((reason, SearchSlot::Here(Box::new(search))))

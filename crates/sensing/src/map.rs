@@ -639,50 +639,6 @@ impl LocalMap {
     /// values as [`LocalMap::distance`]'s), for a [`StaticMap`]. Costs one copy of the window:
     /// each row of the ring buffer is at most two contiguous runs, copied as such.
     pub fn to_esdf(&self) -> Result<Esdf, SensingError> {
-        self.export_esdf(&self.field.dist)
-    }
-
-    /// The window's distance field with the unknown voxels around `around` counted as obstacles
-    /// (those farther than `keep_m` and within `reach_m` of it; nearer ones are the vehicle's
-    /// own place, farther ones and everything outside the window stay free): a route searched
-    /// on it leaves `around` only through space the sensor has seen ([`crate::MapMemory`]).
-    /// At twice the window's voxel edge (a coarse voxel is blocked if one of its eight is): an
-    /// exact transform from scratch (`Esdf::from_occupancy`) over an eighth of the voxels, a
-    /// few milliseconds for the flights' 200 × 200 × 48 window; for a route search's start,
-    /// not for every cycle. Non-finite input blocks no unknown voxel.
-    pub fn to_esdf_unknown_blocked(
-        &self,
-        around: &Vec3,
-        keep_m: f64,
-        reach_m: f64,
-    ) -> Result<Esdf, SensingError> {
-        let d = self.ring.dims;
-        let dc: [usize; 3] = std::array::from_fn(|i| d[i].div_ceil(2));
-        let mut blocked = vec![false; dc[0] * dc[1] * dc[2]];
-        let (keep2, reach2) = (keep_m * keep_m, reach_m * reach_m);
-        self.for_each_voxel(|k, known, occupied| {
-            let unknown_near = !known && {
-                let d2 = (self.ring.center(k) - around).norm_squared();
-                d2 > keep2 && d2 <= reach2
-            };
-            if occupied || unknown_near {
-                let c: [usize; 3] =
-                    std::array::from_fn(|i| ((k[i] - self.ring.low[i]) / 2) as usize);
-                blocked[c[0] + dc[0] * (c[1] + dc[1] * c[2])] = true;
-            }
-        });
-        let w = self.ring.world_box();
-        let h = 2.0 * self.ring.res;
-        Ok(Esdf::from_occupancy(
-            w.min + Vec3::repeat(0.5 * h),
-            h,
-            dc,
-            &blocked,
-        )?)
-    }
-
-    /// `dist` (per slot, in the ring's storage order) as an [`Esdf`] of the window.
-    fn export_esdf(&self, dist: &[f64]) -> Result<Esdf, SensingError> {
         let d = self.ring.dims;
         let (lo, hi) = (self.ring.low, self.ring.high());
         let split = self.ring.axis_slot(0, lo[0]);
@@ -691,7 +647,7 @@ impl LocalMap {
             let sz = self.ring.axis_slot(2, z);
             for y in lo[1]..=hi[1] {
                 let row = d[0] * (self.ring.axis_slot(1, y) + d[1] * sz);
-                let slots = &dist[row..row + d[0]];
+                let slots = &self.field.dist[row..row + d[0]];
                 values.extend_from_slice(&slots[split..]);
                 values.extend_from_slice(&slots[..split]);
             }
@@ -735,15 +691,6 @@ impl LocalMap {
     /// Calls `visit(key, occupied)` for every observed voxel of the window (x fastest), for
     /// maps that outlive it ([`crate::MapMemory::fold`]).
     pub(crate) fn for_each_known(&self, mut visit: impl FnMut(&VoxelKey, bool)) {
-        self.for_each_voxel(|k, known, occupied| {
-            if known {
-                visit(k, occupied);
-            }
-        });
-    }
-
-    /// Calls `visit(key, known, occupied)` for every voxel of the window (x fastest).
-    fn for_each_voxel(&self, mut visit: impl FnMut(&VoxelKey, bool, bool)) {
         let d = self.ring.dims;
         let (lo, hi) = (self.ring.low, self.ring.high());
         for z in lo[2]..=hi[2] {
@@ -752,7 +699,9 @@ impl LocalMap {
                 let row = d[0] * (self.ring.axis_slot(1, y) + d[1] * sz);
                 for x in lo[0]..=hi[0] {
                     let slot = row + self.ring.axis_slot(0, x);
-                    visit(&[x, y, z], self.voxels[slot].known, self.occupied[slot]);
+                    if self.voxels[slot].known {
+                        visit(&[x, y, z], self.occupied[slot]);
+                    }
                 }
             }
         }

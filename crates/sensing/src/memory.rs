@@ -4,16 +4,19 @@
 //! The [`LocalMap`] is a rolling window (20 × 20 × 4.8 m by default in flights): a surface the
 //! camera sees above or below it is never stored, and a wall the vehicle flew along is
 //! forgotten once it leaves the window, so a route searched on the window alone leads over it
-//! or back through it. [`MapMemory`] keeps a coarse record over the world's bounds of every
-//! surface the sensor returned (one bit per cell, kept once seen; [`MapMemory::record`]) and of
-//! the window's occupied voxels ([`MapMemory::fold`]).
+//! or back through it. [`MapMemory`] keeps a coarse record over the world's bounds, one byte
+//! per cell: unknown, seen (some voxel of it observed), occupied (kept once seen). Surfaces come
+//! from every scan's returns ([`MapMemory::record`], wherever they lie), seen space from the
+//! window every few scans ([`MapMemory::fold`]).
 //!
-//! [`MapMemory::route_map`] builds the map a route is searched on: inside the window, the
-//! window's distance field with **unknown space blocked** ([`LocalMap::to_esdf_unknown_blocked`]),
-//! so the route leaves the vehicle through space the sensor has seen (not under a wall the
-//! camera cannot look below, nor through the gaps a grazing view leaves in a wall); beyond the
-//! window, the remembered surfaces as boxes and unknown space free (the optimistic policy: the
-//! route may cross it, what the vehicle commits to may not).
+//! [`MapMemory::route_map`] builds the map a route is searched on: the window's map, the
+//! remembered surfaces beyond the window, and **the unseen cells round the vehicle** (within a
+//! reach, beyond its own place), as merged boxes. The route then leaves the vehicle through
+//! space the sensor has seen: not under a wall the camera cannot look below, not through the
+//! holes a grazing view leaves in a wall, not straight up where a forward camera never looks.
+//! Beyond the reach unknown space stays free (the optimistic policy: the route may cross it,
+//! what the vehicle commits to may not). Cells are coarse (0.5 m) so that a voxel the rays
+//! happened to miss does not close the way.
 
 use std::collections::HashMap;
 
@@ -334,6 +337,29 @@ mod tests {
         assert_eq!(memory.record(&scan), 0, "nothing new");
         let map = LocalMap::new(LocalMapParams::default(), &Vec3::new(5.0, 5.0, 5.0)).unwrap();
         assert_eq!(memory.fold(&map), 0, "an empty window adds nothing");
+    }
+
+    /// Unseen cells round the vehicle block the route, except its own place and the goal's;
+    /// seen ones and those beyond the reach do not.
+    #[test]
+    fn unseen_cells_near_the_vehicle_are_blocked() {
+        let mut memory = MapMemory::new(&bounds(), 0.5).unwrap();
+        let from = Vec3::new(10.0, 10.0, 5.0);
+        let goal = Vec3::new(12.2, 10.2, 5.2);
+        let mut local = LocalMap::new(LocalMapParams::default(), &from).unwrap();
+        local.assume_free(&Vec3::new(10.2, 10.2, 7.2), 0.3);
+        memory.fold(&local);
+        assert!(!memory.is_unseen(&Vec3::new(10.2, 10.2, 7.2)));
+        assert!(memory.is_unseen(&Vec3::new(10.2, 10.2, 8.2)));
+        let near = StaticMap::new(bounds()).unwrap();
+        let window = Aabb::new(from, from).unwrap();
+        let map = memory.route_map(near, &window, &from, &goal, 1.0, 4.0).unwrap();
+        assert!(!map.is_free(&Vec3::new(10.2, 10.2, 8.2), 0.0), "unseen, near");
+        assert!(map.is_free(&Vec3::new(10.2, 10.2, 7.2), 0.0), "seen");
+        assert!(map.is_free(&Vec3::new(10.2, 10.2, 5.2), 0.0), "its own place");
+        assert!(map.is_free(&goal, 0.0), "the goal's place");
+        assert!(map.is_free(&Vec3::new(16.2, 10.2, 5.2), 0.0), "beyond the reach");
+        assert!(map.shapes().len() < 200, "merged: {}", map.shapes().len());
     }
 
     /// A wall of cells becomes one box; cells wholly inside the window are left to it.
