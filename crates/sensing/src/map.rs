@@ -386,6 +386,10 @@ impl LocalMap {
             }
         }
         let window = self.ring.world_box();
+        // A ray from inside the window to inside it needs no clipping (`clip_segment` would
+        // return its ends as they are), and its start voxel is the origin's.
+        let origin_inside = window.contains(&o);
+        let ko = voxel_key(&o, res);
         let mut ray_count = 0;
         let (marks, touched) = (&mut self.marks, &mut self.touched);
         for ray in &scan.rays {
@@ -399,12 +403,18 @@ impl LocalMap {
             }
             ray_count += 1;
             let end = o + ray.direction * ray.range;
-            let Some((a, b)) = window.clip_segment(&o, &end) else {
-                continue;
+            let (a, b, ka) = if origin_inside && window.contains(&end) {
+                (o, end, ko)
+            } else {
+                let Some((a, b)) = window.clip_segment(&o, &end) else {
+                    continue;
+                };
+                (a, b, voxel_key(&a, res))
             };
+            let kb = voxel_key(&b, res);
             // Marks older than `miss` are from earlier frames.
             if self.params.stop_at_visited {
-                walk(&ix, &b, &a, |slot| {
+                walk(&ix, (&b, kb), (&a, ka), |slot| {
                     let m = &mut marks[slot];
                     if *m == miss {
                         return false;
@@ -416,7 +426,7 @@ impl LocalMap {
                     true
                 });
             } else {
-                walk(&ix, &a, &b, |slot| {
+                walk(&ix, (&a, ka), (&b, kb), |slot| {
                     let m = &mut marks[slot];
                     if *m < miss {
                         *m = miss;

@@ -2,9 +2,9 @@
 
 use trust_geometry::{Aabb, Vec3};
 
+use crate::traversal::VoxelKey;
 #[cfg(test)]
-use crate::traversal::VoxelTraversal;
-use crate::traversal::{VoxelKey, voxel_key};
+use crate::traversal::{VoxelTraversal, voxel_key};
 
 /// A window of `dims` voxels whose low corner is the voxel `low`, stored in a fixed buffer: the
 /// voxel `k` lives in slot `(k mod dims)` per axis, so moving the window re-labels slots instead
@@ -143,6 +143,7 @@ impl Indexer {
 
 /// Walks the voxels of the segment `[a, b]` (3-D DDA, the same voxels in the same order as
 /// [`VoxelTraversal`](crate::traversal::VoxelTraversal)) that lie in the window, calling `visit(slot)` until it returns false.
+/// `ka` and `kb` are the voxels of `a` and `b` (`voxel_key`; the caller often has them already).
 ///
 /// The fast form of the walk: integer stepping on a flat slot index (one add per step, a
 /// wrap-around test on the stepped axis only), the window test kept per axis as a bit mask
@@ -150,11 +151,14 @@ impl Indexer {
 /// axis is two comparisons. Equal to the iterator restricted to the window (unit test against
 /// it on random segments).
 #[inline]
-pub(crate) fn walk(ix: &Indexer, a: &Vec3, b: &Vec3, mut visit: impl FnMut(usize) -> bool) {
+pub(crate) fn walk(
+    ix: &Indexer,
+    (a, ka): (&Vec3, VoxelKey),
+    (b, kb): (&Vec3, VoxelKey),
+    mut visit: impl FnMut(usize) -> bool,
+) {
     let ring = &ix.ring;
     let res = ring.res;
-    let ka = voxel_key(a, res);
-    let kb = voxel_key(b, res);
     let d = b - a;
     let dims = ring.dims;
     let strides = [1, dims[0], dims[0] * dims[1]];
@@ -288,10 +292,10 @@ mod tests {
                 .collect();
             let mut got = Vec::new();
             let ix = ring.indexer();
-            walk(&ix, &a, &b, |s| { got.push(s); true });
+            walk(&ix, (&a, voxel_key(&a, res)), (&b, voxel_key(&b, res)), |s| { got.push(s); true });
             prop_assert_eq!(&got, &expect);
             let mut first = Vec::new();
-            walk(&ix, &a, &b, |s| { first.push(s); first.len() < stop });
+            walk(&ix, (&a, voxel_key(&a, res)), (&b, voxel_key(&b, res)), |s| { first.push(s); first.len() < stop });
             let n = stop.max(1).min(expect.len());
             prop_assert_eq!(&first[..], &expect[..n]);
         }
