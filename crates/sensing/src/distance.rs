@@ -448,7 +448,7 @@ fn inside_sq(ix: &Indexer, occupied: &[bool], k: &VoxelKey, r: i64) -> f64 {
                 let mut dx = -rho;
                 while dx <= rho {
                     let q = [k[0] + dx, k[1] + dy, k[2] + dz];
-                    if ring.contains(&q) && !occupied[ring.slot(&q)] {
+                    if ix.slot_in(&q).is_some_and(|slot| !occupied[slot]) {
                         best = best.min((dx * dx + dy * dy + dz * dz) as f64);
                     }
                     dx += if on_shell { 1 } else { 2 * rho };
