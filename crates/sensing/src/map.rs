@@ -386,8 +386,9 @@ impl LocalMap {
             }
         }
         let window = self.ring.world_box();
-        // A ray from inside the window to inside it needs no clipping (`clip_segment` would
-        // return its ends as they are), and its start voxel is the origin's.
+        // A ray from inside the window starts at the origin itself (`clip_segment` returns its
+        // start as it is): the origin's voxel, computed once. (Its end is clipped even when
+        // inside: the clipped end may differ from it in the last bit.)
         let origin_inside = window.contains(&o);
         let ko = voxel_key(&o, res);
         let mut ray_count = 0;
@@ -403,13 +404,13 @@ impl LocalMap {
             }
             ray_count += 1;
             let end = o + ray.direction * ray.range;
-            let (a, b, ka) = if origin_inside && window.contains(&end) {
-                (o, end, ko)
+            let Some((a, b)) = window.clip_segment(&o, &end) else {
+                continue;
+            };
+            let ka = if origin_inside {
+                ko
             } else {
-                let Some((a, b)) = window.clip_segment(&o, &end) else {
-                    continue;
-                };
-                (a, b, voxel_key(&a, res))
+                voxel_key(&a, res)
             };
             let kb = voxel_key(&b, res);
             // Marks older than `miss` are from earlier frames.
