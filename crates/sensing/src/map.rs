@@ -378,11 +378,11 @@ impl LocalMap {
                 continue;
             }
             let k = voxel_key(&(o + ray.direction * ray.range), res);
-            if let Some(slot) = ix.slot_in(&k) {
-                if self.marks[slot] != hit {
-                    self.marks[slot] = hit;
-                    self.touched.push(slot as u32);
-                }
+            if let Some(slot) = ix.slot_in(&k)
+                && self.marks[slot] != hit
+            {
+                self.marks[slot] = hit;
+                self.touched.push(slot as u32);
             }
         }
         let window = self.ring.world_box();

@@ -264,8 +264,8 @@ mod tests {
             let ring = Ring { dims: [dims.0, dims.1, dims.2], low: [low.0, low.1, low.2], res: 0.1 };
             let ix = ring.indexer();
             let k = [k.0, k.1, k.2];
-            for i in 0..3 {
-                prop_assert_eq!(ix.axis_slot(i, k[i]), ring.axis_slot(i, k[i]));
+            for (i, &c) in k.iter().enumerate() {
+                prop_assert_eq!(ix.axis_slot(i, c), ring.axis_slot(i, c));
             }
             let expect = ring.contains(&k).then(|| ring.slot(&k));
             prop_assert_eq!(ix.slot_in(&k), expect);
