@@ -812,9 +812,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             return false;
         };
         let clearance = router.params().clearance_for(router.radius_m());
-        route
-            .is_blocked(scene.map, clearance, s)
-            .unwrap_or(false)
+        route.is_blocked(scene.map, clearance, s).unwrap_or(false)
     }
 
     /// Takes back the route search sent away for a slice between cycles (waiting for it, so a

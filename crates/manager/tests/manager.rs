@@ -1894,7 +1894,10 @@ fn a_sensed_route_uses_its_own_map_and_is_searched_again_when_blocked() {
         })
         .collect();
     assert!(
-        matches!(reasons.first(), Some((_, trust_manager::RouteReason::Blocked))),
+        matches!(
+            reasons.first(),
+            Some((_, trust_manager::RouteReason::Blocked))
+        ),
         "{reasons:?}"
     );
 }

@@ -56,7 +56,14 @@ impl MapMemory {
     /// # Errors
     /// [`SensingError::OutOfRange`] for a cell size outside `[1e-3, 100]` m.
     pub fn new(bounds: &Aabb, cell_m: f64) -> Result<Self, SensingError> {
-        check_range("memory.cell_m", cell_m, 1e-3, 100.0, false, "in [1e-3, 100]")?;
+        check_range(
+            "memory.cell_m",
+            cell_m,
+            1e-3,
+            100.0,
+            false,
+            "in [1e-3, 100]",
+        )?;
         let extent = bounds.max - bounds.min;
         let dims_for = |h: f64| -> [usize; 3] {
             std::array::from_fn(|i| ((extent[i] / h).ceil() as usize).max(1))
@@ -229,8 +236,7 @@ impl MapMemory {
         while k < cells.len() {
             let first = self.coords(cells[k]);
             let mut last = first[0];
-            while k + 1 < cells.len() && cells[k + 1] == cells[k] + 1 && last + 1 < self.dims[0]
-            {
+            while k + 1 < cells.len() && cells[k + 1] == cells[k] + 1 && last + 1 < self.dims[0] {
                 k += 1;
                 last += 1;
             }
@@ -263,7 +269,10 @@ impl MapMemory {
                 }
             }
         }
-        out.extend(open.into_iter().map(|((x0, x1, y0, y1), (z0, z1))| (x0, x1, y0, y1, z0, z1)));
+        out.extend(
+            open.into_iter()
+                .map(|((x0, x1, y0, y1), (z0, z1))| (x0, x1, y0, y1, z0, z1)),
+        );
         out.sort_unstable();
         out.into_iter()
             .filter_map(|(x0, x1, y0, y1, z0, z1)| {
@@ -330,8 +339,16 @@ mod tests {
     #[test]
     fn surfaces_are_remembered_wherever_the_window_is() {
         let mut memory = MapMemory::new(&bounds(), 0.5).unwrap();
-        let scan = hits(&[Vec3::new(5.1, 5.1, 9.1), Vec3::new(5.2, 5.2, 9.2), Vec3::new(50.0, 1.0, 1.0)]);
-        assert_eq!(memory.record(&scan), 1, "two hits in one cell, one outside the bounds");
+        let scan = hits(&[
+            Vec3::new(5.1, 5.1, 9.1),
+            Vec3::new(5.2, 5.2, 9.2),
+            Vec3::new(50.0, 1.0, 1.0),
+        ]);
+        assert_eq!(
+            memory.record(&scan),
+            1,
+            "two hits in one cell, one outside the bounds"
+        );
         assert!(memory.is_occupied(&Vec3::new(5.4, 5.4, 9.4)));
         assert!(!memory.is_occupied(&Vec3::new(5.6, 5.4, 9.4)));
         assert_eq!(memory.record(&scan), 0, "nothing new");
@@ -353,12 +370,23 @@ mod tests {
         assert!(memory.is_unseen(&Vec3::new(10.2, 10.2, 8.2)));
         let near = StaticMap::new(bounds()).unwrap();
         let window = Aabb::new(from, from).unwrap();
-        let map = memory.route_map(near, &window, &from, &goal, 1.0, 4.0).unwrap();
-        assert!(!map.is_free(&Vec3::new(10.2, 10.2, 8.2), 0.0), "unseen, near");
+        let map = memory
+            .route_map(near, &window, &from, &goal, 1.0, 4.0)
+            .unwrap();
+        assert!(
+            !map.is_free(&Vec3::new(10.2, 10.2, 8.2), 0.0),
+            "unseen, near"
+        );
         assert!(map.is_free(&Vec3::new(10.2, 10.2, 7.2), 0.0), "seen");
-        assert!(map.is_free(&Vec3::new(10.2, 10.2, 5.2), 0.0), "its own place");
+        assert!(
+            map.is_free(&Vec3::new(10.2, 10.2, 5.2), 0.0),
+            "its own place"
+        );
         assert!(map.is_free(&goal, 0.0), "the goal's place");
-        assert!(map.is_free(&Vec3::new(16.2, 10.2, 5.2), 0.0), "beyond the reach");
+        assert!(
+            map.is_free(&Vec3::new(16.2, 10.2, 5.2), 0.0),
+            "beyond the reach"
+        );
         assert!(map.shapes().len() < 200, "merged: {}", map.shapes().len());
     }
 
@@ -391,8 +419,13 @@ mod tests {
         let covered: f64 = boxes.iter().map(|b| (b.max - b.min).product()).sum();
         assert!((covered - 1.0 * 5.0 * 6.0).abs() < 1e-9, "{boxes:?}");
         let near = StaticMap::new(bounds()).unwrap();
-        let map = memory.route_map(near, &window, &Vec3::zeros(), &Vec3::zeros(), 0.0, 0.0).unwrap();
+        let map = memory
+            .route_map(near, &window, &Vec3::zeros(), &Vec3::zeros(), 0.0, 0.0)
+            .unwrap();
         assert!(!map.is_free(&Vec3::new(20.5, 10.0, 3.0), 0.0));
-        assert!(map.is_free(&Vec3::new(20.5, 5.0, 3.0), 0.0), "inside the window");
+        assert!(
+            map.is_free(&Vec3::new(20.5, 5.0, 3.0), 0.0),
+            "inside the window"
+        );
     }
 }
