@@ -104,6 +104,9 @@ pub fn run_e3(scenario: &Scenario, out: &Path) -> Result<E3Summary, ExperimentEr
     resolved.manager.wall_images = false;
     // One cycle shows every branch: all its cold solves in that cycle.
     resolved.manager.cold_solves_per_cycle = None;
+    // The table's branches are never refined by a later cycle: their cold solves run to the
+    // backend's own budget (the paper's), not to the flights' cap.
+    resolved.manager.cold_max_evaluations = None;
     let trust_flight::Setup {
         sensing,
         mut manager,

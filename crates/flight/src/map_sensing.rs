@@ -42,7 +42,9 @@ use rand_chacha::ChaCha8Rng;
 use trust_core::{StaticMap, Vec3};
 use trust_manager::CommitCheck;
 use trust_planner::AnyManager;
-use trust_sensing::{DepthCamera, Lidar, LocalMap, Pose, RaySensor, Scan, Truth};
+use trust_sensing::{
+    DEFAULT_MEMORY_CELL_M, DepthCamera, Lidar, LocalMap, MapMemory, Pose, RaySensor, Scan, Truth,
+};
 use trust_vehicle::VehicleState;
 use trust_world::World;
 use trust_world::map_sensing::StaticSensor;
@@ -81,6 +83,12 @@ pub struct MapSensing {
 /// the known-free commit check on it. Times its own work (`take_map_ms`).
 pub struct OnlineMap {
     map: Arc<LocalMap>,
+    /// The surfaces seen, kept for the flight, when the route has a map of its own
+    /// ([`OnlineMap::with_route_memory`]).
+    memory: Option<Arc<MapMemory>>,
+    /// The sensor's range (m), for the route's map.
+    range_m: f64,
+    scans: usize,
     bounds: trust_core::Aabb,
     planner_map: Arc<StaticMap>,
     dirty: bool,
@@ -113,6 +121,9 @@ impl OnlineMap {
         let planner_map = Arc::new(map.to_static_map(bounds)?);
         Ok(OnlineMap {
             map: Arc::new(map),
+            memory: None,
+            range_m: 0.0,
+            scans: 0,
             bounds,
             planner_map,
             dirty: false,
@@ -138,6 +149,14 @@ impl OnlineMap {
         map.recentre(vehicle)?;
         let update = map.insert_scan(scan)?;
         map.assume_free(vehicle, self.body_m);
+        if let Some(memory) = self.memory.as_mut() {
+            let memory = Arc::make_mut(memory);
+            memory.record(scan);
+            self.scans += 1;
+            if self.scans == 1 || self.scans.is_multiple_of(FOLD_EVERY_SCANS) {
+                memory.fold(map);
+            }
+        }
         self.dirty = true;
         self.map_ms += started.elapsed().as_secs_f64() * 1e3;
         Ok(update)
@@ -168,7 +187,42 @@ impl OnlineMap {
         Arc::new(KnownFree {
             map: Arc::clone(&self.map),
             clearance_m: self.clearance_m,
+            route: self.memory.as_ref().map(|memory| RouteView {
+                memory: Arc::clone(memory),
+                near: Arc::clone(&self.planner_map),
+                keep_m: self.body_m + self.clearance_m + ROUTE_KEEP_M,
+                reach_m: ROUTE_BLOCKED_REACH * self.range_m,
+            }),
         })
+    }
+
+    /// Gives the route a map of its own ([`MapMemory::route_map`]): the window with the
+    /// unknown space within [`ROUTE_BLOCKED_REACH`] of the sensor's range `range_m` of the
+    /// vehicle blocked, and beyond the window every surface the sensor has returned, remembered
+    /// for the flight in cells of [`DEFAULT_MEMORY_CELL_M`]. Without it the route searches the
+    /// planner's map (the window only, unknown free). For scans of the static world only: a
+    /// moving obstacle's returns would be remembered as walls.
+    ///
+    /// # Errors
+    /// `SensingError` for a range that is not positive and finite.
+    pub fn with_route_memory(mut self, range_m: f64) -> Result<Self, trust_sensing::SensingError> {
+        if !(range_m.is_finite() && range_m > 0.0) {
+            return Err(trust_sensing::SensingError::OutOfRange {
+                field: "route_memory.range_m".into(),
+                value: range_m,
+                expected: "finite and > 0",
+            });
+        }
+        let mut memory = MapMemory::new(&self.bounds, DEFAULT_MEMORY_CELL_M)?;
+        memory.fold(&self.map);
+        self.memory = Some(Arc::new(memory));
+        self.range_m = range_m;
+        Ok(self)
+    }
+
+    /// The surfaces seen, kept for the flight ([`OnlineMap::with_route_memory`]).
+    pub fn memory(&self) -> Option<&MapMemory> {
+        self.memory.as_deref()
     }
 
     /// The online map.
@@ -197,6 +251,10 @@ impl MapSensing {
                     .into(),
             }));
         }
+        let range = match &sensor {
+            StaticSensor::Depth(p) => p.max_depth_m,
+            StaticSensor::Lidar(p) => p.max_range_m,
+        };
         let sensor: Box<dyn RaySensor> = match sensor {
             StaticSensor::Depth(p) => Box::new(DepthCamera::new(p)?),
             StaticSensor::Lidar(p) => Box::new(Lidar::new(p)?),
@@ -208,7 +266,8 @@ impl MapSensing {
             *world.bounds(),
             world.vehicle_radius_m(),
             blind,
-        )?;
+        )?
+        .with_route_memory(range)?;
         let goal = world.goal() - start;
         let yaw = 0.0;
         Ok(Some(MapSensing {
@@ -308,11 +367,38 @@ impl MapSensing {
 }
 
 /// The commit check of a sensed map: a segment passes if every voxel within the vehicle's
-/// radius of it is observed free (`LocalMap::segment_known_free`).
+/// radius of it is observed free (`LocalMap::segment_known_free`); with a route memory the
+/// route is searched on its own map ([`MapMemory::route_map`]).
 pub struct KnownFree {
     map: Arc<LocalMap>,
     clearance_m: f64,
+    route: Option<RouteView>,
 }
+
+/// What [`KnownFree::route_map`] builds the route's map from.
+struct RouteView {
+    memory: Arc<MapMemory>,
+    near: Arc<StaticMap>,
+    /// Unknown space within this of the vehicle is its own place (m).
+    keep_m: f64,
+    /// Unknown space beyond this stays free for the route (m).
+    reach_m: f64,
+}
+
+/// How many scans between two folds of the window into the memory: 4 (0.13 s at the
+/// camera's 30 Hz, 0.4 s at the LiDAR's 10 Hz; a pass over the window costs a few
+/// milliseconds), well within the time the window holds what it saw.
+pub const FOLD_EVERY_SCANS: usize = 4;
+
+/// Unknown space the route may cross round the vehicle beyond its body and clearance (m): a
+/// camera's view is a pyramid from its lens, narrower than the route's clearance within the
+/// first metre, and the route must get out of it.
+pub const ROUTE_KEEP_M: f64 = 1.0;
+
+/// How far round the vehicle the route treats unknown space as blocked, as a fraction of the
+/// sensor's range: 0.6 (6 m for the D435's 10 m), so that what the sensor sees reaches past it
+/// and the route leaves through seen space.
+pub const ROUTE_BLOCKED_REACH: f64 = 0.6;
 
 impl CommitCheck for KnownFree {
     fn name(&self) -> &str {
@@ -321,5 +407,14 @@ impl CommitCheck for KnownFree {
 
     fn segment_free(&self, a: &Vec3, b: &Vec3) -> bool {
         self.map.segment_known_free(a, b, self.clearance_m)
+    }
+
+    fn route_map(&self, from: &Vec3, goal: &Vec3) -> Option<Arc<StaticMap>> {
+        let r = self.route.as_ref()?;
+        let near = (*r.near).clone();
+        r.memory
+            .route_map(near, &self.map.window(), from, goal, r.keep_m, r.reach_m)
+            .ok()
+            .map(Arc::new)
     }
 }

@@ -9,7 +9,10 @@
 //! ([`crate::Event::NotKnownFree`]) and the fallback brakes instead. Without a check (a known
 //! map) nothing changes.
 
+use std::sync::Arc;
+
 use trust_core::{PolyTraj, State, Vec3};
+use trust_geometry::StaticMap;
 
 use crate::brake::braking_tail;
 
@@ -20,6 +23,14 @@ pub trait CommitCheck: Send + Sync {
     fn name(&self) -> &str;
     /// Whether the vehicle may fly the straight segment `[a, b]`.
     fn segment_free(&self, a: &Vec3, b: &Vec3) -> bool;
+    /// The map a global route from `from` to `goal` is searched on, if not the planning map
+    /// (e.g. a sensed map with the space its sensor cannot see from `from` blocked, so that
+    /// the route leaves through space the vehicle will be able to commit to). Asked when a
+    /// route search starts; `None` (the default) searches the planning map.
+    fn route_map(&self, from: &Vec3, goal: &Vec3) -> Option<Arc<StaticMap>> {
+        let _ = (from, goal);
+        None
+    }
 }
 
 /// Time between two points of [`committed_stretch`] (s): 20 ms, the safety check's densest

@@ -25,7 +25,9 @@ use crate::safety::{
 use trust_route::{GlobalRoute, RoutePoint, RouteProgress, UnreachableCause};
 
 use crate::report::RouteReason;
-use crate::routing::{ROUTE_DEADLINE_FRACTION, Router, SearchSlot, TakenBack, rerouted};
+use crate::routing::{
+    BLOCKED_REROUTE_S, ROUTE_DEADLINE_FRACTION, Router, SearchSlot, TakenBack, rerouted,
+};
 
 mod worker;
 use worker::{Job, JobInput, JobOutput};
@@ -238,6 +240,9 @@ pub struct Manager<F, B, H> {
     /// The route search under way, why it started, and where it is (here, or away for a slice
     /// between cycles).
     route_search: Option<(RouteReason, SearchSlot)>,
+    /// The map the search under way runs on when its commit check gives one
+    /// ([`crate::CommitCheck::route_map`]; else the scene's).
+    route_map: Option<Arc<StaticMap>>,
     /// The static map the scenes are built on, shared with the worker
     /// ([`Manager::share_map`]).
     shared_map: Option<Arc<StaticMap>>,
@@ -297,6 +302,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             unreachable: None,
             deferred_guides: Vec::new(),
             route_search: None,
+            route_map: None,
             cycle_count: 0,
             shared_map: None,
             job: None,
@@ -721,6 +727,8 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             Some(RouteReason::Stalled)
         } else if recheck {
             Some(RouteReason::Recheck)
+        } else if since >= BLOCKED_REROUTE_S && self.route_blocked_ahead(measured, scene, router) {
+            Some(RouteReason::Blocked)
         } else {
             None
         };
@@ -732,7 +740,14 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             self.routed_goal = Some(goal);
             self.routed_at = measured.t;
             away_answer = None;
-            match router.start(scene.map, &measured.p, &goal) {
+            // A sensed map's policy may search the route on a map of its own (unseen space the
+            // sensor cannot look into from here is blocked, `CommitCheck::route_map`).
+            self.route_map = self
+                .commit_check
+                .as_ref()
+                .and_then(|c| c.route_map(&measured.p, &goal));
+            let map = self.route_map.as_deref().unwrap_or(scene.map);
+            match router.start(map, &measured.p, &goal) {
                 Ok(search) => {
                     self.route_search = Some((reason, SearchSlot::Here(Box::new(search))))
                 }
@@ -760,9 +775,8 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             // the cycle ends), else each cycle does a slice itself.
             None if !off_cycle || (started_now && !first_at_rest) => {
                 let deadline = deadline_at(spans.started, &self.params, ROUTE_DEADLINE_FRACTION);
-                match spans.time(Span::Route, || {
-                    router.slice_in_cycle(search, scene.map, deadline)
-                }) {
+                let map = self.route_map.as_deref().unwrap_or(scene.map);
+                match spans.time(Span::Route, || router.slice_in_cycle(search, map, deadline)) {
                     RouteProgress::Pending => return,
                     answer => answer,
                 }
@@ -770,7 +784,35 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             None => return,
         };
         self.route_search = None;
+        // No route on the sensed policy's own map (its blocks of unseen space may close every
+        // way from here) is no verdict: the search starts again on the scene's map.
+        if !matches!(answer, RouteProgress::Found(_)) && self.route_map.take().is_some() {
+            match router.start(scene.map, &measured.p, &goal) {
+                Ok(search) => {
+                    self.route_search = Some((reason, SearchSlot::Here(Box::new(search))))
+                }
+                Err(e) => cycle.events.push(Event::route_failed(reason, &e)),
+            }
+            return;
+        }
         self.apply_route_answer(cycle, measured, &goal, reason, answer);
+    }
+
+    /// Whether the route ahead of the vehicle (from its projection on it) runs into an
+    /// obstacle of `scene`'s map at the route's clearance: with a sensed map
+    /// ([`Manager::set_commit_check`]), an obstacle seen since the route was planned.
+    fn route_blocked_ahead(&self, measured: &State, scene: &Scene<'_>, router: &Router) -> bool {
+        if self.commit_check.is_none() {
+            return false;
+        }
+        let Some(route) = self.route.as_ref() else {
+            return false;
+        };
+        let Ok(s) = route.progress(&measured.p) else {
+            return false;
+        };
+        let clearance = router.params().clearance_for(router.radius_m());
+        route.is_blocked(scene.map, clearance, s).unwrap_or(false)
     }
 
     /// Takes back the route search sent away for a slice between cycles (waiting for it, so a
@@ -1013,9 +1055,10 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     /// [`Router::work_off_cycle`] units between cycles ([`Manager::route_off_cycle`]); the next
     /// cycle takes it back. Returns whether it did.
     fn send_route_away(&mut self, now: f64, spans: &Spans, scene: &Scene<'_>) -> bool {
-        let (Some(router), Some(map)) = (&self.router, self.shared_map_for(scene)) else {
+        let (Some(router), Some(shared)) = (&self.router, self.shared_map_for(scene)) else {
             return false;
         };
+        let map = self.route_map.clone().unwrap_or(shared);
         if !self.params.background {
             return false;
         }

@@ -70,8 +70,13 @@ pub struct ManagerParams {
     /// Default 50 (beyond the paper): a shorter cycle for about 1 % more flight time
     /// (measurements in ARCHITECTURE.md, "Exploration period and warm budget").
     pub sub_branch_max_evaluations: Option<usize>,
-    /// Evaluation budget of a cold solve from a frontend path (FwdExplore); `None`: the backend's
-    /// own.
+    /// Evaluation budget of a cold solve from a frontend path (FwdExplore, and a repair's
+    /// re-solve); `None`: the backend's own (1000 for the presets). Default 400 with history
+    /// (beyond the paper): a new branch is re-solved again every cycle (BwdReplan) and need not
+    /// converge in its first solve; cold solves were 70 % of TRUST-Planner's evaluations on E4
+    /// (a median 553 each, stopping on a stalled cost). 300 let the pacing person of
+    /// `room_penetration_pacing_person` (seed 26) hit the vehicle. `None` for the presets
+    /// without history (baselines 1–3), which keep nothing to refine (decision record 0045).
     pub cold_max_evaluations: Option<usize>,
     /// Cold solves per cycle (with history): an exploring cycle solves the first this many of
     /// its guide paths and keeps the rest, each following cycle solves the next this many from
@@ -191,10 +196,10 @@ impl Default for ManagerParams {
 impl ManagerParams {
     /// TRUST-Planner: five branches with history (Algorithm 1), exploring every third cycle
     /// with warm re-solves capped at 100 evaluations for the main branch and 50 for each
-    /// sub-branch (our defaults, see the fields). Algorithm 1 exactly as written:
-    /// `explore_period_cycles = 1`, `warm_max_evaluations = None`,
-    /// `sub_branch_max_evaluations = None` (`trust-sim ablate --variant explore=1` for the
-    /// exploration period).
+    /// sub-branch, cold solves at 400 (our defaults, see the fields). Algorithm 1 exactly as
+    /// written: `explore_period_cycles = 1`, `warm_max_evaluations = None`,
+    /// `sub_branch_max_evaluations = None`, `cold_max_evaluations = None` (`trust-sim ablate
+    /// --variant explore=1` for the exploration period).
     pub fn trust() -> Self {
         ManagerParams {
             max_branches: 5,
@@ -205,7 +210,7 @@ impl ManagerParams {
             forecast_growth_s: None,
             warm_max_evaluations: Some(100),
             sub_branch_max_evaluations: Some(50),
-            cold_max_evaluations: None,
+            cold_max_evaluations: Some(400),
             cold_solves_per_cycle: Some(2),
             background: true,
             merge_max_evaluations: None,
@@ -233,6 +238,7 @@ impl ManagerParams {
         ManagerParams {
             history: false,
             cold_solves_per_cycle: None,
+            cold_max_evaluations: None,
             ..Self::trust()
         }
     }
@@ -244,6 +250,7 @@ impl ManagerParams {
             history: false,
             max_explored_paths: 1,
             cold_solves_per_cycle: None,
+            cold_max_evaluations: None,
             ..Self::trust()
         }
     }
@@ -554,6 +561,13 @@ mod tests {
         assert!(ManagerParams::trust().history);
         assert!(!ManagerParams::multi_branch_without_history().history);
         assert_eq!(ManagerParams::single_branch().max_branches, 1);
+        // Only a planner with history refines its new branches: only it caps their cold solves.
+        assert_eq!(ManagerParams::trust().cold_max_evaluations, Some(400));
+        assert_eq!(
+            ManagerParams::multi_branch_without_history().cold_max_evaluations,
+            None
+        );
+        assert_eq!(ManagerParams::single_branch().cold_max_evaluations, None);
     }
 
     #[test]

@@ -325,15 +325,18 @@ pub enum RouteReason {
     Stalled,
     /// The goal is held unreachable: the verdict is checked again.
     Recheck,
+    /// An obstacle seen since (a sensed map) blocks the route ahead.
+    Blocked,
 }
 
 impl RouteReason {
-    /// The log's word for it (`"first"`, `"stalled"`, `"recheck"`).
+    /// The log's word for it (`"first"`, `"stalled"`, `"recheck"`, `"blocked"`).
     pub fn as_str(self) -> &'static str {
         match self {
             RouteReason::First => "first",
             RouteReason::Stalled => "stalled",
             RouteReason::Recheck => "recheck",
+            RouteReason::Blocked => "blocked",
         }
     }
 }

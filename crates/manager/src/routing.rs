@@ -201,6 +201,11 @@ pub const ROUTE_WORK_OFF_CYCLE: usize = 24_000;
 /// from the vehicle's position, in case the map or the obstacles changed.
 pub const RECHECK_S: f64 = 2.0;
 
+/// Least time between two route searches started because an obstacle seen since blocks the
+/// route ahead (s): a sensed map changes every scan, and a route that grazes a noisy surface
+/// would otherwise be searched again every cycle.
+pub const BLOCKED_REROUTE_S: f64 = 0.5;
+
 /// Where a search under way is: with the manager, on a thread doing a slice of it between two
 /// cycles, or back from a slice whose answer is not due yet
 /// ([`crate::ManagerParams::real_time_scale`]).

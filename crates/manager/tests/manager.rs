@@ -1818,3 +1818,86 @@ fn a_plan_whose_committed_part_enters_unknown_space_is_not_committed() {
     let report = m.step(0.0, &state, &GOAL, &scene).unwrap();
     assert!(m.main().is_some(), "{:?}", report.event_tags());
 }
+
+/// A sensed map's policy: everything committable, and a route map of its own (a wall across
+/// the straight line that the planning map does not hold, as remembered beyond the window).
+struct RoutesOnItsOwnMap {
+    route_map: std::sync::Arc<StaticMap>,
+}
+
+impl trust_manager::CommitCheck for RoutesOnItsOwnMap {
+    fn name(&self) -> &str {
+        "routes on its own map"
+    }
+
+    fn segment_free(&self, _a: &Vec3, _b: &Vec3) -> bool {
+        true
+    }
+
+    fn route_map(&self, _from: &Vec3, _goal: &Vec3) -> Option<std::sync::Arc<StaticMap>> {
+        Some(std::sync::Arc::clone(&self.route_map))
+    }
+}
+
+/// Issue 34: the route is searched on the commit check's own map when it gives one, and a route
+/// that an obstacle seen since blocks (the planning map changed under it) is searched again
+/// (`blocked`), no sooner than `BLOCKED_REROUTE_S` after the last search.
+#[test]
+fn a_sensed_route_uses_its_own_map_and_is_searched_again_when_blocked() {
+    let bounds = Aabb::new(Vec3::zeros(), Vec3::new(60.0, 20.0, 8.0)).unwrap();
+    let wall = |y0: f64, y1: f64| -> Shape {
+        AaBox::new(Vec3::new(30.0, y0, 0.0), Vec3::new(31.0, y1, 8.0))
+            .unwrap()
+            .into()
+    };
+    let open = StaticMap::new(bounds).unwrap();
+    let (start, goal) = (Vec3::new(3.0, 10.0, 3.5), Vec3::new(55.0, 10.0, 3.5));
+    let route_map = StaticMap::from_shapes(bounds, vec![wall(0.0, 16.0)]).unwrap();
+    let mut m = planner(ManagerParams::trust());
+    m.set_router(Some(
+        trust_manager::Router::new(trust_route::RouteParams::default(), 0.3).unwrap(),
+    ));
+    m.set_commit_check(Some(std::sync::Arc::new(RoutesOnItsOwnMap {
+        route_map: std::sync::Arc::new(route_map),
+    })));
+    let scene = Scene::new(&open, &[], 0.0).unwrap();
+    let mut state = State::at_rest(0.0, start);
+    for i in 0..100 {
+        state.t = 0.1 * i as f64;
+        m.step(state.t, &state, &goal, &scene).unwrap();
+        if m.route().is_some() {
+            break;
+        }
+    }
+    let route = m.route().expect("a route").clone();
+    assert!(
+        route.points().iter().any(|p| p.y > 16.0),
+        "round the wall of the route's own map: {:?}",
+        route.points()
+    );
+    // The planning map now holds a wall across that route (seen since): searched again.
+    let seen = StaticMap::from_shapes(bounds, vec![wall(14.0, 20.0)]).unwrap();
+    let scene = Scene::new(&seen, &[], 0.0).unwrap();
+    let reasons: Vec<_> = (0..60)
+        .flat_map(|i| {
+            state.t += 0.1;
+            let _ = i;
+            m.step(state.t, &state, &goal, &scene)
+                .unwrap()
+                .events
+                .into_iter()
+                .filter_map(|e| match e {
+                    Event::Rerouted { reason, .. } => Some((state.t, reason)),
+                    _ => None,
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    assert!(
+        matches!(
+            reasons.first(),
+            Some((_, trust_manager::RouteReason::Blocked))
+        ),
+        "{reasons:?}"
+    );
+}

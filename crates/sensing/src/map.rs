@@ -138,6 +138,9 @@ pub struct LocalMap {
     voxels: Vec<Voxel>,
     occupied: Vec<bool>,
     occupied_count: usize,
+    /// Occupied voxels per x row of slots (`slot / dims.x`): the distance field skips empty
+    /// rows without reading them.
+    row_occupied: Vec<u32>,
     field: DistanceField,
     /// Per slot: `frame` if a ray of the current frame passed it, `frame + 1` if one ended in
     /// it (a generation stamp: older frames' marks are smaller, nothing to clear per frame; one
@@ -183,6 +186,7 @@ impl LocalMap {
             voxels: vec![Voxel::default(); n],
             occupied: vec![false; n],
             occupied_count: 0,
+            row_occupied: vec![0; n / params.dims[0]],
             field: DistanceField::new(n, r, res),
             marks: vec![0; n],
             frame: 2,
@@ -260,7 +264,12 @@ impl LocalMap {
                 } else {
                     entering.hi[i] = lo[i] - delta - 1;
                 }
-                self.field.recompute(&self.ring, &self.occupied, &entering);
+                self.field.recompute(
+                    &self.ring,
+                    &self.occupied,
+                    Some(&self.row_occupied),
+                    &entering,
+                );
             }
             if lost_occupied {
                 let mut near = KeyBox { lo, hi };
@@ -269,7 +278,8 @@ impl LocalMap {
                 } else {
                     near.lo[i] = hi[i] - r + 1;
                 }
-                self.field.recompute(&self.ring, &self.occupied, &near);
+                self.field
+                    .recompute(&self.ring, &self.occupied, Some(&self.row_occupied), &near);
             }
         }
         Ok(())
@@ -295,6 +305,7 @@ impl LocalMap {
                 if self.occupied[slot] {
                     self.occupied[slot] = false;
                     self.occupied_count -= 1;
+                    self.row_occupied[slot / d[0]] -= 1;
                     lost = true;
                 }
                 self.field.dist[slot] = far;
@@ -306,6 +317,7 @@ impl LocalMap {
     fn clear_all(&mut self, new_low: VoxelKey) {
         self.voxels.fill(Voxel::default());
         self.occupied.fill(false);
+        self.row_occupied.fill(0);
         self.occupied_count = 0;
         self.field.reset(self.ring.res);
         self.ring.low = new_low;
@@ -359,21 +371,26 @@ impl LocalMap {
         self.touched.clear();
         let o = scan.origin;
         let res = self.ring.res;
+        let ix = self.ring.indexer();
         // Hits first, so that a voxel some ray ends in is a hit whatever the order of the rays.
         for ray in &scan.rays {
             if ray.kind != ReturnKind::Hit {
                 continue;
             }
             let k = voxel_key(&(o + ray.direction * ray.range), res);
-            if self.ring.contains(&k) {
-                let slot = self.ring.slot(&k);
-                if self.marks[slot] != hit {
-                    self.marks[slot] = hit;
-                    self.touched.push(slot as u32);
-                }
+            if let Some(slot) = ix.slot_in(&k)
+                && self.marks[slot] != hit
+            {
+                self.marks[slot] = hit;
+                self.touched.push(slot as u32);
             }
         }
         let window = self.ring.world_box();
+        // A ray from inside the window starts at the origin itself (`clip_segment` returns its
+        // start as it is): the origin's voxel, computed once. (Its end is clipped even when
+        // inside: the clipped end may differ from it in the last bit.)
+        let origin_inside = window.contains(&o);
+        let ko = voxel_key(&o, res);
         let mut ray_count = 0;
         let (marks, touched) = (&mut self.marks, &mut self.touched);
         for ray in &scan.rays {
@@ -390,9 +407,15 @@ impl LocalMap {
             let Some((a, b)) = window.clip_segment(&o, &end) else {
                 continue;
             };
+            let ka = if origin_inside {
+                ko
+            } else {
+                voxel_key(&a, res)
+            };
+            let kb = voxel_key(&b, res);
             // Marks older than `miss` are from earlier frames.
             if self.params.stop_at_visited {
-                walk(&self.ring, &b, &a, |slot| {
+                walk(&ix, (&b, kb), (&a, ka), |slot| {
                     let m = &mut marks[slot];
                     if *m == miss {
                         return false;
@@ -404,7 +427,7 @@ impl LocalMap {
                     true
                 });
             } else {
-                walk(&self.ring, &a, &b, |slot| {
+                walk(&ix, (&a, ka), (&b, kb), |slot| {
                     let m = &mut marks[slot];
                     if *m < miss {
                         *m = miss;
@@ -426,10 +449,13 @@ impl LocalMap {
             let now = lo.is_occupied(f64::from(v.log_odds));
             if now != self.occupied[slot] {
                 self.occupied[slot] = now;
+                let row = &mut self.row_occupied[slot / self.ring.dims[0]];
                 if now {
                     self.occupied_count += 1;
+                    *row += 1;
                 } else {
                     self.occupied_count -= 1;
+                    *row -= 1;
                 }
                 flip_count += 1;
                 let k = self.ring.key_of_slot(slot);
@@ -494,7 +520,12 @@ impl LocalMap {
             lo: [b.lo[0] - r, b.lo[1] - r, b.lo[2] - r],
             hi: [b.hi[0] + r, b.hi[1] + r, b.hi[2] + r],
         };
-        self.field.recompute(&self.ring, &self.occupied, &target);
+        self.field.recompute(
+            &self.ring,
+            &self.occupied,
+            Some(&self.row_occupied),
+            &target,
+        );
         self.field.recomputed_count - before
     }
 
@@ -675,6 +706,7 @@ impl LocalMap {
         field.recompute(
             &self.ring,
             &self.occupied,
+            None,
             &KeyBox {
                 lo: self.ring.low,
                 hi: self.ring.high(),
@@ -686,6 +718,25 @@ impl LocalMap {
     /// The distance field per slot (the storage order of the ring buffer).
     pub fn distance_slots(&self) -> &[f64] {
         &self.field.dist
+    }
+
+    /// Calls `visit(key, occupied)` for every observed voxel of the window (x fastest), for
+    /// maps that outlive it ([`crate::MapMemory::fold`]).
+    pub(crate) fn for_each_known(&self, mut visit: impl FnMut(&VoxelKey, bool)) {
+        let d = self.ring.dims;
+        let (lo, hi) = (self.ring.low, self.ring.high());
+        for z in lo[2]..=hi[2] {
+            let sz = self.ring.axis_slot(2, z);
+            for y in lo[1]..=hi[1] {
+                let row = d[0] * (self.ring.axis_slot(1, y) + d[1] * sz);
+                for x in lo[0]..=hi[0] {
+                    let slot = row + self.ring.axis_slot(0, x);
+                    if self.voxels[slot].known {
+                        visit(&[x, y, z], self.occupied[slot]);
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -889,6 +940,12 @@ mod tests {
                     map.occupied_count,
                     map.occupied.iter().filter(|&&o| o).count()
                 );
+                let rows: Vec<u32> = map
+                    .occupied
+                    .chunks(map.ring.dims[0])
+                    .map(|row| row.iter().filter(|&&o| o).count() as u32)
+                    .collect();
+                prop_assert_eq!(&map.row_occupied, &rows);
                 prop_assert_eq!(map.distance_slots(), &map.recompute_distance_from_scratch()[..]);
             }
         }

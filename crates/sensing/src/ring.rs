@@ -2,9 +2,9 @@
 
 use trust_geometry::{Aabb, Vec3};
 
+use crate::traversal::VoxelKey;
 #[cfg(test)]
-use crate::traversal::VoxelTraversal;
-use crate::traversal::{VoxelKey, voxel_key};
+use crate::traversal::{VoxelTraversal, voxel_key};
 
 /// A window of `dims` voxels whose low corner is the voxel `low`, stored in a fixed buffer: the
 /// voxel `k` lives in slot `(k mod dims)` per axis, so moving the window re-labels slots instead
@@ -62,6 +62,18 @@ impl Ring {
         k
     }
 
+    /// The slot indexer of the window as it is now (division-free slots for keys near it).
+    pub fn indexer(&self) -> Indexer {
+        let mut low_slot = [0; 3];
+        for (i, s) in low_slot.iter_mut().enumerate() {
+            *s = self.axis_slot(i, self.low[i]);
+        }
+        Indexer {
+            ring: *self,
+            low_slot,
+        }
+    }
+
     /// The region the window's voxels cover.
     pub fn world_box(&self) -> Aabb {
         let h = self.high();
@@ -89,8 +101,49 @@ impl Ring {
     }
 }
 
+/// A [`Ring`] with the slots of its low corner: the slot of a coordinate inside the window is
+/// then an add and a conditional subtract, not a division (`rem_euclid` on `i64`). Valid until
+/// the window moves.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Indexer {
+    pub ring: Ring,
+    low_slot: [usize; 3],
+}
+
+impl Indexer {
+    /// [`Ring::axis_slot`]: the same value, without a division for `k` inside the window.
+    #[inline]
+    pub fn axis_slot(&self, i: usize, k: i64) -> usize {
+        let n = self.ring.dims[i];
+        let off = k.wrapping_sub(self.ring.low[i]);
+        if (0..n as i64).contains(&off) {
+            let s = self.low_slot[i] + off as usize;
+            if s >= n { s - n } else { s }
+        } else {
+            self.ring.axis_slot(i, k)
+        }
+    }
+
+    /// The slot of `k` if it lies inside the window.
+    #[inline]
+    pub fn slot_in(&self, k: &VoxelKey) -> Option<usize> {
+        let d = self.ring.dims;
+        let mut s = [0usize; 3];
+        for i in 0..3 {
+            let off = k[i].wrapping_sub(self.ring.low[i]);
+            if !(0..d[i] as i64).contains(&off) {
+                return None;
+            }
+            let v = self.low_slot[i] + off as usize;
+            s[i] = if v >= d[i] { v - d[i] } else { v };
+        }
+        Some(s[0] + d[0] * (s[1] + d[1] * s[2]))
+    }
+}
+
 /// Walks the voxels of the segment `[a, b]` (3-D DDA, the same voxels in the same order as
 /// [`VoxelTraversal`](crate::traversal::VoxelTraversal)) that lie in the window, calling `visit(slot)` until it returns false.
+/// `ka` and `kb` are the voxels of `a` and `b` (`voxel_key`; the caller often has them already).
 ///
 /// The fast form of the walk: integer stepping on a flat slot index (one add per step, a
 /// wrap-around test on the stepped axis only), the window test kept per axis as a bit mask
@@ -98,10 +151,14 @@ impl Ring {
 /// axis is two comparisons. Equal to the iterator restricted to the window (unit test against
 /// it on random segments).
 #[inline]
-pub(crate) fn walk(ring: &Ring, a: &Vec3, b: &Vec3, mut visit: impl FnMut(usize) -> bool) {
+pub(crate) fn walk(
+    ix: &Indexer,
+    (a, ka): (&Vec3, VoxelKey),
+    (b, kb): (&Vec3, VoxelKey),
+    mut visit: impl FnMut(usize) -> bool,
+) {
+    let ring = &ix.ring;
     let res = ring.res;
-    let ka = voxel_key(a, res);
-    let kb = voxel_key(b, res);
     let d = b - a;
     let dims = ring.dims;
     let strides = [1, dims[0], dims[0] * dims[1]];
@@ -114,7 +171,7 @@ pub(crate) fn walk(ring: &Ring, a: &Vec3, b: &Vec3, mut visit: impl FnMut(usize)
     let mut key = ka;
     let mut outside = 0u32;
     for i in 0..3 {
-        s[i] = ring.axis_slot(i, ka[i]);
+        s[i] = ix.axis_slot(i, ka[i]);
         if ka[i] < lo[i] || ka[i] > hi[i] {
             outside |= 1 << i;
         }
@@ -197,6 +254,23 @@ mod tests {
     proptest! {
         #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
 
+        /// The indexer's division-free slots equal the ring's, inside the window and out.
+        #[test]
+        fn indexer_equals_the_ring(
+            k in (-40i64..40, -40i64..40, -40i64..40),
+            low in (-30i64..30, -30i64..30, -30i64..30),
+            dims in (2usize..16, 2usize..16, 2usize..16),
+        ) {
+            let ring = Ring { dims: [dims.0, dims.1, dims.2], low: [low.0, low.1, low.2], res: 0.1 };
+            let ix = ring.indexer();
+            let k = [k.0, k.1, k.2];
+            for (i, &c) in k.iter().enumerate() {
+                prop_assert_eq!(ix.axis_slot(i, c), ring.axis_slot(i, c));
+            }
+            let expect = ring.contains(&k).then(|| ring.slot(&k));
+            prop_assert_eq!(ix.slot_in(&k), expect);
+        }
+
         /// The fast walk visits exactly the slots of the iterator's voxels inside the window, in
         /// its order, and stops when asked.
         #[test]
@@ -217,10 +291,11 @@ mod tests {
                 .map(|k| ring.slot(&k))
                 .collect();
             let mut got = Vec::new();
-            walk(&ring, &a, &b, |s| { got.push(s); true });
+            let ix = ring.indexer();
+            walk(&ix, (&a, voxel_key(&a, res)), (&b, voxel_key(&b, res)), |s| { got.push(s); true });
             prop_assert_eq!(&got, &expect);
             let mut first = Vec::new();
-            walk(&ring, &a, &b, |s| { first.push(s); first.len() < stop });
+            walk(&ix, (&a, voxel_key(&a, res)), (&b, voxel_key(&b, res)), |s| { first.push(s); first.len() < stop });
             let n = stop.max(1).min(expect.len());
             prop_assert_eq!(&first[..], &expect[..n]);
         }

@@ -53,10 +53,13 @@ pub struct MapSpec {
     /// Truncation of the distance field (m).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_distance_m: Option<f64>,
-    /// Fast-Planner's ray-casting shortcut (`LocalMapParams::stop_at_visited`). Default true
-    /// in flight (unlike the library's default): a frame's rays share the voxels near the
-    /// sensor, and tracing each from its end back to the first voxel another ray cleared costs a
-    /// fraction of the exact update (`cargo bench -p trust-sensing --bench map_update`).
+    /// Fast-Planner's ray-casting shortcut (`LocalMapParams::stop_at_visited`). Default false,
+    /// as the library's: tracing each ray from its end back to the first voxel another ray of
+    /// the frame cleared costs a fraction of the exact update (`cargo bench -p trust-sensing
+    /// --bench map_update`), but a hovering camera's frame then leaves holes of metres in the
+    /// free space it saw (a ray stops at the first voxel a neighbour cleared far out, and the
+    /// near voxels only it crossed stay unknown), and a plan is committed only through known
+    /// free space: a vehicle stopped in front of a wall never commits to the way along it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stop_at_visited: Option<bool>,
 }
@@ -82,7 +85,7 @@ impl MapSpec {
             resolution_m,
             dims: self.dims.unwrap_or([across, across, d.dims[2]]),
             max_distance_m: self.max_distance_m.unwrap_or(d.max_distance_m),
-            stop_at_visited: self.stop_at_visited.unwrap_or(true),
+            stop_at_visited: self.stop_at_visited.unwrap_or(false),
             ..d
         }
     }
