@@ -60,37 +60,29 @@ trait Sq: Copy + Ord + Default + std::fmt::Debug {
     fn index(self) -> usize;
 }
 
-impl Sq for u8 {
-    const MAX: Self = u8::MAX;
-    #[inline]
-    fn of(v: i64) -> Self {
-        v as u8
-    }
-    #[inline]
-    fn sat_add(self, other: Self) -> Self {
-        self.saturating_add(other)
-    }
-    #[inline]
-    fn index(self) -> usize {
-        usize::from(self)
-    }
+/// `Sq` for an unsigned integer type: its maximum, a truncating cast, a saturating add.
+macro_rules! impl_sq {
+    ($t:ty) => {
+        impl Sq for $t {
+            const MAX: Self = <$t>::MAX;
+            #[inline]
+            fn of(v: i64) -> Self {
+                v as $t
+            }
+            #[inline]
+            fn sat_add(self, other: Self) -> Self {
+                self.saturating_add(other)
+            }
+            #[inline]
+            fn index(self) -> usize {
+                usize::from(self)
+            }
+        }
+    };
 }
 
-impl Sq for u16 {
-    const MAX: Self = u16::MAX;
-    #[inline]
-    fn of(v: i64) -> Self {
-        v as u16
-    }
-    #[inline]
-    fn sat_add(self, other: Self) -> Self {
-        self.saturating_add(other)
-    }
-    #[inline]
-    fn index(self) -> usize {
-        usize::from(self)
-    }
-}
+impl_sq!(u8);
+impl_sq!(u16);
 
 /// A box of voxel keys, inclusive on both ends.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
