@@ -16,11 +16,14 @@
 //!   the sensor's blind reach for it, `StaticSensor::blind_reach_m`: the first stretch of any
 //!   path has parts the sensor cannot see from the start, e.g. below and above the camera's 58°
 //!   vertical field within 0.54 m; FASTER's initial condition, the vehicle starts in known
-//!   free space), and at every scan the ball the vehicle's body fills, grown by a voxel
-//!   diagonal (the voxels its body touches; the commit check's own discretization: a voxel
-//!   within its clearance of the vehicle's voxel, `LocalMap::segment_known_free`). Without it
-//!   the camera's minimum depth (0.3 m) and vertical field leave the voxels round a hovering
-//!   vehicle unobserved, and a plan that sets off sideways, up or down is never committed.
+//!   free space), and at every scan the ball the vehicle's body fills, grown to the voxels the
+//!   commit check asks about for the vehicle's own place (`LocalMap::known_free_reach_m`: the
+//!   check's voxel ball of the vehicle's radius reaches voxel centres 0.52 m away for r =
+//!   0.3 m). Without it the camera's minimum depth (0.3 m) and vertical field leave the voxels
+//!   round a hovering vehicle unobserved, and a plan that sets off sideways, up or down is
+//!   never committed; with only the body and a voxel diagonal (0.47 m), a vehicle that stopped
+//!   beside a wall could not even commit to its own place (the U-trap and the long trip
+//!   stalled there, decision 0047).
 //! * **Heading.** A forward-looking camera must look where the vehicle goes: the commanded yaw
 //!   turns toward the direction of the best branch (main, else the best-ranked kept one) one
 //!   second ahead, else toward the goal, at most [`YAW_RATE_RAD_S`]. A known map keeps yaw 0.
@@ -103,7 +106,7 @@ impl OnlineMap {
     /// (the world's), for a vehicle of radius `radius_m` whose sensor cannot see within
     /// `blind_reach_m` of it (`StaticSensor::blind_reach_m`): the ball round `start` of radius
     /// `radius_m + blind_reach_m + voxel diagonal` starts known free, and after each scan the
-    /// ball of `radius_m + voxel diagonal` round the vehicle (module docs).
+    /// ball of `LocalMap::known_free_reach_m(radius_m)` round the vehicle (module docs).
     ///
     /// # Errors
     /// `SensingError` for invalid map parameters, a `start` out of scale or a map that cannot
@@ -119,6 +122,7 @@ impl OnlineMap {
         let diagonal = 3f64.sqrt() * params.resolution_m;
         map.assume_free(start, radius_m + blind_reach_m + diagonal);
         let planner_map = Arc::new(map.to_static_map(bounds)?);
+        let body_m = map.known_free_reach_m(radius_m).max(radius_m + diagonal);
         Ok(OnlineMap {
             map: Arc::new(map),
             memory: None,
@@ -128,7 +132,7 @@ impl OnlineMap {
             planner_map,
             dirty: false,
             clearance_m: radius_m,
-            body_m: radius_m + diagonal,
+            body_m,
             map_ms: 0.0,
         })
     }

@@ -603,6 +603,24 @@ impl LocalMap {
         true
     }
 
+    /// How far from a point the centres of the voxels [`LocalMap::segment_known_free`] asks
+    /// about for it at `clearance` can lie (m): the farthest offset of its voxel ball plus half a
+    /// voxel diagonal (the point may lie anywhere in its voxel). Marking the ball of this radius
+    /// round a vehicle known free (`assume_free`) lets a vehicle at rest commit to its own place
+    /// whatever its sensor cannot see round it. 0 for a NaN clearance or one above 16 voxels.
+    pub fn known_free_reach_m(&self, clearance: f64) -> f64 {
+        let res = self.ring.res;
+        let r = clearance.max(0.0) / res;
+        if clearance.is_nan() || r > 16.0 {
+            return 0.0;
+        }
+        let far = ball_offsets(r)
+            .iter()
+            .map(|d| ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt())
+            .fold(0.0, f64::max);
+        (far + 0.5 * 3f64.sqrt()) * res
+    }
+
     /// Signed distance at `p` from the distance field (trilinear between voxel centres), as of
     /// the last [`LocalMap::update_distance`]; `None` outside the box of the window's voxel
     /// centres or for a non-finite `p`. Values are exact up to
@@ -874,6 +892,30 @@ mod tests {
         let (map, c) = ball_known(0.4);
         assert!(!map.segment_known_free(&c, &c, 0.3));
         assert!(map.segment_known_free(&c, &c, 0.2));
+    }
+
+    #[test]
+    fn the_known_free_reach_covers_the_voxels_the_check_asks_about() {
+        let map = LocalMap::new(LocalMapParams::default(), &Vec3::zeros()).unwrap();
+        // Offsets (3, 3, 1) pass for 3 voxels: √19 voxels and half a diagonal.
+        let reach = map.known_free_reach_m(0.3);
+        assert!(
+            (reach - (19f64.sqrt() + 0.5 * 3f64.sqrt()) * 0.1).abs() < 1e-12,
+            "{reach}"
+        );
+        assert_eq!(map.known_free_reach_m(f64::NAN), 0.0);
+        assert_eq!(map.known_free_reach_m(2.0), 0.0);
+        // A vehicle at rest: its reach ball marked free, the check passes at its place.
+        let mut map = map;
+        let p = Vec3::new(0.37, -0.21, 0.44);
+        map.assume_free(&p, reach);
+        assert!(map.segment_known_free(&p, &p, 0.3));
+        let mut short = LocalMap::new(LocalMapParams::default(), &Vec3::zeros()).unwrap();
+        short.assume_free(&p, 0.3 + 0.1 * 3f64.sqrt());
+        assert!(
+            !short.segment_known_free(&p, &p, 0.3),
+            "the old body ball fell short"
+        );
     }
 
     #[test]
