@@ -417,7 +417,15 @@ impl CommitCheck for KnownFree {
         let r = self.route.as_ref()?;
         let near = (*r.near).clone();
         r.memory
-            .route_map(near, &self.map.window(), from, goal, r.keep_m, r.reach_m)
+            .route_map(
+                near,
+                &self.map.window(),
+                &|b| self.map.observed_in(b),
+                from,
+                goal,
+                r.keep_m,
+                r.reach_m,
+            )
             .ok()
             .map(Arc::new)
     }

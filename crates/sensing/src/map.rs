@@ -603,6 +603,27 @@ impl LocalMap {
         true
     }
 
+    /// True if some voxel of the window whose centre lies in `region` is observed (free or
+    /// occupied).
+    pub fn observed_in(&self, region: &Aabb) -> bool {
+        let res = self.ring.res;
+        let lo = voxel_key(&region.min, res);
+        let hi = voxel_key(&region.max, res);
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    let k = [x, y, z];
+                    if region.contains(&self.ring.center(&k))
+                        && self.state_of_key(&k) != VoxelState::Unknown
+                    {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
     /// How far from a point the centres of the voxels [`LocalMap::segment_known_free`] asks
     /// about for it at `clearance` can lie (m): the farthest offset of its voxel ball plus half a
     /// voxel diagonal (the point may lie anywhere in its voxel). Marking the ball of this radius

@@ -182,12 +182,14 @@ impl MapMemory {
     /// The cells a route from `from` toward `goal` may not cross, as merged boxes (runs along
     /// x, then equal runs on consecutive rows along y, then equal rectangles on consecutive
     /// layers along z: a wall becomes one box, not thousands): the remembered surfaces not
-    /// wholly inside `window` (the window's own field holds those exactly), and the unseen cells
+    /// wholly inside `window` whose voxels the window has observed (`knows`: its own field holds
+    /// those exactly; a window that moved away and back has forgotten them), and the unseen cells
     /// whose centres lie farther than `keep_m` and within `reach_m` of `from` and farther than
     /// `keep_m` from `goal`.
     pub fn blocked_boxes(
         &self,
         window: &Aabb,
+        knows: &dyn Fn(&Aabb) -> bool,
         from: &Vec3,
         goal: &Vec3,
         keep_m: f64,
@@ -197,7 +199,8 @@ impl MapMemory {
         let lo = |c: [usize; 3]| Vec3::from_fn(|i, _| self.bounds.min[i] + c[i] as f64 * h);
         let inside = |c: [usize; 3]| {
             let a = lo(c);
-            window.contains(&a) && window.contains(&(a + Vec3::repeat(h)))
+            let b = a + Vec3::repeat(h);
+            window.contains(&a) && window.contains(&b) && knows(&Aabb { min: a, max: b })
         };
         let mut cells: Vec<usize> = self
             .list
@@ -290,12 +293,13 @@ impl MapMemory {
         &self,
         near: StaticMap,
         window: &Aabb,
+        knows: &dyn Fn(&Aabb) -> bool,
         from: &Vec3,
         goal: &Vec3,
         keep_m: f64,
         reach_m: f64,
     ) -> Result<StaticMap, SensingError> {
-        let boxes = self.blocked_boxes(window, from, goal, keep_m, reach_m);
+        let boxes = self.blocked_boxes(window, knows, from, goal, keep_m, reach_m);
         Ok(near.with_shapes(boxes.into_iter().map(Shape::from))?)
     }
 }
@@ -371,7 +375,7 @@ mod tests {
         let near = StaticMap::new(bounds()).unwrap();
         let window = Aabb::new(from, from).unwrap();
         let map = memory
-            .route_map(near, &window, &from, &goal, 1.0, 4.0)
+            .route_map(near, &window, &|_| true, &from, &goal, 1.0, 4.0)
             .unwrap();
         assert!(
             !map.is_free(&Vec3::new(10.2, 10.2, 8.2), 0.0),
@@ -409,18 +413,37 @@ mod tests {
         memory.record(&hits(&points));
         assert_eq!(memory.occupied_count(), 480);
         let far = Aabb::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(5.0, 5.0, 5.0)).unwrap();
-        let boxes = memory.blocked_boxes(&far, &Vec3::zeros(), &Vec3::zeros(), 0.0, 0.0);
+        let boxes = memory.blocked_boxes(&far, &|_| true, &Vec3::zeros(), &Vec3::zeros(), 0.0, 0.0);
         assert_eq!(boxes.len(), 1, "{boxes:?}");
         assert!((boxes[0].min - Vec3::new(20.0, 2.0, 0.0)).norm() < 1e-9);
         assert!((boxes[0].max - Vec3::new(21.0, 12.0, 6.0)).norm() < 1e-9);
         // A window holding part of the wall: the cells wholly inside it are not boxes.
         let window = Aabb::new(Vec3::new(15.0, 0.0, 0.0), Vec3::new(25.0, 7.0, 10.0)).unwrap();
-        let boxes = memory.blocked_boxes(&window, &Vec3::zeros(), &Vec3::zeros(), 0.0, 0.0);
+        let boxes =
+            memory.blocked_boxes(&window, &|_| true, &Vec3::zeros(), &Vec3::zeros(), 0.0, 0.0);
         let covered: f64 = boxes.iter().map(|b| (b.max - b.min).product()).sum();
         assert!((covered - 1.0 * 5.0 * 6.0).abs() < 1e-9, "{boxes:?}");
+        // A window that moved away and back has forgotten the wall: all of it is a box again.
+        let forgot = memory.blocked_boxes(
+            &window,
+            &|_| false,
+            &Vec3::zeros(),
+            &Vec3::zeros(),
+            0.0,
+            0.0,
+        );
+        assert_eq!(forgot.len(), 1, "{forgot:?}");
         let near = StaticMap::new(bounds()).unwrap();
         let map = memory
-            .route_map(near, &window, &Vec3::zeros(), &Vec3::zeros(), 0.0, 0.0)
+            .route_map(
+                near,
+                &window,
+                &|_| true,
+                &Vec3::zeros(),
+                &Vec3::zeros(),
+                0.0,
+                0.0,
+            )
             .unwrap();
         assert!(!map.is_free(&Vec3::new(20.5, 10.0, 3.0), 0.0));
         assert!(
