@@ -47,6 +47,7 @@ use trust_manager::CommitCheck;
 use trust_planner::AnyManager;
 use trust_sensing::{
     DEFAULT_MEMORY_CELL_M, DepthCamera, Lidar, LocalMap, MapMemory, Pose, RaySensor, Scan, Truth,
+    Unseen,
 };
 use trust_vehicle::VehicleState;
 use trust_world::World;
@@ -421,10 +422,12 @@ impl CommitCheck for KnownFree {
                 near,
                 &self.map.window(),
                 &|b| self.map.observed_in(b),
-                from,
-                goal,
-                r.keep_m,
-                r.reach_m,
+                &Unseen {
+                    from: *from,
+                    goal: *goal,
+                    keep_m: r.keep_m,
+                    reach_m: r.reach_m,
+                },
             )
             .ok()
             .map(Arc::new)

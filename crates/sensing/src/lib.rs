@@ -73,7 +73,7 @@ pub use camera::{DepthCamera, DepthCameraParams};
 pub use error::SensingError;
 pub use lidar::{Lidar, LidarParams};
 pub use map::{LocalMap, LocalMapParams, MAX_WINDOW_VOXELS, ScanUpdate};
-pub use memory::{DEFAULT_MEMORY_CELL_M, MAX_MEMORY_CELLS, MapMemory};
+pub use memory::{DEFAULT_MEMORY_CELL_M, MAX_MEMORY_CELLS, MapMemory, Unseen};
 pub use occupancy::{LogOddsParams, VoxelState, logit};
 pub use pose::Pose;
 pub use scan::{RayMeasurement, ReturnKind, Scan};

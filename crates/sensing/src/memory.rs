@@ -34,6 +34,33 @@ pub const MAX_MEMORY_CELLS: usize = 1 << 25;
 /// remembered obstacle lies, not the width of a door.
 pub const DEFAULT_MEMORY_CELL_M: f64 = 0.5;
 
+/// The unseen cells a route may not cross ([`MapMemory::blocked_boxes`]): those whose centres
+/// lie farther than `keep_m` and within `reach_m` of `from`, and farther than `keep_m` from
+/// `goal`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Unseen {
+    /// Where the route starts (the vehicle).
+    pub from: Vec3,
+    /// Where it goes.
+    pub goal: Vec3,
+    /// The vehicle's own place and the goal's (m).
+    pub keep_m: f64,
+    /// How far round `from` unseen cells are blocked (m).
+    pub reach_m: f64,
+}
+
+impl Unseen {
+    /// No unseen cell blocked (a reach of 0).
+    pub fn none() -> Self {
+        Self {
+            from: Vec3::zeros(),
+            goal: Vec3::zeros(),
+            keep_m: 0.0,
+            reach_m: 0.0,
+        }
+    }
+}
+
 /// A coarse record over the world's bounds of the surfaces the vehicle has seen (module docs).
 #[derive(Debug, Clone)]
 pub struct MapMemory {
@@ -190,11 +217,14 @@ impl MapMemory {
         &self,
         window: &Aabb,
         knows: &dyn Fn(&Aabb) -> bool,
-        from: &Vec3,
-        goal: &Vec3,
-        keep_m: f64,
-        reach_m: f64,
+        unseen: &Unseen,
     ) -> Vec<AaBox> {
+        let Unseen {
+            from,
+            goal,
+            keep_m,
+            reach_m,
+        } = *unseen;
         let h = self.cell_m;
         let lo = |c: [usize; 3]| Vec3::from_fn(|i, _| self.bounds.min[i] + c[i] as f64 * h);
         let inside = |c: [usize; 3]| {
@@ -294,12 +324,9 @@ impl MapMemory {
         near: StaticMap,
         window: &Aabb,
         knows: &dyn Fn(&Aabb) -> bool,
-        from: &Vec3,
-        goal: &Vec3,
-        keep_m: f64,
-        reach_m: f64,
+        unseen: &Unseen,
     ) -> Result<StaticMap, SensingError> {
-        let boxes = self.blocked_boxes(window, knows, from, goal, keep_m, reach_m);
+        let boxes = self.blocked_boxes(window, knows, unseen);
         Ok(near.with_shapes(boxes.into_iter().map(Shape::from))?)
     }
 }
@@ -375,7 +402,17 @@ mod tests {
         let near = StaticMap::new(bounds()).unwrap();
         let window = Aabb::new(from, from).unwrap();
         let map = memory
-            .route_map(near, &window, &|_| true, &from, &goal, 1.0, 4.0)
+            .route_map(
+                near,
+                &window,
+                &|_| true,
+                &Unseen {
+                    from,
+                    goal,
+                    keep_m: 1.0,
+                    reach_m: 4.0,
+                },
+            )
             .unwrap();
         assert!(
             !map.is_free(&Vec3::new(10.2, 10.2, 8.2), 0.0),
@@ -413,37 +450,21 @@ mod tests {
         memory.record(&hits(&points));
         assert_eq!(memory.occupied_count(), 480);
         let far = Aabb::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(5.0, 5.0, 5.0)).unwrap();
-        let boxes = memory.blocked_boxes(&far, &|_| true, &Vec3::zeros(), &Vec3::zeros(), 0.0, 0.0);
+        let boxes = memory.blocked_boxes(&far, &|_| true, &Unseen::none());
         assert_eq!(boxes.len(), 1, "{boxes:?}");
         assert!((boxes[0].min - Vec3::new(20.0, 2.0, 0.0)).norm() < 1e-9);
         assert!((boxes[0].max - Vec3::new(21.0, 12.0, 6.0)).norm() < 1e-9);
         // A window holding part of the wall: the cells wholly inside it are not boxes.
         let window = Aabb::new(Vec3::new(15.0, 0.0, 0.0), Vec3::new(25.0, 7.0, 10.0)).unwrap();
-        let boxes =
-            memory.blocked_boxes(&window, &|_| true, &Vec3::zeros(), &Vec3::zeros(), 0.0, 0.0);
+        let boxes = memory.blocked_boxes(&window, &|_| true, &Unseen::none());
         let covered: f64 = boxes.iter().map(|b| (b.max - b.min).product()).sum();
         assert!((covered - 1.0 * 5.0 * 6.0).abs() < 1e-9, "{boxes:?}");
         // A window that moved away and back has forgotten the wall: all of it is a box again.
-        let forgot = memory.blocked_boxes(
-            &window,
-            &|_| false,
-            &Vec3::zeros(),
-            &Vec3::zeros(),
-            0.0,
-            0.0,
-        );
+        let forgot = memory.blocked_boxes(&window, &|_| false, &Unseen::none());
         assert_eq!(forgot.len(), 1, "{forgot:?}");
         let near = StaticMap::new(bounds()).unwrap();
         let map = memory
-            .route_map(
-                near,
-                &window,
-                &|_| true,
-                &Vec3::zeros(),
-                &Vec3::zeros(),
-                0.0,
-                0.0,
-            )
+            .route_map(near, &window, &|_| true, &Unseen::none())
             .unwrap();
         assert!(!map.is_free(&Vec3::new(20.5, 10.0, 3.0), 0.0));
         assert!(
