@@ -796,6 +796,7 @@ fn cycle_record(
         waited_ms: (merged || route_away).then(|| time(report.timing.waited_ms)),
         route_worker_ms: route_away.then(|| time(report.timing.route_worker_ms)),
         map_ms: None,
+        aim: Some(report.aim),
     }
 }
 

@@ -125,9 +125,16 @@ struct Candidate {
     repaired: bool,
 }
 
-/// A route vertex turning by more than this (60°) is aimed at before the route's local goal
+/// A route vertex turning by more than this (60°, over [`CORNER_SPAN_S`]) is aimed at before the
+/// route's local goal
 /// ([`trust_route::GlobalRoute::first_sharp_turn`]; beyond the paper).
 const SHARP_TURN_RAD: f64 = std::f64::consts::FRAC_PI_3;
+
+/// The span over which a route's turn is measured for [`SHARP_TURN_RAD`] (s of flight at
+/// `v_max`): the route's direction 0.4 s before a vertex against 0.4 s after it. A turn that
+/// tight, within about one of the presets' 0.7 s trajectory pieces, is one the local planner
+/// cuts.
+const CORNER_SPAN_S: f64 = 0.4;
 
 /// What a vehicle at `from` (arc length `s0` on `route`) aims at when the route turns sharply
 /// at `corner` before the aim `ahead`: the farthest route point up to `ahead` in sight at
@@ -384,11 +391,15 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     /// ([`Manager::set_route`]), or a sharp corner before it that hides the route beyond
     /// ([`aim_past_corner`]), or `goal` without a route, near the route's end, or when the
     /// route cannot be queried. While `stalled`, the farthest route point before it that is in
-    /// sight from `from` ([`trust_route::GlobalRoute::last_in_sight`]).
+    /// sight from `from` ([`trust_route::GlobalRoute::last_in_sight`]). Sight is judged on the
+    /// route's own map when the sensed map's policy gave it one ([`crate::CommitCheck::route_map`]:
+    /// a rolling window forgets the walls it has left, the route's map remembers them), else on
+    /// `map`.
     fn aim(&self, from: &Vec3, goal: &Vec3, stalled: bool, map: &StaticMap) -> Vec3 {
         let Some(route) = &self.route else {
             return *goal;
         };
+        let map = self.route_map.as_deref().unwrap_or(map);
         let horizon_m = self.params.horizon_s * self.limits.v_max;
         let Ok(s0) = route.progress(from) else {
             return *goal;
@@ -411,7 +422,10 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         // safety clearance — is not: aimed at, the plan ended at rest on it (a forest's route
         // turning by 61° stopped the vehicle there, 10 m/s to 1.4 m/s).
         let reach = route.clearance_m().max(self.params.goal_reached_m);
-        let target = match route.first_sharp_turn(s0 + reach, ahead.s, SHARP_TURN_RAD) {
+        // The turn is measured over the distance flown in `CORNER_SPAN_S`: a hairpin of short
+        // segments (a sensed U-trap's route out of its pocket) is a corner too.
+        let span = (CORNER_SPAN_S * self.limits.v_max).max(reach);
+        let target = match route.first_sharp_turn(s0 + reach, ahead.s, SHARP_TURN_RAD, span) {
             Some(corner) => aim_past_corner(
                 route,
                 map,
@@ -557,6 +571,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             events: cycle.events,
             frontend: explored.frontend,
             straight_guide: explored.straight_guide,
+            aim: [aim.x, aim.y, aim.z],
             timing: spans.finish(),
             fallback,
             goal_unreachable: self.unreachable.clone(),

@@ -540,6 +540,10 @@ pub struct StepReport {
     /// Whether the straight guide toward the goal was explored because the frontend found no path
     /// ([`crate::ManagerParams::straight_guide_when_empty`]).
     pub straight_guide: bool,
+    /// Where the cycle's branches aimed: the route's local goal, a corner of the route that
+    /// hides what lies beyond, or the goal (`Manager`'s aim, see [`crate::Manager::step`]).
+    #[serde(default = "zero_aim")]
+    pub aim: [f64; 3],
     /// Where the time went.
     pub timing: CycleTiming,
     /// The braking fallback, when no branch was feasible.
@@ -566,6 +570,10 @@ pub struct GoalUnreachable {
     pub held_at: Option<[f64; 3]>,
     /// When the verdict was first reached (s).
     pub since_t: f64,
+}
+
+fn zero_aim() -> [f64; 3] {
+    [0.0; 3]
 }
 
 impl StepReport {

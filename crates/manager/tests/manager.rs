@@ -1901,3 +1901,48 @@ fn a_sensed_route_uses_its_own_map_and_is_searched_again_when_blocked() {
         "{reasons:?}"
     );
 }
+
+/// Issue 34: on a sensed map the vehicle aims at what it can see on the route's own map. A
+/// rolling window forgets the walls it has left; aimed past a corner through such a wall (a
+/// sensed U-trap), the vehicle hovered against it for a minute.
+#[test]
+fn a_sensed_route_aims_at_its_corner_when_a_remembered_wall_hides_the_rest() {
+    let bounds = Aabb::new(Vec3::zeros(), Vec3::new(60.0, 30.0, 8.0)).unwrap();
+    let wall: Shape = AaBox::new(Vec3::new(30.0, 0.0, 0.0), Vec3::new(31.0, 16.0, 8.0))
+        .unwrap()
+        .into();
+    // The planning map (the window) has forgotten the wall; the route's map remembers it.
+    let open = StaticMap::new(bounds).unwrap();
+    let route_map = std::sync::Arc::new(StaticMap::from_shapes(bounds, vec![wall]).unwrap());
+    let (start, goal) = (Vec3::new(28.0, 10.0, 3.5), Vec3::new(55.0, 10.0, 3.5));
+    let mut m = planner(ManagerParams::trust());
+    m.set_router(Some(
+        trust_manager::Router::new(trust_route::RouteParams::default(), 0.3).unwrap(),
+    ));
+    m.set_commit_check(Some(std::sync::Arc::new(RoutesOnItsOwnMap {
+        route_map: std::sync::Arc::clone(&route_map),
+    })));
+    let scene = Scene::new(&open, &[], 0.0).unwrap();
+    let mut state = State::at_rest(0.0, start);
+    let mut aims = Vec::new();
+    for i in 0..60 {
+        state.t = 0.1 * i as f64;
+        let report = m.step(state.t, &state, &goal, &scene).unwrap();
+        if m.route().is_some() {
+            aims.push(Vec3::from(report.aim));
+        }
+    }
+    let route = m.route().expect("a route");
+    assert!(
+        route.points().iter().any(|p| p.y > 16.0),
+        "round the wall: {:?}",
+        route.points()
+    );
+    assert!(!aims.is_empty());
+    for aim in aims {
+        assert!(
+            route_map.segment_clear(&start, &aim, 0.0),
+            "aimed at {aim:?}, behind the remembered wall"
+        );
+    }
+}

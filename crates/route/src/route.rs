@@ -237,20 +237,32 @@ impl GlobalRoute {
     }
 
     /// The first vertex with arc length in `(from_s, to_s)` where the route turns by more than
-    /// `min_turn_rad` (the angle between the incoming and the outgoing segment), or `None`. A
-    /// local planner that aims beyond such a corner cuts it (its trajectory pieces are longer
-    /// than the corner is sharp); aiming at the corner first brings the vehicle round it.
+    /// `min_turn_rad` within `span_m` (m) of it, or `None`: the angle between the chord from the
+    /// route's point `span_m` before the vertex to the vertex and the chord from the vertex to the
+    /// point `span_m` after it (each chord at least the vertex's own segment, so with `span_m` = 0
+    /// the angle between the incoming and the outgoing segment). A hairpin of short segments,
+    /// none turning much, is a corner too. A local planner that aims beyond such a corner cuts
+    /// it (its trajectory pieces are longer than the corner is sharp); aiming at the corner
+    /// first brings the vehicle round it. A non-finite or negative `span_m` counts as 0.
     pub fn first_sharp_turn(
         &self,
         from_s: f64,
         to_s: f64,
         min_turn_rad: f64,
+        span_m: f64,
     ) -> Option<RoutePoint> {
+        let span = if span_m.is_finite() {
+            span_m.max(0.0)
+        } else {
+            0.0
+        };
         (1..self.points.len().saturating_sub(1))
             .filter(|&i| self.cum[i] > from_s && self.cum[i] < to_s)
             .find(|&i| {
-                let a = self.points[i] - self.points[i - 1];
-                let b = self.points[i + 1] - self.points[i];
+                let p = self.points[i];
+                let before = self.point_at((self.cum[i] - span).min(self.cum[i - 1]));
+                let after = self.point_at((self.cum[i] + span).max(self.cum[i + 1]));
+                let (a, b) = (p - before, after - p);
                 let (na, nb) = (a.norm(), b.norm());
                 na > 0.0
                     && nb > 0.0

@@ -361,6 +361,37 @@ fn the_aim_in_sight_stops_at_the_corner_a_building_hides_the_rest_behind() {
     assert_eq!(route.last_in_sight(&map, &inside, 0.0, far, 0.2), far);
 }
 
+#[test]
+fn a_hairpin_of_short_segments_is_a_sharp_turn_over_a_span() {
+    // A sensed U-trap's route: out of the pocket round the end of a side wall the vehicle has
+    // not seen, then on to the goal behind the pocket's back wall. No vertex turns by more than
+    // 45°, but within 3 m the route doubles back.
+    let p = |x: f64, y: f64| Vec3::new(x, y, 4.0);
+    let route = GlobalRoute::from_points(vec![
+        p(39.0, 28.0),
+        p(34.0, 20.0),
+        p(34.0, 19.0),
+        p(35.0, 18.0),
+        p(41.0, 18.0),
+        p(90.0, 30.0),
+    ])
+    .unwrap();
+    let len = route.length();
+    let turn = std::f64::consts::FRAC_PI_3;
+    assert_eq!(route.first_sharp_turn(0.0, len, turn, 0.0), None);
+    let corner = route.first_sharp_turn(0.0, len, turn, 3.0).unwrap();
+    assert!((corner.point - p(34.0, 20.0)).norm() < 1e-9, "{corner:?}");
+    assert!((corner.s - (p(34.0, 20.0) - p(39.0, 28.0)).norm()).abs() < 1e-9);
+    // A single sharp vertex is found at every span; a straight route has none; a bad span is 0.
+    let l = GlobalRoute::from_points(vec![p(0.0, 0.0), p(10.0, 0.0), p(10.0, 10.0)]).unwrap();
+    for span in [0.0, 1.0, 30.0, f64::NAN, -1.0, f64::INFINITY] {
+        let c = l.first_sharp_turn(0.0, 20.0, turn, span).unwrap();
+        assert!((c.point - p(10.0, 0.0)).norm() < 1e-9, "span {span}");
+    }
+    let straight = GlobalRoute::from_points(vec![p(0.0, 0.0), p(5.0, 0.1), p(10.0, 0.0)]).unwrap();
+    assert_eq!(straight.first_sharp_turn(0.0, 10.0, turn, 5.0), None);
+}
+
 /// A random map of full-height pillars and boxes in a `size` world, start and goal kept free.
 fn random_map(seed: u64, size: [f64; 3], count: usize, r: f64) -> (StaticMap, Vec3, Vec3) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);

@@ -288,6 +288,11 @@ pub struct CycleRecord {
     /// of the planner's map. Perception, not planning: not part of `wall_ms`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub map_ms: Option<f64>,
+    /// Added (issue 34), in the planner's cycles: the point its branches aimed at this cycle
+    /// (the global route's local goal, a route corner that hides what lies beyond, or the
+    /// goal; m, world frame). Where to look first when a flight stalls.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aim: Option<[f64; 3]>,
 }
 
 impl CycleRecord {
