@@ -63,6 +63,7 @@ mod map;
 mod memory;
 mod occupancy;
 mod pose;
+mod projective;
 mod ring;
 mod scan;
 mod sensor;
