@@ -14,6 +14,9 @@ use crate::error::SensingError;
 use crate::pose::Pose;
 use crate::scan::{ReturnKind, Scan};
 
+/// Half a voxel's diagonal in voxels, `√3 / 2`.
+const HALF_DIAGONAL: f64 = 0.866_025_403_784_438_6;
+
 /// One frame's projective rule (module docs).
 #[derive(Debug, Clone)]
 pub(crate) struct DepthFrame {
@@ -32,11 +35,11 @@ pub(crate) struct DepthFrame {
     /// `[u, u + 1)`, its centre ray at `u + 0.5`, as [`DepthCamera`] builds its rays).
     fu: f64,
     fv: f64,
-    /// A voxel centre outside the image within half a voxel of the frustum's side (the voxel
-    /// reaches into the view) is decided by the nearest edge pixel: the margin in columns (rows)
-    /// is `edge_u / x` (`edge_v / x`) at depth `x`.
-    edge_u: f64,
-    edge_v: f64,
+    /// A voxel centre outside the image whose voxel reaches across the frustum's side plane is
+    /// decided by the nearest edge pixel: the margins below columns 0 and above `w`, below row 0
+    /// and above `h`, are these over the depth `x` (the box's support along the plane's normal,
+    /// `res/2 · |n|₁` in the world frame, in pixels at unit depth).
+    edges: [f64; 4],
     /// Per pixel (row by row): a voxel whose centre projects into the pixel is a miss when its
     /// depth along the optical axis is below this; `-inf` for a pixel without evidence.
     clear_below: Vec<f64>,
@@ -104,12 +107,14 @@ impl DepthFrame {
         let mut far = f64::NEG_INFINITY;
         let mut ray_count = 0;
         for (i, ray) in scan.rays.iter().enumerate() {
-            let err = (ray.direction - rot * dirs[i]).norm();
-            if err.is_nan() || err > 1e-6 {
+            // Squared, so that a good ray costs no square root.
+            let err2 = (ray.direction - rot * dirs[i]).norm_squared();
+            if err2.is_nan() || err2 > 1e-12 {
                 return Err(SensingError::Scan {
                     field: format!("scan.rays[{i}].direction"),
                     problem: format!(
-                        "{err} from pixel ({}, {})'s direction; expected the camera's ray",
+                        "{} from pixel ({}, {})'s direction; expected the camera's ray",
+                        err2.sqrt(),
                         i % w,
                         i / w
                     ),
@@ -154,8 +159,20 @@ impl DepthFrame {
             ty,
             fu: w as f64 / (2.0 * tx),
             fv: h as f64 / (2.0 * ty),
-            edge_u: w as f64 / (2.0 * tx) * 0.5 * res * tx.hypot(1.0),
-            edge_v: h as f64 / (2.0 * ty) * 0.5 * res * ty.hypot(1.0),
+            edges: [
+                (tx, 1.0, 0.0, w as f64 / (2.0 * tx)),
+                (tx, -1.0, 0.0, w as f64 / (2.0 * tx)),
+                (ty, 0.0, 1.0, h as f64 / (2.0 * ty)),
+                (ty, 0.0, -1.0, h as f64 / (2.0 * ty)),
+            ]
+            .map(|(t, ny, nz, f)| {
+                // The side plane's outward normal `(−t, ny, nz) / √(1 + t²)` in the world frame.
+                let support: f64 = (0..3)
+                    .map(|j| (-t * rt[0][j] + ny * rt[1][j] + nz * rt[2][j]).abs())
+                    .sum::<f64>()
+                    / t.hypot(1.0);
+                f * 0.5 * res * support * t.hypot(1.0)
+            }),
             clear_below,
             far,
             ray_count,
@@ -187,9 +204,9 @@ impl DepthFrame {
     }
 
     /// The pixel (row-major index) that decides a voxel centre at sensor coordinates `p`: the
-    /// one it projects into, or the nearest edge pixel if it projects outside the image within
-    /// half a voxel of the frustum's side (the voxel reaches into the view); `None` behind the
-    /// sensor or farther out.
+    /// one it projects into, or the nearest edge pixel if it projects outside the image but its
+    /// voxel reaches across the side planes it lies beyond; `None` behind the sensor or
+    /// farther out.
     #[inline]
     pub fn pixel_of(&self, p: &[f64; 3]) -> Option<usize> {
         if p[0].is_nan() || p[0] <= 0.0 {
@@ -199,8 +216,8 @@ impl DepthFrame {
         let (w, h) = (self.width as f64, self.height as f64);
         let u = 0.5 * w - self.fu * (p[1] * inv);
         let v = 0.5 * h - self.fv * (p[2] * inv);
-        let (mu, mv) = (self.edge_u * inv, self.edge_v * inv);
-        if !(u >= -mu && u < w + mu && v >= -mv && v < h + mv) {
+        let e = self.edges;
+        if !(u >= -e[0] * inv && u < w + e[1] * inv && v >= -e[2] * inv && v < h + e[3] * inv) {
             return None;
         }
         // Finite here; `as` saturates a negative value to 0, `min` the far edge.
@@ -218,11 +235,11 @@ impl DepthFrame {
         self.pixel_of(p).is_some_and(|i| p[0] < self.clear_below[i])
     }
 
-    /// Slack (m) for [`DepthFrame::row_span`] that covers the edge margin of
-    /// [`DepthFrame::pixel_of`] (half a voxel from the side planes, `res/2 · √(1 + tan²)` in
-    /// `|y| − x tan`) with a voxel to spare.
+    /// Slack (m) for [`DepthFrame::row_span`] that covers the edge margins of
+    /// [`DepthFrame::pixel_of`] (at most half a voxel diagonal from the side planes,
+    /// `√3/2 res · √(1 + tan²)` in `|y| − x tan`) with a voxel to spare.
     pub fn span_slack(&self, res: f64) -> f64 {
-        res * (1.0 + 0.5 * self.tx.max(self.ty).hypot(1.0))
+        res * (1.0 + HALF_DIAGONAL * self.tx.max(self.ty).hypot(1.0))
     }
 
     /// The world x offsets from the origin along the row of offsets `(·, dy, dz)` that can hold
