@@ -132,8 +132,8 @@ pub struct ScanUpdate {
 ///   Tordesillas et al., IEEE T-RO 2022). Everything outside the window is unknown.
 ///
 /// The usual cycle: [`LocalMap::recentre`] on the vehicle, [`LocalMap::insert_scan`] per frame
-/// (or [`LocalMap::integrate_scan`] then [`LocalMap::update_distance`]), then queries or
-/// [`LocalMap::to_static_map`].
+/// (or [`LocalMap::integrate_scan`] then [`LocalMap::update_distance`]; for a depth camera's
+/// frame [`LocalMap::insert_depth_frame`]), then queries or [`LocalMap::to_static_map`].
 #[derive(Debug, Clone)]
 pub struct LocalMap {
     params: LocalMapParams,
