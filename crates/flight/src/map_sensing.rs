@@ -5,7 +5,9 @@
 //! the truth.
 //!
 //! * **When.** The first scan at `t = 0`, then one per sensor period (at the first physics step
-//!   at or after it); the window is re-centred on the vehicle before each scan.
+//!   at or after it); the window is re-centred on the vehicle before each scan. A depth
+//!   camera's frames go in by projection (`LocalMap::insert_depth_frame`, decision 0048), a
+//!   LiDAR's scans by walking each ray.
 //! * **The planner's map.** Rebuilt at a planning cycle if a scan came in since the last one
 //!   (`LocalMap::to_static_map` over the world's bounds); shared with the manager's worker.
 //! * **Commitment.** The committed part of a plan and its braking must lie in observed free
@@ -69,6 +71,8 @@ pub const NOISE_STREAM: u64 = 5;
 /// The online map of one flight and its sensor (module docs).
 pub struct MapSensing {
     sensor: Box<dyn RaySensor>,
+    /// The sensor again when it is a depth camera: its frames go in by projection.
+    camera: Option<DepthCamera>,
     online: OnlineMap,
     rng: ChaCha8Rng,
     scan: Scan,
@@ -139,7 +143,8 @@ impl OnlineMap {
     }
 
     /// Re-centres the window on `vehicle` (the vehicle's position at the scan), folds `scan`
-    /// in, and marks the vehicle's body ball known free.
+    /// in (`LocalMap::insert_scan`: free space along each ray), and marks the vehicle's body
+    /// ball known free.
     ///
     /// # Errors
     /// `SensingError` for a non-finite or out-of-scale position or a malformed scan (the map
@@ -149,10 +154,37 @@ impl OnlineMap {
         scan: &Scan,
         vehicle: &Vec3,
     ) -> Result<trust_sensing::ScanUpdate, trust_sensing::SensingError> {
+        self.insert_with(scan, vehicle, None)
+    }
+
+    /// [`OnlineMap::insert`] for a frame `camera` took at `pose` (the vehicle's pose):
+    /// free space by projecting the frustum's voxels into the depth image
+    /// (`LocalMap::insert_depth_frame`, decision 0048) instead of walking each pixel's ray.
+    ///
+    /// # Errors
+    /// As [`OnlineMap::insert`], and for a scan that is not `camera`'s frame at `pose`.
+    pub fn insert_depth_frame(
+        &mut self,
+        scan: &Scan,
+        camera: &DepthCamera,
+        pose: &Pose,
+    ) -> Result<trust_sensing::ScanUpdate, trust_sensing::SensingError> {
+        self.insert_with(scan, &pose.position, Some((camera, pose)))
+    }
+
+    fn insert_with(
+        &mut self,
+        scan: &Scan,
+        vehicle: &Vec3,
+        camera: Option<(&DepthCamera, &Pose)>,
+    ) -> Result<trust_sensing::ScanUpdate, trust_sensing::SensingError> {
         let started = Instant::now();
         let map = Arc::make_mut(&mut self.map);
         map.recentre(vehicle)?;
-        let update = map.insert_scan(scan)?;
+        let update = match camera {
+            Some((camera, pose)) => map.insert_depth_frame(camera, pose, scan)?,
+            None => map.insert_scan(scan)?,
+        };
         map.assume_free(vehicle, self.body_m);
         if let Some(memory) = self.memory.as_mut() {
             let memory = Arc::make_mut(memory);
@@ -260,9 +292,12 @@ impl MapSensing {
             StaticSensor::Depth(p) => p.max_depth_m,
             StaticSensor::Lidar(p) => p.max_range_m,
         };
-        let sensor: Box<dyn RaySensor> = match sensor {
-            StaticSensor::Depth(p) => Box::new(DepthCamera::new(p)?),
-            StaticSensor::Lidar(p) => Box::new(Lidar::new(p)?),
+        let (sensor, camera): (Box<dyn RaySensor>, _) = match sensor {
+            StaticSensor::Depth(p) => {
+                let camera = DepthCamera::new(p)?;
+                (Box::new(camera.clone()), Some(camera))
+            }
+            StaticSensor::Lidar(p) => (Box::new(Lidar::new(p)?), None),
         };
         let start = world.start();
         let online = OnlineMap::new(
@@ -278,6 +313,7 @@ impl MapSensing {
         Ok(Some(MapSensing {
             period_s: 1.0 / sensor.rate_hz(),
             sensor,
+            camera,
             online,
             rng: ChaCha8Rng::seed_from_u64(trust_world::mix_seed(scenario.seed, NOISE_STREAM)),
             scan: Scan::default(),
@@ -316,7 +352,10 @@ impl MapSensing {
             &mut self.scan,
         )?;
         self.online.map_ms += started.elapsed().as_secs_f64() * 1e3;
-        self.online.insert(&self.scan, &vehicle.p)?;
+        match &self.camera {
+            Some(camera) => self.online.insert_depth_frame(&self.scan, camera, &pose)?,
+            None => self.online.insert(&self.scan, &vehicle.p)?,
+        };
         Ok(())
     }
 

@@ -1,12 +1,14 @@
 //! One 160 × 120 depth frame into the online map, stage by stage: the ray cast against a
 //! forest-like static map (trees as cylinders, a ground slab, two office-like walls), the
-//! occupancy update (log-odds, free space by the 3-D DDA) and the incremental distance field.
+//! occupancy update (log-odds, free space by the 3-D DDA along each ray, or by projecting the
+//! frustum's voxels into the depth image: `LocalMap::integrate_depth_frame`) and the
+//! incremental distance field.
 //!
 //! Before measuring, the bench flies the camera through the forest at 2 m/s and 30 frames per
 //! second (90 frames; 30 under `--test`) with the default map (112 × 112 × 48 voxels of 0.1 m,
 //! field truncated at 1 m) and prints the median, p90 and maximum of each stage over the
-//! flight's frames (the first, cold frame apart), for the exact ray update and for Fast-Planner's
-//! stop-at-visited shortcut. Criterion then measures the steady frame (the next frame of that
+//! flight's frames (the first, cold frame apart), for the exact ray update, for Fast-Planner's
+//! stop-at-visited shortcut and for the projective update (same poses, same noise). Criterion then measures the steady frame (the next frame of that
 //! flight, from a copy of the map) and the cold one (a first frame into an empty map); the
 //! target is a whole map update (occupancy + distance) of one frame within 2 ms.
 
@@ -70,8 +72,22 @@ fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
+/// Folds one frame into `map`: by the ray walk, or by projection (`projective`).
+fn integrate(map: &mut LocalMap, camera: &DepthCamera, pose: &Pose, scan: &Scan, projective: bool) {
+    if projective {
+        map.integrate_depth_frame(camera, pose, scan).unwrap();
+    } else {
+        map.integrate_scan(scan).unwrap();
+    }
+}
+
 /// Flies `frames` frames; returns the per-stage times (ms) and the map before the last frame.
-fn fly(world: &StaticMap, params: LocalMapParams, frames: usize) -> (Stages, LocalMap) {
+fn fly(
+    world: &StaticMap,
+    params: LocalMapParams,
+    projective: bool,
+    frames: usize,
+) -> (Stages, LocalMap) {
     let camera = DepthCamera::new(DepthCameraParams::default()).unwrap();
     let truth = Truth::static_only(world);
     let mut rng = ChaCha8Rng::seed_from_u64(1);
@@ -92,7 +108,7 @@ fn fly(world: &StaticMap, params: LocalMapParams, frames: usize) -> (Stages, Loc
         camera.scan(&p, &truth, &mut rng, &mut scan).unwrap();
         s.raycast.push(ms(t));
         let t = Instant::now();
-        map.integrate_scan(&scan).unwrap();
+        integrate(&mut map, &camera, &p, &scan, projective);
         s.occupancy.push(ms(t));
         let t = Instant::now();
         map.update_distance();
@@ -113,8 +129,8 @@ fn summary(label: &str, v: &[f64]) -> String {
     )
 }
 
-fn report(world: &StaticMap, params: LocalMapParams, name: &str, frames: usize) {
-    let (s, map) = fly(world, params, frames);
+fn report(world: &StaticMap, params: LocalMapParams, projective: bool, name: &str, frames: usize) {
+    let (s, map) = fly(world, params, projective, frames);
     // The first frame is the cold one (everything new); the rest are the steady state.
     let warm = |v: &[f64]| v[1..].to_vec();
     let total: Vec<f64> = (1..frames)
@@ -144,8 +160,9 @@ fn bench_map_update(c: &mut Criterion) {
         stop_at_visited: true,
         ..exact
     };
-    report(&world, exact, "exact rays", frames);
-    report(&world, shortcut, "stop at visited", frames);
+    report(&world, exact, false, "exact rays", frames);
+    report(&world, shortcut, false, "stop at visited", frames);
+    report(&world, exact, true, "projective", frames);
 
     let camera = DepthCamera::new(DepthCameraParams::default()).unwrap();
     let truth = Truth::static_only(&world);
@@ -158,18 +175,24 @@ fn bench_map_update(c: &mut Criterion) {
     camera
         .scan(&next, &truth, &mut ChaCha8Rng::seed_from_u64(2), &mut scan)
         .unwrap();
-    for (params, tag) in [(exact, "exact"), (shortcut, "stop_at_visited")] {
-        let (_, mut warm) = fly(&world, params, frames);
+    for (params, projective, tag) in [
+        (exact, false, "exact"),
+        (shortcut, false, "stop_at_visited"),
+        (exact, true, "projective"),
+    ] {
+        let (_, mut warm) = fly(&world, params, projective, frames);
         warm.recentre(&next.position).unwrap();
+        let cam = &camera;
+        let (scan, next) = (&scan, &next);
         c.bench_function(&format!("occupancy_160x120_steady_{tag}"), |b| {
             b.iter_batched(
                 || warm.clone(),
-                |mut m| m.integrate_scan(&scan).unwrap(),
+                |mut m| integrate(&mut m, cam, next, scan, projective),
                 BatchSize::LargeInput,
             )
         });
         let mut integrated = warm.clone();
-        integrated.integrate_scan(&scan).unwrap();
+        integrate(&mut integrated, cam, next, scan, projective);
         c.bench_function(&format!("distance_160x120_steady_{tag}"), |b| {
             b.iter_batched(
                 || integrated.clone(),
@@ -180,7 +203,10 @@ fn bench_map_update(c: &mut Criterion) {
         c.bench_function(&format!("map_update_160x120_steady_{tag}"), |b| {
             b.iter_batched(
                 || warm.clone(),
-                |mut m| m.insert_scan(&scan).unwrap(),
+                |mut m| {
+                    integrate(&mut m, cam, next, scan, projective);
+                    m.update_distance()
+                },
                 BatchSize::LargeInput,
             )
         });
@@ -188,7 +214,10 @@ fn bench_map_update(c: &mut Criterion) {
         c.bench_function(&format!("map_update_160x120_cold_{tag}"), |b| {
             b.iter_batched(
                 || empty.clone(),
-                |mut m| m.insert_scan(&scan).unwrap(),
+                |mut m| {
+                    integrate(&mut m, cam, next, scan, projective);
+                    m.update_distance()
+                },
                 BatchSize::LargeInput,
             )
         });

@@ -177,6 +177,12 @@ impl DepthCamera {
             .then(|| self.pattern.dirs[v * self.params.width + u])
     }
 
+    /// Unit pixel directions in the sensor frame and the range per unit of depth of each (row
+    /// by row), for the projective map update.
+    pub(crate) fn pixel_rays(&self) -> (&[Vec3], &[f64]) {
+        (&self.pattern.dirs, &self.pattern.range_per_unit)
+    }
+
     /// Depth per pixel (row by row) of a scan this camera took: metres along the optical axis,
     /// 0 where there is no measurement (the RealSense convention for "no data"): rays of kind
     /// [`ReturnKind::NoReturn`] or [`ReturnKind::Invalid`]. Rays beyond the image are ignored.

@@ -11,7 +11,8 @@
 //!   `ChaCha8Rng` passed in: the same seed gives the same scan.
 //! * The online map ([`LocalMap`]): log-odds voxels with OctoMap's sensor model
 //!   ([`LogOddsParams`]), free space cleared along each ray by the 3-D DDA
-//!   ([`VoxelTraversal`], Amanatides & Woo 1987), a rolling window around the vehicle in a ring
+//!   ([`VoxelTraversal`], Amanatides & Woo 1987; a depth frame's by projecting the frustum's
+//!   voxels into its image, [`LocalMap::insert_depth_frame`]), a rolling window in a ring
 //!   buffer, states unknown / free / occupied ([`VoxelState`]), and a truncated signed distance
 //!   field kept exact incrementally: after each scan only the box of the voxels that flipped,
 //!   grown by the truncation distance, is recomputed.
@@ -63,6 +64,7 @@ mod map;
 mod memory;
 mod occupancy;
 mod pose;
+mod projective;
 mod ring;
 mod scan;
 mod sensor;

@@ -4,10 +4,13 @@
 use serde::{Deserialize, Serialize};
 use trust_geometry::{Aabb, Esdf, StaticMap, Vec3};
 
+use crate::camera::DepthCamera;
 use crate::distance::{DistanceField, KeyBox};
 use crate::error::{SensingError, check_count, check_range};
 use crate::occupancy::{LogOddsParams, VoxelState};
-use crate::ring::{Ring, walk};
+use crate::pose::Pose;
+use crate::projective::DepthFrame;
+use crate::ring::{Indexer, Ring, walk};
 use crate::scan::{ReturnKind, Scan};
 use crate::traversal::{VoxelKey, VoxelTraversal, voxel_key};
 
@@ -129,8 +132,8 @@ pub struct ScanUpdate {
 ///   Tordesillas et al., IEEE T-RO 2022). Everything outside the window is unknown.
 ///
 /// The usual cycle: [`LocalMap::recentre`] on the vehicle, [`LocalMap::insert_scan`] per frame
-/// (or [`LocalMap::integrate_scan`] then [`LocalMap::update_distance`]), then queries or
-/// [`LocalMap::to_static_map`].
+/// (or [`LocalMap::integrate_scan`] then [`LocalMap::update_distance`]; for a depth camera's
+/// frame [`LocalMap::insert_depth_frame`]), then queries or [`LocalMap::to_static_map`].
 #[derive(Debug, Clone)]
 pub struct LocalMap {
     params: LocalMapParams,
@@ -362,29 +365,12 @@ impl LocalMap {
                 )?;
             }
         }
-        if self.frame > u8::MAX - 3 {
-            self.marks.fill(0);
-            self.frame = 2;
-        }
-        self.frame += 2;
-        let (miss, hit) = (self.frame, self.frame + 1);
-        self.touched.clear();
+        let (miss, hit) = self.next_frame();
         let o = scan.origin;
         let res = self.ring.res;
         let ix = self.ring.indexer();
         // Hits first, so that a voxel some ray ends in is a hit whatever the order of the rays.
-        for ray in &scan.rays {
-            if ray.kind != ReturnKind::Hit {
-                continue;
-            }
-            let k = voxel_key(&(o + ray.direction * ray.range), res);
-            if let Some(slot) = ix.slot_in(&k)
-                && self.marks[slot] != hit
-            {
-                self.marks[slot] = hit;
-                self.touched.push(slot as u32);
-            }
-        }
+        self.mark_hits(scan, hit, &ix);
         let window = self.ring.world_box();
         // A ray from inside the window starts at the origin itself (`clip_segment` returns its
         // start as it is): the origin's voxel, computed once. (Its end is clipped even when
@@ -439,37 +425,204 @@ impl LocalMap {
         }
         let lo = self.params.log_odds;
         let mut flip_count = 0;
-        for &slot in &self.touched {
-            let slot = slot as usize;
-            let v = &mut self.voxels[slot];
-            let prior = if v.known { f64::from(v.log_odds) } else { 0.0 };
-            let value = lo.update(prior, self.marks[slot] == hit);
-            v.log_odds = value as f32;
-            v.known = true;
-            let now = lo.is_occupied(f64::from(v.log_odds));
-            if now != self.occupied[slot] {
-                self.occupied[slot] = now;
-                let row = &mut self.row_occupied[slot / self.ring.dims[0]];
-                if now {
-                    self.occupied_count += 1;
-                    *row += 1;
-                } else {
-                    self.occupied_count -= 1;
-                    *row -= 1;
-                }
-                flip_count += 1;
-                let k = self.ring.key_of_slot(slot);
-                match &mut self.pending {
-                    Some(b) => b.include(&k),
-                    None => self.pending = Some(KeyBox::point(k)),
-                }
-            }
+        for i in 0..self.touched.len() {
+            let slot = self.touched[i] as usize;
+            flip_count += usize::from(self.apply(slot, self.marks[slot] == hit, &lo));
         }
         Ok(ScanUpdate {
             ray_count,
             voxel_count: self.touched.len(),
             flip_count,
         })
+    }
+
+    /// One update of the sensor model to the voxel in `slot` (a hit or a miss); a flip is
+    /// counted into the occupancy counts and the pending box. Returns whether it flipped.
+    #[inline(always)]
+    fn apply(&mut self, slot: usize, hit: bool, lo: &LogOddsParams) -> bool {
+        let v = &mut self.voxels[slot];
+        let prior = if v.known { f64::from(v.log_odds) } else { 0.0 };
+        let value = lo.update(prior, hit);
+        v.log_odds = value as f32;
+        v.known = true;
+        let now = lo.is_occupied(f64::from(v.log_odds));
+        if now == self.occupied[slot] {
+            return false;
+        }
+        self.occupied[slot] = now;
+        let row = &mut self.row_occupied[slot / self.ring.dims[0]];
+        if now {
+            self.occupied_count += 1;
+            *row += 1;
+        } else {
+            self.occupied_count -= 1;
+            *row -= 1;
+        }
+        let k = self.ring.key_of_slot(slot);
+        match &mut self.pending {
+            Some(b) => b.include(&k),
+            None => self.pending = Some(KeyBox::point(k)),
+        }
+        true
+    }
+
+    /// Starts a frame: a new generation stamp; returns the (miss, hit) marks of this frame.
+    fn next_frame(&mut self) -> (u8, u8) {
+        if self.frame > u8::MAX - 3 {
+            self.marks.fill(0);
+            self.frame = 2;
+        }
+        self.frame += 2;
+        self.touched.clear();
+        (self.frame, self.frame + 1)
+    }
+
+    /// Integrates a depth camera's frame and updates the distance field:
+    /// [`LocalMap::integrate_depth_frame`] then [`LocalMap::update_distance`].
+    pub fn insert_depth_frame(
+        &mut self,
+        camera: &DepthCamera,
+        pose: &Pose,
+        scan: &Scan,
+    ) -> Result<ScanUpdate, SensingError> {
+        let u = self.integrate_depth_frame(camera, pose, scan)?;
+        self.update_distance();
+        Ok(u)
+    }
+
+    /// Folds one frame of a pinhole depth camera into the occupancy (not yet into the distance
+    /// field) by projection instead of ray walks (decision 0048): `scan` is the frame `camera`
+    /// took at `pose` ([`DepthCamera`]'s ray order, row by row). Each voxel is updated at most
+    /// once: a hit if some pixel's surface point lies in it (as [`LocalMap::integrate_scan`]),
+    /// else a miss if its centre lies in front of the measurement of the pixel it projects
+    /// into, along the optical axis — by more than half a voxel for a hit, within the maximum
+    /// depth for a no-return if [`LocalMapParams::free_on_no_return`], never for an invalid
+    /// pixel. A centre projecting outside the image whose voxel reaches across the frustum's
+    /// side planes (its support along each plane's normal) is decided by the nearest edge pixel;
+    /// farther out, untouched. The camera's own voxel is a miss if any pixel clears (every ray
+    /// starts there).
+    ///
+    /// Against the ray walk: a voxel is decided by one pixel, so no voxel in front of a surface
+    /// within range is skipped however far (the walk's rays spread wider than a voxel beyond
+    /// 8.4 m for the default 160 × 120 frame and 0.1 m voxels and miss voxels between them);
+    /// where half a pixel's footprint diagonal is under half a voxel (6.6 m for the defaults),
+    /// a miss whose centre projects into the image is also one of the walk's (its pixel's ray
+    /// crosses the voxel before its end). The walk clears more where a voxel straddles a pixel
+    /// border and another pixel's ray crosses it towards a farther surface, in the layer within
+    /// half a voxel in front of a surface, and at the image's edges. Property-tested.
+    ///
+    /// Errors (and changes nothing) on a non-finite or out-of-scale origin or pose, a scan
+    /// whose origin is not the pose's position, whose ray count is not the camera's pixel count,
+    /// or whose rays are not the camera's pixel rays at `pose` (within `1e-6`) with ranges
+    /// finite in `[0, 1e4]` m.
+    pub fn integrate_depth_frame(
+        &mut self,
+        camera: &DepthCamera,
+        pose: &Pose,
+        scan: &Scan,
+    ) -> Result<ScanUpdate, SensingError> {
+        check_point("scan.origin", &scan.origin)?;
+        let res = self.ring.res;
+        let frame = DepthFrame::new(camera, pose, scan, res, self.params.free_on_no_return)?;
+        let (miss, hit) = self.next_frame();
+        let o = scan.origin;
+        let ix = self.ring.indexer();
+        self.mark_hits(scan, hit, &ix);
+        let lo = self.params.log_odds;
+        let mut flip_count = 0;
+        for i in 0..self.touched.len() {
+            let slot = self.touched[i] as usize;
+            flip_count += usize::from(self.apply(slot, true, &lo));
+        }
+        let mut voxel_count = self.touched.len();
+        // Every ray starts in the camera's voxel.
+        if frame.ray_count > 0
+            && let Some(slot) = ix.slot_in(&voxel_key(&o, res))
+            && self.marks[slot] < miss
+        {
+            self.marks[slot] = miss;
+            flip_count += usize::from(self.apply(slot, false, &lo));
+            voxel_count += 1;
+        }
+        if frame.far > 0.0 {
+            let (wlo, whi) = (self.ring.low, self.ring.high());
+            let slack = frame.span_slack(res);
+            let (blo, bhi) = frame.frustum_box();
+            // Keys whose voxel may hold a frustum point, a voxel wider on each side.
+            let span = |i: usize| {
+                let a = ((blo[i] - slack) / res).floor().max(wlo[i] as f64 - 1.0) as i64 - 1;
+                let b = ((bhi[i] + slack) / res).floor().min(whi[i] as f64 + 1.0) as i64 + 1;
+                (a.max(wlo[i]), b.min(whi[i]))
+            };
+            let ((ylo, yhi), (zlo, zhi)) = (span(1), span(2));
+            let d = self.ring.dims;
+            let a = [frame.rt[0][0], frame.rt[1][0], frame.rt[2][0]];
+            // `update(floor, miss) = clamp_min` (the miss is negative): the same `f32`.
+            let floor = lo.clamp_min as f32;
+            for kz in zlo..=zhi {
+                let dz = (kz as f64 + 0.5) * res - o.z;
+                let sz = ix.axis_slot(2, kz);
+                for ky in ylo..=yhi {
+                    let dy = (ky as f64 + 0.5) * res - o.y;
+                    let (x0, x1) = frame.row_span(dy, dz, slack);
+                    if x0.is_nan() || x1.is_nan() || x0 > x1 {
+                        continue;
+                    }
+                    // Centres `(k + 0.5) res − o.x` within `[x0, x1]`, a voxel wider.
+                    let klo = ((x0 + o.x) / res - 0.5).max(wlo[0] as f64 - 2.0).floor() as i64;
+                    let khi = ((x1 + o.x) / res - 0.5).min(whi[0] as f64 + 2.0).ceil() as i64;
+                    let (klo, khi) = ((klo - 1).max(wlo[0]), (khi + 1).min(whi[0]));
+                    if klo > khi {
+                        continue;
+                    }
+                    let q = frame.row_part(dy, dz);
+                    let row = d[0] * (ix.axis_slot(1, ky) + d[1] * sz);
+                    let mut sx = ix.axis_slot(0, klo);
+                    for kx in klo..=khi {
+                        let dx = (kx as f64 + 0.5) * res - o.x;
+                        let p = [a[0] * dx + q[0], a[1] * dx + q[1], a[2] * dx + q[2]];
+                        if frame.miss_at(&p) {
+                            let slot = row + sx;
+                            if self.marks[slot] < miss {
+                                voxel_count += 1;
+                                // A miss leaves a voxel at the lower clamp as it is.
+                                let v = self.voxels[slot];
+                                if !(v.known && v.log_odds == floor) {
+                                    flip_count += usize::from(self.apply(slot, false, &lo));
+                                }
+                            }
+                        }
+                        sx += 1;
+                        if sx == d[0] {
+                            sx = 0;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(ScanUpdate {
+            ray_count: frame.ray_count,
+            voxel_count,
+            flip_count,
+        })
+    }
+
+    /// Marks the window's voxels some hit of `scan` ends in with `hit`, into `touched` (once
+    /// each).
+    fn mark_hits(&mut self, scan: &Scan, hit: u8, ix: &Indexer) {
+        let (o, res) = (scan.origin, self.ring.res);
+        for ray in &scan.rays {
+            if ray.kind != ReturnKind::Hit {
+                continue;
+            }
+            let k = voxel_key(&(o + ray.direction * ray.range), res);
+            if let Some(slot) = ix.slot_in(&k)
+                && self.marks[slot] != hit
+            {
+                self.marks[slot] = hit;
+                self.touched.push(slot as u32);
+            }
+        }
     }
 
     /// Marks the unknown voxels whose centre lies within `radius` of `center` as known free
@@ -954,6 +1107,285 @@ mod tests {
         }
     }
 
+    use crate::camera::DepthCameraParams;
+    use crate::sensor::RaySensor;
+    use rand::{Rng, SeedableRng};
+    use std::collections::{BTreeSet, HashMap};
+
+    /// A random depth frame of a small camera: each pixel's ray as the camera would cast it at
+    /// `pose`, its kind and depth drawn from `seed` (hits at any depth in range, no-returns,
+    /// invalid pixels: surfaces with every edge a depth jump).
+    fn random_frame(camera: &DepthCamera, pose: &Pose, seed: u64) -> Scan {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let p = camera.params();
+        let rot = pose.attitude.to_rotation_matrix();
+        let (dirs, per_unit) = camera.pixel_rays();
+        let rays = dirs
+            .iter()
+            .zip(per_unit)
+            .map(|(d, &n)| {
+                let (range, kind) = match rng.random_range(0..8) {
+                    0..6 => (
+                        rng.random_range(p.min_depth_m..p.max_depth_m) * n,
+                        ReturnKind::Hit,
+                    ),
+                    6 => (p.max_depth_m * n, ReturnKind::NoReturn),
+                    _ => (0.0, ReturnKind::Invalid),
+                };
+                RayMeasurement {
+                    direction: rot * d,
+                    range,
+                    kind,
+                }
+            })
+            .collect();
+        Scan {
+            origin: pose.position,
+            rays,
+        }
+    }
+
+    fn camera_strategy() -> impl Strategy<Value = DepthCamera> {
+        (
+            4usize..24,
+            3usize..18,
+            0.4f64..2.0,
+            0.3f64..1.6,
+            1.0f64..3.5,
+        )
+            .prop_map(|(width, height, hfov_rad, vfov_rad, max_depth_m)| {
+                DepthCamera::new(DepthCameraParams {
+                    width,
+                    height,
+                    hfov_rad,
+                    vfov_rad,
+                    min_depth_m: 0.1,
+                    max_depth_m,
+                    rate_hz: 30.0,
+                    noise_k_per_m: 0.0,
+                })
+                .unwrap()
+            })
+    }
+
+    fn pose_strategy() -> impl Strategy<Value = Pose> {
+        (
+            (-0.5f64..0.5, -0.5f64..0.5, -0.3f64..0.3),
+            (-0.6f64..0.6, -0.6f64..0.6, -3.2f64..3.2),
+        )
+            .prop_map(|(p, (roll, pitch, yaw))| {
+                Pose::new(
+                    Vec3::new(p.0, p.1, p.2),
+                    nalgebra::UnitQuaternion::from_euler_angles(roll, pitch, yaw),
+                )
+            })
+    }
+
+    /// The voxels of `scan`'s hit points inside the window.
+    fn hit_keys(map: &LocalMap, scan: &Scan) -> BTreeSet<VoxelKey> {
+        scan.points()
+            .map(|p| voxel_key(&p, map.ring.res))
+            .filter(|k| map.ring.contains(k))
+            .collect()
+    }
+
+    /// Every window voxel, x fastest.
+    fn window_keys(map: &LocalMap) -> Vec<VoxelKey> {
+        let (lo, hi) = (map.ring.low, map.ring.high());
+        let mut out = Vec::new();
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    out.push([x, y, z]);
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_depth_frame_must_be_the_cameras() {
+        let camera = DepthCamera::new(DepthCameraParams {
+            width: 8,
+            height: 6,
+            ..DepthCameraParams::default()
+        })
+        .unwrap();
+        let pose = Pose::level(Vec3::new(0.1, 0.2, 0.0), 0.3);
+        let scan = random_frame(&camera, &pose, 3);
+        let fresh = LocalMap::new(LocalMapParams::default(), &Vec3::zeros()).unwrap();
+        let check = |scan: &Scan, pose: &Pose, field: &str| {
+            let mut map = fresh.clone();
+            let err = map.integrate_depth_frame(&camera, pose, scan).unwrap_err();
+            let text = err.to_string();
+            assert!(text.contains(field), "{text}");
+            assert_eq!(map.occupied_count(), 0);
+            assert!(
+                map.voxels.iter().all(|v| !v.known),
+                "changed by a bad frame"
+            );
+        };
+        let mut short = scan.clone();
+        short.rays.pop();
+        check(&short, &pose, "scan.rays");
+        let mut moved = scan.clone();
+        moved.origin.x += 0.01;
+        check(&moved, &pose, "scan.origin");
+        let mut turned = scan.clone();
+        turned.rays[9].direction = Vec3::x();
+        check(&turned, &pose, "scan.rays[9].direction");
+        let mut nan = scan.clone();
+        nan.rays[4].range = f64::NAN;
+        check(&nan, &pose, "scan.rays[4].range");
+        nan.rays[4].range = 2e4;
+        check(&nan, &pose, "scan.rays[4].range");
+        let bad_pose = Pose::new(
+            pose.position,
+            nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(2.0, 0.0, 0.0, 0.0)),
+        );
+        check(&scan, &bad_pose, "pose.attitude");
+        let mut far = scan.clone();
+        far.origin = Vec3::new(f64::NAN, 0.0, 0.0);
+        check(&far, &pose, "scan.origin");
+        // The camera's own frame passes.
+        let mut map = fresh.clone();
+        let u = map.integrate_depth_frame(&camera, &pose, &scan).unwrap();
+        assert!(u.voxel_count > 0);
+    }
+
+    /// A fronto-parallel wall 9.5 m ahead of the default 160 × 120 camera: between 8.4 and
+    /// 9 m its pixels' rays spread wider than a voxel and the walk misses voxels between them;
+    /// the projective update clears every voxel of that slab in the image.
+    #[test]
+    fn the_projective_update_has_no_holes_where_the_rays_spread() {
+        let camera = DepthCamera::new(DepthCameraParams {
+            noise_k_per_m: 0.0,
+            ..DepthCameraParams::default()
+        })
+        .unwrap();
+        let pose = Pose::at(Vec3::new(0.05, 0.05, 0.05));
+        let (dirs, per_unit) = camera.pixel_rays();
+        let scan = Scan {
+            origin: pose.position,
+            rays: dirs
+                .iter()
+                .zip(per_unit)
+                .map(|(d, &n)| RayMeasurement {
+                    direction: *d,
+                    range: 9.5 * n,
+                    kind: ReturnKind::Hit,
+                })
+                .collect(),
+        };
+        let params = LocalMapParams {
+            dims: [112, 80, 24],
+            ..LocalMapParams::default()
+        };
+        let fresh = LocalMap::new(params, &Vec3::new(5.0, 0.0, 0.0)).unwrap();
+        let mut walked = fresh.clone();
+        walked.integrate_scan(&scan).unwrap();
+        let mut projected = fresh;
+        projected
+            .integrate_depth_frame(&camera, &pose, &scan)
+            .unwrap();
+        let slab: Vec<Vec3> = window_keys(&walked)
+            .iter()
+            .map(|k| walked.ring.center(k))
+            .filter(|c| (8.45..9.0).contains(&c.x) && c.y.abs() < 3.0 && c.z.abs() < 1.0)
+            .collect();
+        assert!(slab.len() > 1000);
+        let unknown = |m: &LocalMap| {
+            slab.iter()
+                .filter(|c| m.state(c) == VoxelState::Unknown)
+                .count()
+        };
+        assert!(unknown(&walked) > 0, "the walk left no hole");
+        assert_eq!(unknown(&projected), 0);
+        // The wall itself: the same hits.
+        for k in window_keys(&walked) {
+            let occupied = walked.occupied[walked.ring.slot(&k)];
+            assert_eq!(
+                occupied,
+                projected.occupied[projected.ring.slot(&k)],
+                "{k:?}"
+            );
+        }
+    }
+
+    /// The D435 defaults through the simulated camera against a wall and two posts: the
+    /// projective update agrees with the walk on every voxel within 6.6 m that the walk
+    /// decides, up to pixel borders and the half-voxel layer.
+    #[test]
+    fn the_projective_update_matches_the_walk_on_a_simulated_frame() {
+        let bounds =
+            trust_geometry::Aabb::new(Vec3::new(-1.0, -6.0, -3.0), Vec3::new(12.0, 6.0, 3.0))
+                .unwrap();
+        let shapes: Vec<trust_geometry::Shape> = vec![
+            trust_geometry::AaBox::new(Vec3::new(4.0, -6.0, -3.0), Vec3::new(4.3, 6.0, 3.0))
+                .unwrap()
+                .into(),
+            trust_geometry::Cylinder::new(Vec3::new(2.0, 0.5, 0.0), 0.2, 3.0)
+                .unwrap()
+                .into(),
+            trust_geometry::Cylinder::new(Vec3::new(3.0, -0.8, 0.0), 0.3, 3.0)
+                .unwrap()
+                .into(),
+        ];
+        let world = trust_geometry::StaticMap::from_shapes(bounds, shapes).unwrap();
+        let camera = DepthCamera::new(DepthCameraParams::default()).unwrap();
+        let pose = Pose::level(Vec3::new(0.0, 0.0, 0.2), 0.2);
+        let mut scan = Scan::default();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        camera
+            .scan(
+                &pose,
+                &crate::Truth::static_only(&world),
+                &mut rng,
+                &mut scan,
+            )
+            .unwrap();
+        let fresh = LocalMap::new(LocalMapParams::default(), &pose.position).unwrap();
+        let mut walked = fresh.clone();
+        walked.integrate_scan(&scan).unwrap();
+        let mut projected = fresh;
+        projected
+            .integrate_depth_frame(&camera, &pose, &scan)
+            .unwrap();
+        let (mut same, mut only_walk, mut only_proj, mut edge) = (0, 0, 0, 0);
+        let p = camera.params();
+        let (tx, ty) = ((0.5 * p.hfov_rad).tan(), (0.5 * p.vfov_rad).tan());
+        for k in window_keys(&walked) {
+            let (a, b) = (walked.state_of_key(&k), projected.state_of_key(&k));
+            if a == VoxelState::Occupied || b == VoxelState::Occupied {
+                assert_eq!(a, b, "{k:?}: the hits are the walk's");
+                continue;
+            }
+            match (a == VoxelState::Free, b == VoxelState::Free) {
+                (true, true) => same += 1,
+                (true, false) => only_walk += 1,
+                (false, true) => {
+                    // Outside the image: an edge pixel's margin (counted apart).
+                    let q = pose.attitude.inverse() * (walked.ring.center(&k) - pose.position);
+                    let (a, b) = (q.y / q.x / tx, q.z / q.x / ty);
+                    if q.x > 0.0 && a.abs() < 1.0 && b.abs() < 1.0 {
+                        only_proj += 1;
+                    } else {
+                        edge += 1;
+                    }
+                }
+                _ => {}
+            }
+        }
+        // Within 6.6 m of the defaults every projective miss whose centre projects into the
+        // image is a walk miss; the walk's extra misses are a thin fringe, and so are the
+        // projective ones at the image's edges (voxels reaching across a side plane that no
+        // edge ray crossed). When written: 43 281 shared, 1425 walk only, 812 at the edges.
+        assert!(same > 10_000, "{same}");
+        assert_eq!(only_proj, 0, "{only_proj} misses the walk does not make");
+        assert!(only_walk * 10 < same, "{only_walk} vs {same}");
+        assert!(edge * 10 < same, "{edge} vs {same}");
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
@@ -1010,6 +1442,166 @@ mod tests {
                     .collect();
                 prop_assert_eq!(&map.row_occupied, &rows);
                 prop_assert_eq!(map.distance_slots(), &map.recompute_distance_from_scratch()[..]);
+            }
+        }
+
+        /// The projective update equals a straightforward one voxel for voxel (every window
+        /// voxel asked the rule), for three frames in a row into a window that moves.
+        #[test]
+        fn integrate_depth_frame_equals_the_reference(
+            camera in camera_strategy(),
+            poses in prop::collection::vec(pose_strategy(), 3),
+            seed in any::<u64>(),
+            shift in (-0.4f64..0.4, -0.4f64..0.4, -0.2f64..0.2),
+            free_on_no_return in any::<bool>(),
+            res in prop_oneof![Just(0.1f64), Just(0.2)],
+        ) {
+            let params = LocalMapParams {
+                dims: [24, 20, 12],
+                resolution_m: res,
+                max_distance_m: 2.0 * res,
+                free_on_no_return,
+                ..LocalMapParams::default()
+            };
+            let mut map = LocalMap::new(params, &Vec3::zeros()).unwrap();
+            for (i, pose) in poses.iter().enumerate() {
+                if i == 1 {
+                    map.recentre(&Vec3::new(shift.0, shift.1, shift.2)).unwrap();
+                }
+                let scan = random_frame(&camera, pose, seed.wrapping_add(i as u64));
+                let frame = DepthFrame::new(&camera, pose, &scan, res, free_on_no_return).unwrap();
+                let hits = hit_keys(&map, &scan);
+                let ko = voxel_key(&scan.origin, res);
+                let lo = map.params.log_odds;
+                let before = map.clone();
+                let u = map.insert_depth_frame(&camera, pose, &scan).unwrap();
+                let mut updated = 0;
+                for k in window_keys(&map) {
+                    let s = map.ring.slot(&k);
+                    let c = map.ring.center(&k);
+                    let decided = if hits.contains(&k) {
+                        Some(true)
+                    } else if (k == ko && frame.ray_count > 0)
+                        || frame.miss_at(&frame.sensor(&(c - scan.origin)))
+                    {
+                        Some(false)
+                    } else {
+                        None
+                    };
+                    let b = before.voxels[s];
+                    let (value, known, occ) = match decided {
+                        Some(hit) => {
+                            updated += 1;
+                            let prior = if b.known { f64::from(b.log_odds) } else { 0.0 };
+                            let v = lo.update(prior, hit) as f32;
+                            (v, true, lo.is_occupied(f64::from(v)))
+                        }
+                        None => (b.log_odds, b.known, before.occupied[s]),
+                    };
+                    prop_assert_eq!(map.voxels[s].log_odds, value, "{:?}", k);
+                    prop_assert_eq!(map.voxels[s].known, known, "{:?}", k);
+                    prop_assert_eq!(map.occupied[s], occ, "{:?}", k);
+                }
+                prop_assert_eq!(u.voxel_count, updated);
+                prop_assert_eq!(
+                    map.occupied_count,
+                    map.occupied.iter().filter(|&&o| o).count()
+                );
+                let rows: Vec<u32> = map
+                    .occupied
+                    .chunks(map.ring.dims[0])
+                    .map(|row| row.iter().filter(|&&o| o).count() as u32)
+                    .collect();
+                prop_assert_eq!(&map.row_occupied, &rows);
+                prop_assert_eq!(map.distance_slots(), &map.recompute_distance_from_scratch()[..]);
+            }
+        }
+
+        /// Against the ray walk on random frames (one fresh map each): no voxel holding a hit
+        /// point is a miss; where a pixel's footprint is under a voxel every projective miss is
+        /// a walk miss; and every walk miss the projective update leaves has its centre outside
+        /// the image or behind the camera, or is crossed only by rays of pixels other than its
+        /// centre's (it straddles a pixel border), or lies within a voxel of its pixel's
+        /// measured depth (`[z − res/2, z + √3 res/2)`).
+        #[test]
+        fn projective_misses_against_the_walk(
+            camera in camera_strategy(),
+            pose in pose_strategy(),
+            seed in any::<u64>(),
+            free_on_no_return in any::<bool>(),
+            res in prop_oneof![Just(0.1f64), Just(0.2)],
+        ) {
+            let params = LocalMapParams {
+                dims: [24, 24, 16],
+                resolution_m: res,
+                max_distance_m: 2.0 * res,
+                free_on_no_return,
+                ..LocalMapParams::default()
+            };
+            let fresh = LocalMap::new(params, &Vec3::zeros()).unwrap();
+            let scan = random_frame(&camera, &pose, seed);
+            let hits = hit_keys(&fresh, &scan);
+            let mut projected = fresh.clone();
+            projected.integrate_depth_frame(&camera, &pose, &scan).unwrap();
+            // The walk's misses, with the pixels whose rays cross each.
+            let window = fresh.ring.world_box();
+            let mut walk: HashMap<VoxelKey, Vec<usize>> = HashMap::new();
+            for (i, ray) in scan.rays.iter().enumerate() {
+                let clears = match ray.kind {
+                    ReturnKind::Hit => true,
+                    ReturnKind::NoReturn => free_on_no_return,
+                    ReturnKind::Invalid => false,
+                };
+                let end = scan.origin + ray.direction * ray.range;
+                let Some((a, b)) = window.clip_segment(&scan.origin, &end) else { continue };
+                if !clears {
+                    continue;
+                }
+                for k in VoxelTraversal::unchecked(&a, &b, res) {
+                    if fresh.ring.contains(&k) && !hits.contains(&k) {
+                        walk.entry(k).or_default().push(i);
+                    }
+                }
+            }
+            let p = camera.params();
+            let (w, h) = (p.width, p.height);
+            let (tx, ty) = ((0.5 * p.hfov_rad).tan(), (0.5 * p.vfov_rad).tan());
+            let near = 0.99 * 0.5 * res / ((tx / w as f64).hypot(ty / h as f64));
+            let (_, per_unit) = camera.pixel_rays();
+            let to_sensor = pose.attitude.inverse();
+            for k in window_keys(&fresh) {
+                let s = fresh.ring.slot(&k);
+                let v = projected.voxels[s];
+                let c = fresh.ring.center(&k);
+                let q = to_sensor * (c - scan.origin);
+                if hits.contains(&k) {
+                    prop_assert!(v.known && v.log_odds > 0.0, "{:?}: a hit", k);
+                    continue;
+                }
+                let proj_miss = v.known;
+                let uf = 0.5 * w as f64 * (1.0 - q.y / q.x / tx);
+                let vf = 0.5 * h as f64 * (1.0 - q.z / q.x / ty);
+                let inside = q.x > 0.0
+                    && (0.0..w as f64).contains(&uf)
+                    && (0.0..h as f64).contains(&vf);
+                if proj_miss && inside && q.x < near {
+                    prop_assert!(walk.contains_key(&k), "{:?} at depth {}: not the walk's", k, q.x);
+                }
+                let Some(rays) = walk.get(&k) else { continue };
+                if proj_miss || !inside {
+                    continue;
+                }
+                let i = vf as usize * w + uf as usize;
+                if !rays.contains(&i) {
+                    continue;
+                }
+                let ray = scan.rays[i];
+                let z = ray.range / per_unit[i];
+                let margin = if ray.kind == ReturnKind::Hit { 0.5 * res } else { 0.0 };
+                prop_assert!(
+                    q.x >= z - margin - 1e-9 && q.x < z + 0.5 * 3f64.sqrt() * res + 1e-9,
+                    "{:?}: depth {} against its pixel's {} ({:?})", k, q.x, z, ray.kind
+                );
             }
         }
     }
