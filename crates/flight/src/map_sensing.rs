@@ -18,14 +18,13 @@
 //!   the sensor's blind reach for it, `StaticSensor::blind_reach_m`: the first stretch of any
 //!   path has parts the sensor cannot see from the start, e.g. below and above the camera's 58°
 //!   vertical field within 0.54 m; FASTER's initial condition, the vehicle starts in known
-//!   free space), and at every scan the ball the vehicle's body fills, grown to the voxels the
-//!   commit check asks about for the vehicle's own place (`LocalMap::known_free_reach_m`: the
-//!   check's voxel ball of the vehicle's radius reaches voxel centres 0.52 m away for r =
-//!   0.3 m). Without it the camera's minimum depth (0.3 m) and vertical field leave the voxels
-//!   round a hovering vehicle unobserved, and a plan that sets off sideways, up or down is
-//!   never committed; with only the body and a voxel diagonal (0.47 m), a vehicle that stopped
-//!   beside a wall could not even commit to its own place (the U-trap and the long trip
-//!   stalled there, decision 0047).
+//!   free space), and at every scan the voxels that lie wholly inside the vehicle's body
+//!   (centres within `r` minus half a voxel diagonal): nothing else is certain. A ball as wide
+//!   as the voxels the commit check asks about for the vehicle's own place (0.52 m for
+//!   r = 0.3 m, decisions 0047–0049) let a vehicle hovering above a slab its camera never saw
+//!   creep down onto it: each scan marked the slab's top voxels free, 0.3 m below the centre,
+//!   and the next plan sank into them (decision 0050). The price: a vehicle beside surfaces
+//!   its camera has not seen (above, below, behind) cannot commit to leave, and holds.
 //! * **Heading.** A forward-looking camera must look where the vehicle goes: the commanded yaw
 //!   turns toward the direction of the best branch (main, else the best-ranked kept one) one
 //!   second ahead, else toward the goal, at most [`YAW_RATE_RAD_S`]. A known map keeps yaw 0.
@@ -101,8 +100,12 @@ pub struct OnlineMap {
     planner_map: Arc<StaticMap>,
     dirty: bool,
     clearance_m: f64,
-    /// The radius of the ball round the vehicle that counts as free at each scan (m).
+    /// The radius of the ball round the vehicle that counts as free at each scan (m): voxel
+    /// centres within it have their whole box inside the body.
     body_m: f64,
+    /// How far from the vehicle the commit check's voxels reach (m,
+    /// `LocalMap::known_free_reach_m`): the route keeps this much round it open.
+    reach_m: f64,
     map_ms: f64,
 }
 
@@ -111,7 +114,7 @@ impl OnlineMap {
     /// (the world's), for a vehicle of radius `radius_m` whose sensor cannot see within
     /// `blind_reach_m` of it (`StaticSensor::blind_reach_m`): the ball round `start` of radius
     /// `radius_m + blind_reach_m + voxel diagonal` starts known free, and after each scan the
-    /// ball of `LocalMap::known_free_reach_m(radius_m)` round the vehicle (module docs).
+    /// voxels wholly inside the vehicle's body (module docs).
     ///
     /// # Errors
     /// `SensingError` for invalid map parameters, a `start` out of scale or a map that cannot
@@ -127,7 +130,8 @@ impl OnlineMap {
         let diagonal = 3f64.sqrt() * params.resolution_m;
         map.assume_free(start, radius_m + blind_reach_m + diagonal);
         let planner_map = Arc::new(map.to_static_map(bounds)?);
-        let body_m = map.known_free_reach_m(radius_m).max(radius_m + diagonal);
+        let body_m = (radius_m - 0.5 * diagonal).max(0.0);
+        let reach_m = map.known_free_reach_m(radius_m).max(radius_m + diagonal);
         Ok(OnlineMap {
             map: Arc::new(map),
             memory: None,
@@ -138,6 +142,7 @@ impl OnlineMap {
             dirty: false,
             clearance_m: radius_m,
             body_m,
+            reach_m,
             map_ms: 0.0,
         })
     }
@@ -227,7 +232,7 @@ impl OnlineMap {
             route: self.memory.as_ref().map(|memory| RouteView {
                 memory: Arc::clone(memory),
                 near: Arc::clone(&self.planner_map),
-                keep_m: self.body_m + self.clearance_m + ROUTE_KEEP_M,
+                keep_m: self.reach_m + self.clearance_m + ROUTE_KEEP_M,
                 reach_m: ROUTE_BLOCKED_REACH * self.range_m,
             }),
         })

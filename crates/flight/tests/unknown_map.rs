@@ -124,3 +124,34 @@ struct Wrap {
     #[serde(rename = "static")]
     s: trust_world::map_sensing::StaticSensing,
 }
+
+/// Decision 0050: after each scan only the voxels wholly inside the vehicle's body count as
+/// free without a measurement. A ball as large as the commit check's reach (0.52 m for r =
+/// 0.3 m) let a vehicle hovering 0.3 m above a slab its camera never saw creep down onto it.
+#[test]
+fn a_scan_assumes_free_only_what_the_body_fills() {
+    use trust_core::{Aabb, Vec3};
+    use trust_flight::map_sensing::OnlineMap;
+    let bounds = Aabb::new(Vec3::zeros(), Vec3::new(20.0, 20.0, 10.0)).unwrap();
+    let params = trust_sensing::LocalMapParams::default();
+    let (start, vehicle) = (Vec3::new(10.0, 10.0, 5.0), Vec3::new(4.0, 4.0, 3.0));
+    let mut online = OnlineMap::new(params, &start, bounds, 0.3, 0.54).unwrap();
+    online
+        .insert(&trust_sensing::Scan::default(), &vehicle)
+        .unwrap();
+    let map = online.map();
+    for (d, free) in [
+        (Vec3::zeros(), true),
+        (Vec3::new(0.1, 0.0, 0.0), true),
+        (Vec3::new(0.0, 0.0, -0.3), false),
+        (Vec3::new(0.0, 0.0, 0.3), false),
+        (Vec3::new(0.3, 0.0, 0.0), false),
+        (Vec3::new(0.0, -0.35, 0.0), false),
+    ] {
+        assert_eq!(
+            map.is_known_free(&(vehicle + d)),
+            free,
+            "{d:?} from the centre"
+        );
+    }
+}
