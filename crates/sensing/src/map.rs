@@ -1386,6 +1386,26 @@ mod tests {
         assert!(edge * 10 < same, "{edge} vs {same}");
     }
 
+    /// The map's bookkeeping after an update: the occupied count and the per-row counts agree
+    /// with the occupancy, and the distance field with one computed from scratch.
+    fn check_counts_and_field(map: &LocalMap) -> Result<(), proptest::test_runner::TestCaseError> {
+        prop_assert_eq!(
+            map.occupied_count,
+            map.occupied.iter().filter(|&&o| o).count()
+        );
+        let rows: Vec<u32> = map
+            .occupied
+            .chunks(map.ring.dims[0])
+            .map(|row| row.iter().filter(|&&o| o).count() as u32)
+            .collect();
+        prop_assert_eq!(&map.row_occupied, &rows);
+        prop_assert_eq!(
+            map.distance_slots(),
+            &map.recompute_distance_from_scratch()[..]
+        );
+        Ok(())
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
@@ -1431,17 +1451,7 @@ mod tests {
                         }
                     }
                 }
-                prop_assert_eq!(
-                    map.occupied_count,
-                    map.occupied.iter().filter(|&&o| o).count()
-                );
-                let rows: Vec<u32> = map
-                    .occupied
-                    .chunks(map.ring.dims[0])
-                    .map(|row| row.iter().filter(|&&o| o).count() as u32)
-                    .collect();
-                prop_assert_eq!(&map.row_occupied, &rows);
-                prop_assert_eq!(map.distance_slots(), &map.recompute_distance_from_scratch()[..]);
+                check_counts_and_field(&map)?;
             }
         }
 
@@ -1503,17 +1513,7 @@ mod tests {
                     prop_assert_eq!(map.occupied[s], occ, "{:?}", k);
                 }
                 prop_assert_eq!(u.voxel_count, updated);
-                prop_assert_eq!(
-                    map.occupied_count,
-                    map.occupied.iter().filter(|&&o| o).count()
-                );
-                let rows: Vec<u32> = map
-                    .occupied
-                    .chunks(map.ring.dims[0])
-                    .map(|row| row.iter().filter(|&&o| o).count() as u32)
-                    .collect();
-                prop_assert_eq!(&map.row_occupied, &rows);
-                prop_assert_eq!(map.distance_slots(), &map.recompute_distance_from_scratch()[..]);
+                check_counts_and_field(&map)?;
             }
         }
 
