@@ -1282,12 +1282,7 @@ mod tests {
             ..LocalMapParams::default()
         };
         let fresh = LocalMap::new(params, &Vec3::new(5.0, 0.0, 0.0)).unwrap();
-        let mut walked = fresh.clone();
-        walked.integrate_scan(&scan).unwrap();
-        let mut projected = fresh;
-        projected
-            .integrate_depth_frame(&camera, &pose, &scan)
-            .unwrap();
+        let (walked, projected) = walked_and_projected(fresh, &camera, &pose, &scan);
         let slab: Vec<Vec3> = window_keys(&walked)
             .iter()
             .map(|k| walked.ring.center(k))
@@ -1345,12 +1340,7 @@ mod tests {
             )
             .unwrap();
         let fresh = LocalMap::new(LocalMapParams::default(), &pose.position).unwrap();
-        let mut walked = fresh.clone();
-        walked.integrate_scan(&scan).unwrap();
-        let mut projected = fresh;
-        projected
-            .integrate_depth_frame(&camera, &pose, &scan)
-            .unwrap();
+        let (walked, projected) = walked_and_projected(fresh, &camera, &pose, &scan);
         let (mut same, mut only_walk, mut only_proj, mut edge) = (0, 0, 0, 0);
         let p = camera.params();
         let (tx, ty) = ((0.5 * p.hfov_rad).tan(), (0.5 * p.vfov_rad).tan());
@@ -1384,6 +1374,31 @@ mod tests {
         assert_eq!(only_proj, 0, "{only_proj} misses the walk does not make");
         assert!(only_walk * 10 < same, "{only_walk} vs {same}");
         assert!(edge * 10 < same, "{edge} vs {same}");
+    }
+
+    /// `scan` into two copies of `fresh`: by the ray walk and by projection.
+    fn walked_and_projected(
+        fresh: LocalMap,
+        camera: &DepthCamera,
+        pose: &Pose,
+        scan: &Scan,
+    ) -> (LocalMap, LocalMap) {
+        let mut walked = fresh.clone();
+        walked.integrate_scan(scan).unwrap();
+        let mut projected = fresh;
+        projected.integrate_depth_frame(camera, pose, scan).unwrap();
+        (walked, projected)
+    }
+
+    /// A small window of `res` voxels for the projective update's properties.
+    fn projective_params(dims: [usize; 3], res: f64, free_on_no_return: bool) -> LocalMapParams {
+        LocalMapParams {
+            dims,
+            resolution_m: res,
+            max_distance_m: 2.0 * res,
+            free_on_no_return,
+            ..LocalMapParams::default()
+        }
     }
 
     /// The map's bookkeeping after an update: the occupied count and the per-row counts agree
@@ -1466,13 +1481,7 @@ mod tests {
             free_on_no_return in any::<bool>(),
             res in prop_oneof![Just(0.1f64), Just(0.2)],
         ) {
-            let params = LocalMapParams {
-                dims: [24, 20, 12],
-                resolution_m: res,
-                max_distance_m: 2.0 * res,
-                free_on_no_return,
-                ..LocalMapParams::default()
-            };
+            let params = projective_params([24, 20, 12], res, free_on_no_return);
             let mut map = LocalMap::new(params, &Vec3::zeros()).unwrap();
             for (i, pose) in poses.iter().enumerate() {
                 if i == 1 {
@@ -1531,13 +1540,7 @@ mod tests {
             free_on_no_return in any::<bool>(),
             res in prop_oneof![Just(0.1f64), Just(0.2)],
         ) {
-            let params = LocalMapParams {
-                dims: [24, 24, 16],
-                resolution_m: res,
-                max_distance_m: 2.0 * res,
-                free_on_no_return,
-                ..LocalMapParams::default()
-            };
+            let params = projective_params([24, 24, 16], res, free_on_no_return);
             let fresh = LocalMap::new(params, &Vec3::zeros()).unwrap();
             let scan = random_frame(&camera, &pose, seed);
             let hits = hit_keys(&fresh, &scan);
