@@ -47,8 +47,8 @@ use trust_core::{StaticMap, Vec3};
 use trust_manager::CommitCheck;
 use trust_planner::AnyManager;
 use trust_sensing::{
-    DEFAULT_MEMORY_CELL_M, DepthCamera, Lidar, LocalMap, MapMemory, Pose, RaySensor, Scan, Truth,
-    Unseen,
+    BodyBall, DEFAULT_MEMORY_CELL_M, DepthCamera, Lidar, LocalMap, MapMemory, Pose, RaySensor,
+    Scan, Truth, Unseen,
 };
 use trust_vehicle::VehicleState;
 use trust_world::World;
@@ -106,6 +106,8 @@ pub struct OnlineMap {
     /// How far from the vehicle the commit check's voxels reach (m,
     /// `LocalMap::known_free_reach_m`): the route keeps this much round it open.
     reach_m: f64,
+    /// The vehicle's body at the last scan: free whatever the sensor saw (decision 0051).
+    body: BodyBall,
     map_ms: f64,
 }
 
@@ -143,6 +145,10 @@ impl OnlineMap {
             clearance_m: radius_m,
             body_m,
             reach_m,
+            body: BodyBall {
+                center: *start,
+                radius: radius_m,
+            },
             map_ms: 0.0,
         })
     }
@@ -191,6 +197,7 @@ impl OnlineMap {
             None => map.insert_scan(scan)?,
         };
         map.assume_free(vehicle, self.body_m);
+        self.body.center = *vehicle;
         if let Some(memory) = self.memory.as_mut() {
             let memory = Arc::make_mut(memory);
             memory.record(scan);
@@ -229,6 +236,7 @@ impl OnlineMap {
         Arc::new(KnownFree {
             map: Arc::clone(&self.map),
             clearance_m: self.clearance_m,
+            body: self.body,
             route: self.memory.as_ref().map(|memory| RouteView {
                 memory: Arc::clone(memory),
                 near: Arc::clone(&self.planner_map),
@@ -421,6 +429,8 @@ impl MapSensing {
 pub struct KnownFree {
     map: Arc<LocalMap>,
     clearance_m: f64,
+    /// The vehicle's body at the map's last scan.
+    body: BodyBall,
     route: Option<RouteView>,
 }
 
@@ -455,7 +465,8 @@ impl CommitCheck for KnownFree {
     }
 
     fn segment_free(&self, a: &Vec3, b: &Vec3) -> bool {
-        self.map.segment_known_free(a, b, self.clearance_m)
+        self.map
+            .segment_known_free_beside(a, b, self.clearance_m, &self.body)
     }
 
     fn route_map(&self, from: &Vec3, goal: &Vec3) -> Option<Arc<StaticMap>> {

@@ -155,3 +155,43 @@ fn a_scan_assumes_free_only_what_the_body_fills() {
         );
     }
 }
+
+/// Decision 0051: the commit check counts the body as free point by point. A vehicle among
+/// unseen voxels may hold its place, and may not leave it: its tube pokes out of the body into
+/// voxels nobody has observed. Seen free space ahead lets it go.
+#[test]
+fn the_commit_check_lets_a_vehicle_hold_its_place_and_not_creep() {
+    use trust_core::{Aabb, Vec3};
+    use trust_flight::map_sensing::OnlineMap;
+    let bounds = Aabb::new(Vec3::zeros(), Vec3::new(20.0, 20.0, 10.0)).unwrap();
+    let params = trust_sensing::LocalMapParams::default();
+    let (start, vehicle) = (Vec3::new(10.0, 10.0, 5.0), Vec3::new(4.03, 4.02, 3.01));
+    let mut online = OnlineMap::new(params, &start, bounds, 0.3, 0.54).unwrap();
+    online
+        .insert(&trust_sensing::Scan::default(), &vehicle)
+        .unwrap();
+    let check = online.commit_check();
+    assert!(check.segment_free(&vehicle, &vehicle), "holding its place");
+    let drift = vehicle + Vec3::new(0.002, -0.001, 0.001);
+    assert!(check.segment_free(&drift, &drift), "its tracking error");
+    for step in [
+        Vec3::new(0.0, 0.0, -0.02),
+        Vec3::new(0.05, 0.0, 0.0),
+        Vec3::new(0.0, 0.3, 0.0),
+    ] {
+        assert!(
+            !check.segment_free(&vehicle, &(vehicle + step)),
+            "{step:?} into unseen space"
+        );
+    }
+    // The take-off ball is observed free space: from the start, the vehicle may move in it.
+    let check = {
+        let mut online = OnlineMap::new(params, &start, bounds, 0.3, 0.54).unwrap();
+        online
+            .insert(&trust_sensing::Scan::default(), &start)
+            .unwrap();
+        online.commit_check()
+    };
+    assert!(check.segment_free(&start, &(start + Vec3::new(0.3, 0.0, 0.0))));
+    assert!(!check.segment_free(&start, &(start + Vec3::new(2.0, 0.0, 0.0))));
+}

@@ -6,8 +6,11 @@
 //!
 //! The manager asks its [`CommitCheck`] ([`crate::Manager::set_commit_check`]) about the
 //! polyline of [`committed_stretch`]; a main branch that fails is not committed
-//! ([`crate::Event::NotKnownFree`]) and the fallback brakes instead. Without a check (a known
-//! map) nothing changes.
+//! ([`crate::Event::NotKnownFree`]) and the fallback brakes instead. The fallback's options are
+//! judged by the same check over their committed stretch: the first one clear of the forecasts and
+//! in known free space wins (braking along the committed plan counts as known: it stays in the
+//! stretch its check passed); with none, they are chosen as without a check. Without a check
+//! (a known map) nothing changes.
 
 use std::sync::Arc;
 

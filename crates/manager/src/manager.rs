@@ -1437,17 +1437,23 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     /// latency).
     fn outside_known_free(&self, traj: &PolyTraj, cycle: &Cycle) -> Option<f64> {
         let check = self.commit_check.as_ref()?;
-        let period = self
-            .last_now
-            .map(|last| cycle.start.t - self.params.latency() - last)
-            .filter(|p| p.is_finite() && *p > 0.0)
-            .unwrap_or(2.0 * self.params.cycle_budget_ms * 1e-3);
-        let until = cycle.start.t + period + self.params.latency();
+        let until = self.next_plan_at(cycle.start.t);
         let points = crate::committed_stretch(traj, cycle.start.t, until, self.limits.a_max);
         points
             .windows(2)
             .find(|w| !check.segment_free(&w[0].1, &w[1].1))
             .map(|w| w[0].0)
+    }
+
+    /// When the plan after one starting at `start_t` takes effect: the last cycle period (or
+    /// twice the cycle budget before a second cycle) plus the latency later.
+    fn next_plan_at(&self, start_t: f64) -> f64 {
+        let period = self
+            .last_now
+            .map(|last| start_t - self.params.latency() - last)
+            .filter(|p| p.is_finite() && *p > 0.0)
+            .unwrap_or(2.0 * self.params.cycle_budget_ms * 1e-3);
+        start_t + period + self.params.latency()
     }
 
     /// The state the new plan starts from, and whether it was re-anchored on the measurement.
@@ -1698,10 +1704,19 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             forecasts: &held,
             ..*scene
         };
-        let (mut best, verdicts) = self.first_clear_fallback(&options, start, &judged);
+        // Whether each option lies in known free space, asked only of the options it decides.
+        // Braking along the committed plan stays in the stretch its commit check passed.
+        let memo: Vec<std::cell::OnceCell<bool>> = vec![std::cell::OnceCell::new(); options.len()];
+        let known = |i: usize| {
+            *memo[i].get_or_init(|| {
+                options[i].0 == FallbackKind::Committed
+                    || self.known_free_committed(&options[i].1, start)
+            })
+        };
+        let (mut best, verdicts) = self.first_clear_fallback(&options, &known, start, &judged);
         if best.as_ref().is_some_and(|(_, v)| v.violation.is_some())
             && let Some(i) =
-                self.widest_likely_fallback(&options, &verdicts, start, scene, continued)
+                self.widest_likely_fallback(&options, &known, &verdicts, start, scene, continued)
         {
             // Reported against the forecasts (its shortfall is theirs).
             best = Some((i, verdicts[i]));
@@ -1825,25 +1840,43 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         kind != FallbackKind::Evade || !(v.over_limits || max_jerk(traj) > jerk_limit)
     }
 
-    /// The first admissible option clear of `judged`'s forecasts; else, clear of the static map
-    /// and the bounds before all (they are known, the forecasts are guesses: a vehicle that
-    /// dodged a person into a door frame hit it), the one that collides latest, then least
-    /// deeply. Also every verdict computed, by option (up to the first clear one).
+    /// With a commit check, whether the stretch of `traj` committed from `start` (as for a
+    /// plan: until the next plan takes effect, and braking along it) lies in the space it
+    /// accepts; true without one.
+    fn known_free_committed(&self, traj: &PolyTraj, start: &State) -> bool {
+        let Some(check) = self.commit_check.as_ref() else {
+            return true;
+        };
+        let until = self.next_plan_at(start.t);
+        let points = crate::committed_stretch(traj, start.t, until, self.limits.a_max);
+        points
+            .windows(2)
+            .all(|w| check.segment_free(&w[0].1, &w[1].1))
+    }
+
+    /// The first admissible option clear of `judged`'s forecasts and in known free space
+    /// (`known`, by option), else the first clear one; else, clear of the static map and the
+    /// bounds before all (they are known, the forecasts are guesses: a vehicle that dodged a
+    /// person into a door frame hit it), then in known free space, the one that collides
+    /// latest, then least deeply. Also every verdict computed, by option (up to the chosen
+    /// clear one).
     fn first_clear_fallback(
         &self,
         options: &[(FallbackKind, PolyTraj)],
+        known: &dyn Fn(usize) -> bool,
         start: &State,
         judged: &Scene<'_>,
     ) -> (Option<(usize, SafetyVerdict)>, Vec<SafetyVerdict>) {
-        let rank = |v: &SafetyVerdict| {
-            let static_clear = v.min_static_margin_m >= 0.0;
+        let rank = |i: usize, v: &SafetyVerdict| {
             (
-                u8::from(static_clear),
+                u8::from(v.min_static_margin_m >= 0.0),
+                u8::from(known(i)),
                 v.violation.map_or(f64::INFINITY, |x| x.t),
                 v.min_margin_m(),
             )
         };
         let mut best: Option<(usize, SafetyVerdict)> = None;
+        let mut first_clear: Option<(usize, SafetyVerdict)> = None;
         let mut verdicts = Vec::with_capacity(options.len());
         for (i, (kind, traj)) in options.iter().enumerate() {
             let v = self.assess_fallback(traj, start, judged);
@@ -1852,21 +1885,27 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                 continue;
             }
             if v.violation.is_none() {
-                best = Some((i, v));
-                break;
+                if known(i) {
+                    return (Some((i, v)), verdicts);
+                }
+                first_clear.get_or_insert((i, v));
+                continue;
             }
-            if best.as_ref().is_none_or(|(_, b)| {
-                rank(&v).partial_cmp(&rank(b)) == Some(std::cmp::Ordering::Greater)
-            }) {
+            if first_clear.is_none()
+                && best.as_ref().is_none_or(|(j, b)| {
+                    rank(i, &v).partial_cmp(&rank(*j, b)) == Some(std::cmp::Ordering::Greater)
+                })
+            {
                 best = Some((i, v));
             }
         }
-        (best, verdicts)
+        (first_clear.or(best), verdicts)
     }
 
     /// Nothing clear of the forecasts: of the options that stay clear of the obstacles' likely
     /// motion — the forecasts without their growth, else without any margin beyond the
-    /// obstacle's own size — and of the static map, the one with the widest margin there.
+    /// obstacle's own size — and of the static map, the one with the widest margin there: in
+    /// known free space (`known`, by option) if any is clear, else anywhere.
     /// "Collides latest" alone fled along a faster person's path, where the person catches up,
     /// instead of stepping out of it, which the forecasts' margins (some 0.4 m on each side of a
     /// person's lane) had ruled out (a holdout room with a person pacing across it: 16 of 60
@@ -1874,6 +1913,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
     fn widest_likely_fallback(
         &self,
         options: &[(FallbackKind, PolyTraj)],
+        known: &dyn Fn(usize) -> bool,
         verdicts: &[SafetyVerdict],
         start: &State,
         scene: &Scene<'_>,
@@ -1895,7 +1935,11 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                 })
                 .collect(),
         ];
-        for forecasts in &likely {
+        // Known free space first; then, if nothing there is clear, any.
+        for (known_only, forecasts) in [true, false]
+            .into_iter()
+            .flat_map(|k| likely.iter().map(move |f| (k, f)))
+        {
             let level = Scene {
                 forecasts,
                 ..*scene
@@ -1910,6 +1954,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                     let v = self.assess_fallback(traj, start, &level);
                     v.violation.is_none().then(|| (i, v.min_margin_m()))
                 })
+                .filter(|(i, _)| !known_only || known(*i))
                 .collect();
             let widest = clear
                 .iter()

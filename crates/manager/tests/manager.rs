@@ -1946,3 +1946,58 @@ fn a_sensed_route_aims_at_its_corner_when_a_remembered_wall_hides_the_rest() {
         );
     }
 }
+
+/// Known free space for the commit check: the half-space `y <= max_y`.
+struct KnownUpToY {
+    max_y: f64,
+}
+
+impl trust_manager::CommitCheck for KnownUpToY {
+    fn name(&self) -> &str {
+        "known up to y"
+    }
+
+    fn segment_free(&self, a: &Vec3, b: &Vec3) -> bool {
+        a.y <= self.max_y && b.y <= self.max_y
+    }
+}
+
+/// With a sensed map the fallback stays in known free space when it can: the ball rolling at
+/// a vehicle at rest is dodged, but not into the unobserved side (+y), where a wall may stand.
+#[test]
+fn the_fallback_dodges_into_known_free_space() {
+    let map = open_air();
+    let ball = [Forecast::new(
+        ObstacleShape::Sphere,
+        Vec3::new(46.0, 0.0, 5.0),
+        Vec3::new(2.0, 0.0, 0.0),
+        0.0,
+        0.5,
+        0.2,
+        0.6,
+    )
+    .unwrap()];
+    let scene = Scene::new(&map, &ball, 0.0).unwrap();
+    let start = State::at_rest(0.0, Vec3::new(50.0, 0.0, 5.0));
+    let goal = Vec3::new(95.0, 0.0, 5.0);
+    let widest_y = |max_y: Option<f64>| {
+        let mut m = blind_single_branch_at_room_limits();
+        if let Some(max_y) = max_y {
+            m.set_commit_check(Some(std::sync::Arc::new(KnownUpToY { max_y })));
+        }
+        let r = m.step(0.0, &start, &goal, &scene).unwrap();
+        assert!(r.fallback.is_some(), "every branch collides");
+        let plan = m.plan().unwrap();
+        let moved = plan.position(plan.t_end()) - start.p;
+        assert!(moved.y.hypot(moved.z) > 0.7, "moved {moved:?}");
+        (0..=100)
+            .map(|k| {
+                plan.position(plan.t_start() + plan.duration() * f64::from(k) / 100.0)
+                    .y
+            })
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    assert!(widest_y(Some(0.0)) <= 1e-9);
+    // The check is what keeps it there: on the known map, the first dodge is to +y.
+    assert!(widest_y(None) > 0.01);
+}

@@ -18,7 +18,8 @@
 //!   grown by the truncation distance, is recomputed.
 //! * To the planner: [`LocalMap::to_static_map`] (through `Esdf::from_signed_distances`); the
 //!   unknown-space policy: unknown is free for planning, but what the vehicle commits to must
-//!   pass [`LocalMap::segment_known_free`] (FASTER's rule).
+//!   pass [`LocalMap::segment_known_free`] (FASTER's rule), or with the vehicle's body counted
+//!   free point by point, [`LocalMap::segment_known_free_beside`] ([`BodyBall`]).
 //!
 //! Use it to fly the planner on what it could sense instead of the true map, or to test a
 //! perception-dependent part (the safety check, the route) against partial knowledge. The paper
@@ -56,6 +57,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod body;
 mod camera;
 mod distance;
 mod error;
@@ -71,6 +73,7 @@ mod sensor;
 mod traversal;
 mod truth;
 
+pub use body::BodyBall;
 pub use camera::{DepthCamera, DepthCameraParams};
 pub use error::SensingError;
 pub use lidar::{Lidar, LidarParams};

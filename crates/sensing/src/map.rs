@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 use trust_geometry::{Aabb, Esdf, StaticMap, Vec3};
 
+use crate::body::{BodyBall, HOVER_VOXELS, tube_part_in_body};
 use crate::camera::DepthCamera;
 use crate::distance::{DistanceField, KeyBox};
 use crate::error::{SensingError, check_count, check_range};
@@ -732,6 +733,26 @@ impl LocalMap {
     /// leaving the window, or a clearance above 16 voxels (the check would cost too much; ask
     /// the distance field instead). A negative clearance counts as 0.
     pub fn segment_known_free(&self, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
+        self.segment_free_of(a, b, clearance, None)
+    }
+
+    /// [`LocalMap::segment_known_free`] for a vehicle whose body fills `body`: a voxel not
+    /// observed free also passes when every point of it within `clearance` of the segment lies
+    /// in the body ball (module `body`; decision 0051). A vehicle at rest may so commit to its
+    /// own place, and a plan needs observed free space only where its clearance tube leaves the
+    /// body. Point-exact up to pieces of 1/16 voxel; an invalid `body` (non-finite, negative
+    /// radius) counts as no body.
+    pub fn segment_known_free_beside(
+        &self,
+        a: &Vec3,
+        b: &Vec3,
+        clearance: f64,
+        body: &BodyBall,
+    ) -> bool {
+        self.segment_free_of(a, b, clearance, body.is_valid().then_some(body))
+    }
+
+    fn segment_free_of(&self, a: &Vec3, b: &Vec3, clearance: f64, body: Option<&BodyBall>) -> bool {
         if clearance.is_nan() {
             return false;
         }
@@ -745,12 +766,24 @@ impl LocalMap {
             return false;
         }
         let offsets = ball_offsets(r);
+        let mut cleared: Vec<VoxelKey> = Vec::new();
         for k in VoxelTraversal::unchecked(a, b, res) {
             for d in &offsets {
                 let q = [k[0] + d[0], k[1] + d[1], k[2] + d[2]];
-                if self.state_of_key(&q) != VoxelState::Free {
+                if self.state_of_key(&q) == VoxelState::Free || cleared.contains(&q) {
+                    continue;
+                }
+                let Some(body) = body else {
+                    return false;
+                };
+                let half = Vec3::repeat(0.5 * res);
+                let centre = self.ring.center(&q);
+                let (lo, hi) = (centre - half, centre + half);
+                let hover = HOVER_VOXELS * res;
+                if !tube_part_in_body(&lo, &hi, a, b, clearance.max(0.0), body, hover) {
                     return false;
                 }
+                cleared.push(q);
             }
         }
         true
