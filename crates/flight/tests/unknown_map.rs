@@ -195,3 +195,26 @@ fn the_commit_check_lets_a_vehicle_hold_its_place_and_not_creep() {
     assert!(check.segment_free(&start, &(start + Vec3::new(0.3, 0.0, 0.0))));
     assert!(!check.segment_free(&start, &(start + Vec3::new(2.0, 0.0, 0.0))));
 }
+
+/// `scenarios/unknown-variants/` is the suite's static variants sensed: each file is its
+/// `scenarios/variants/` namesake, a two-line header before it and the depth camera after it.
+#[test]
+fn the_unknown_variants_are_the_variants_sensed() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios");
+    let mut count = 0;
+    for entry in std::fs::read_dir(root.join("unknown-variants")).unwrap() {
+        let path = entry.unwrap().path();
+        let sensed = std::fs::read_to_string(&path).unwrap();
+        let name = path.file_name().unwrap();
+        let known = std::fs::read_to_string(root.join("variants").join(name)).unwrap();
+        let body: String = sensed.lines().skip(2).map(|l| format!("{l}\n")).collect();
+        assert_eq!(
+            body,
+            format!("{known}\n[sensing]\nstatic = {{ depth = {{}} }}\n"),
+            "{}",
+            path.display()
+        );
+        count += 1;
+    }
+    assert_eq!(count, 24);
+}
