@@ -1776,18 +1776,30 @@ fn without_a_shared_map_or_history_there_is_no_worker() {
     assert!(reports.iter().all(|r| !r.worker_started));
 }
 
-/// Known free space for the commit check: the half-space `x <= max_x` (the rest unobserved).
+/// Known free space for the commit check: the half-space where coordinate `axis` (0 = x,
+/// 1 = y, 2 = z) is at most `max` (the rest unobserved).
 struct KnownUpTo {
-    max_x: f64,
+    axis: usize,
+    max: f64,
+}
+
+impl KnownUpTo {
+    fn x(max: f64) -> Self {
+        Self { axis: 0, max }
+    }
+
+    fn y(max: f64) -> Self {
+        Self { axis: 1, max }
+    }
 }
 
 impl trust_manager::CommitCheck for KnownUpTo {
     fn name(&self) -> &str {
-        "known up to x"
+        "known up to a plane"
     }
 
     fn segment_free(&self, a: &Vec3, b: &Vec3) -> bool {
-        a.x <= self.max_x && b.x <= self.max_x
+        a[self.axis] <= self.max && b[self.axis] <= self.max
     }
 }
 
@@ -1800,7 +1812,7 @@ fn a_plan_whose_committed_part_enters_unknown_space_is_not_committed() {
     // known free space at once (from rest it moves only millimetres in its committed stretch,
     // so a margin ahead of the start would let it pass).
     let mut m = planner(ManagerParams::trust());
-    m.set_commit_check(Some(std::sync::Arc::new(KnownUpTo { max_x: START.x })));
+    m.set_commit_check(Some(std::sync::Arc::new(KnownUpTo::x(START.x))));
     let report = m.step(0.0, &state, &GOAL, &scene).unwrap();
     assert!(
         report
@@ -1814,7 +1826,7 @@ fn a_plan_whose_committed_part_enters_unknown_space_is_not_committed() {
     assert!(!m.branches().is_empty(), "the branch itself is kept");
     // Observed free far enough: the same plan is committed.
     let mut m = planner(ManagerParams::trust());
-    m.set_commit_check(Some(std::sync::Arc::new(KnownUpTo { max_x: 100.0 })));
+    m.set_commit_check(Some(std::sync::Arc::new(KnownUpTo::x(100.0))));
     let report = m.step(0.0, &state, &GOAL, &scene).unwrap();
     assert!(m.main().is_some(), "{:?}", report.event_tags());
 }
@@ -1947,21 +1959,6 @@ fn a_sensed_route_aims_at_its_corner_when_a_remembered_wall_hides_the_rest() {
     }
 }
 
-/// Known free space for the commit check: the half-space `y <= max_y`.
-struct KnownUpToY {
-    max_y: f64,
-}
-
-impl trust_manager::CommitCheck for KnownUpToY {
-    fn name(&self) -> &str {
-        "known up to y"
-    }
-
-    fn segment_free(&self, a: &Vec3, b: &Vec3) -> bool {
-        a.y <= self.max_y && b.y <= self.max_y
-    }
-}
-
 /// With a sensed map the fallback stays in known free space when it can: the ball rolling at
 /// a vehicle at rest is dodged, but not into the unobserved side (+y), where a wall may stand.
 #[test]
@@ -1983,7 +1980,7 @@ fn the_fallback_dodges_into_known_free_space() {
     let widest_y = |max_y: Option<f64>| {
         let mut m = blind_single_branch_at_room_limits();
         if let Some(max_y) = max_y {
-            m.set_commit_check(Some(std::sync::Arc::new(KnownUpToY { max_y })));
+            m.set_commit_check(Some(std::sync::Arc::new(KnownUpTo::y(max_y))));
         }
         let r = m.step(0.0, &start, &goal, &scene).unwrap();
         assert!(r.fallback.is_some(), "every branch collides");
