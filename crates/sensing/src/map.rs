@@ -11,6 +11,7 @@ use crate::error::{SensingError, check_count, check_range};
 use crate::occupancy::{LogOddsParams, VoxelState};
 use crate::pose::Pose;
 use crate::projective::DepthFrame;
+use crate::recall::{DEFAULT_RECALL_BLOCKS, Recall};
 use crate::ring::{Indexer, Ring, walk};
 use crate::scan::{ReturnKind, Scan};
 use crate::traversal::{VoxelKey, VoxelTraversal, voxel_key};
@@ -154,6 +155,8 @@ pub struct LocalMap {
     /// Slots updated by the current frame.
     touched: Vec<u32>,
     pending: Option<KeyBox>,
+    /// The voxels that left the window, handed back when they re-enter (module `recall`).
+    recall: Recall,
 }
 
 /// Checks that `p` is finite and within the scale policy.
@@ -196,7 +199,21 @@ impl LocalMap {
             frame: 2,
             touched: Vec::new(),
             pending: None,
+            recall: Recall::new(DEFAULT_RECALL_BLOCKS),
         })
+    }
+
+    /// This map keeping at most `blocks` blocks of [`crate::RECALL_BLOCK`]³ voxels that left
+    /// the window (default [`DEFAULT_RECALL_BLOCKS`]; 0 forgets a voxel as it leaves). Clears
+    /// what was kept.
+    pub fn with_recall_blocks(mut self, blocks: usize) -> Self {
+        self.recall = Recall::new(blocks);
+        self
+    }
+
+    /// Blocks of voxels kept since they left the window ([`LocalMap::with_recall_blocks`]).
+    pub fn recall_block_count(&self) -> usize {
+        self.recall.block_count()
     }
 
     fn low_for(params: &LocalMapParams, center: &Vec3) -> VoxelKey {
@@ -229,9 +246,10 @@ impl LocalMap {
     }
 
     /// Moves the window so that it is centred on `center` (to the voxel). Voxels that stay inside
-    /// keep their state; those that leave are forgotten (unknown when they come back); only the
-    /// slots that change hands are touched, and the distance field is recomputed near the two
-    /// faces that moved. Pending occupancy changes are folded into the field first.
+    /// keep their state; those that leave are kept aside and come back as they left (up to the
+    /// recall's bound, [`LocalMap::with_recall_blocks`]; beyond it unknown); only the slots that
+    /// change hands are touched, and the distance field is recomputed near the two faces that
+    /// moved. Pending occupancy changes are folded into the field first.
     pub fn recentre(&mut self, center: &Vec3) -> Result<(), SensingError> {
         check_point("center", center)?;
         self.update_distance();
@@ -245,6 +263,7 @@ impl LocalMap {
             let n = self.ring.dims[i] as i64;
             if delta.abs() >= n {
                 self.clear_all(new_low);
+                self.update_distance();
                 return Ok(());
             }
             let (lo, hi) = (self.ring.low[i], self.ring.high()[i]);
@@ -259,15 +278,17 @@ impl LocalMap {
             }
             self.ring.low[i] = new_low[i];
             let (lo, hi) = (self.ring.low, self.ring.high());
+            let mut entering = KeyBox { lo, hi };
+            if delta > 0 {
+                entering.lo[i] = hi[i] - delta + 1;
+            } else {
+                entering.hi[i] = lo[i] - delta - 1;
+            }
+            self.restore(&entering);
             if self.occupied_count > 0 {
-                // The entering voxels get their distances; the voxels within `r` of the face the
-                // lost occupied voxels were behind lose them.
-                let mut entering = KeyBox { lo, hi };
-                if delta > 0 {
-                    entering.lo[i] = hi[i] - delta + 1;
-                } else {
-                    entering.hi[i] = lo[i] - delta - 1;
-                }
+                // The entering voxels get their distances (a recalled occupied voxel's reach
+                // inside the window is pending, `restore`); the voxels within `r` of the face
+                // the lost occupied voxels were behind lose them.
                 self.field.recompute(
                     &self.ring,
                     &self.occupied,
@@ -286,6 +307,8 @@ impl LocalMap {
                     .recompute(&self.ring, &self.occupied, Some(&self.row_occupied), &near);
             }
         }
+        // The reach of recalled occupied voxels.
+        self.update_distance();
         Ok(())
     }
 
@@ -302,9 +325,16 @@ impl LocalMap {
         let strides = [1, d[0], d[0] * d[1]];
         let far = self.field.r as f64 * self.ring.res;
         let mut lost = false;
+        let mut key = [0i64; 3];
+        key[axis] = k;
         for j in 0..d[a2] {
+            key[a2] = self.ring.low[a2] + (j as i64 - self.ring.low[a2]).rem_euclid(d[a2] as i64);
             for i in 0..d[a1] {
+                key[a1] =
+                    self.ring.low[a1] + (i as i64 - self.ring.low[a1]).rem_euclid(d[a1] as i64);
                 let slot = s * strides[axis] + i * strides[a1] + j * strides[a2];
+                let v = self.voxels[slot];
+                self.recall.keep(&key, v.known.then_some(v.log_odds));
                 self.voxels[slot] = Voxel::default();
                 if self.occupied[slot] {
                     self.occupied[slot] = false;
@@ -319,6 +349,10 @@ impl LocalMap {
     }
 
     fn clear_all(&mut self, new_low: VoxelKey) {
+        for (slot, v) in self.voxels.iter().enumerate() {
+            let key = self.ring.key_of_slot(slot);
+            self.recall.keep(&key, v.known.then_some(v.log_odds));
+        }
         self.voxels.fill(Voxel::default());
         self.occupied.fill(false);
         self.row_occupied.fill(0);
@@ -326,6 +360,48 @@ impl LocalMap {
         self.field.reset(self.ring.res);
         self.ring.low = new_low;
         self.pending = None;
+        let whole = KeyBox {
+            lo: self.ring.low,
+            hi: self.ring.high(),
+        };
+        self.restore(&whole);
+        if self.pending.is_some() {
+            // Recalled occupied voxels: the whole window's field.
+            self.pending = Some(whole);
+        }
+    }
+
+    /// Hands the recalled voxels of `region` (entering the window, unknown until now) their
+    /// log-odds back; a recalled occupied voxel counts into the occupancy and the pending box,
+    /// so that the distance field catches up within its reach.
+    fn restore(&mut self, region: &KeyBox) {
+        let lo = &self.params.log_odds;
+        let ring = self.ring;
+        let mut gained: Vec<VoxelKey> = Vec::new();
+        let (voxels, occupied, rows) =
+            (&mut self.voxels, &mut self.occupied, &mut self.row_occupied);
+        let mut count = 0usize;
+        self.recall
+            .for_each_in(&region.lo, &region.hi, |k, log_odds| {
+                let slot = ring.slot(&k);
+                voxels[slot] = Voxel {
+                    log_odds,
+                    known: true,
+                };
+                if lo.is_occupied(f64::from(log_odds)) && !occupied[slot] {
+                    occupied[slot] = true;
+                    rows[slot / ring.dims[0]] += 1;
+                    count += 1;
+                    gained.push(k);
+                }
+            });
+        self.occupied_count += count;
+        for k in gained {
+            match &mut self.pending {
+                Some(b) => b.include(&k),
+                None => self.pending = Some(KeyBox::point(k)),
+            }
+        }
     }
 
     /// Integrates a scan and updates the distance field: [`LocalMap::integrate_scan`] then

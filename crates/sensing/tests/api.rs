@@ -421,7 +421,10 @@ fn rolling_window_keeps_what_stays_and_forgets_what_leaves() {
         dims: [40, 40, 20],
         ..LocalMapParams::default()
     };
-    let mut map = LocalMap::new(params, &Vec3::zeros()).unwrap();
+    // Without the recall (`rolling_window_recalls_what_left_it` has it).
+    let mut map = LocalMap::new(params, &Vec3::zeros())
+        .unwrap()
+        .with_recall_blocks(0);
     let o = v(0.05, 0.05, 0.05);
     let a = v(1.05, 0.05, 0.05);
     let b = v(-1.55, 0.05, 0.05);
@@ -457,6 +460,82 @@ fn rolling_window_keeps_what_stays_and_forgets_what_leaves() {
     assert_eq!(map.occupied_count(), 0);
     map.recentre(&Vec3::zeros()).unwrap();
     assert_eq!(map.state(&a), VoxelState::Unknown);
+}
+
+/// Every voxel of the window: its centre, state and log-odds.
+fn window_states(map: &LocalMap) -> Vec<(Vec3, VoxelState, Option<f64>)> {
+    let res = map.params().resolution_m;
+    let w = map.window();
+    let n = map.params().dims;
+    let mut out = Vec::new();
+    for k in 0..n[2] {
+        for j in 0..n[1] {
+            for i in 0..n[0] {
+                let c = w.min + res * v(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5);
+                out.push((c, map.state(&c), map.log_odds(&c)));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn rolling_window_recalls_what_left_it() {
+    let params = LocalMapParams {
+        dims: [40, 40, 20],
+        ..LocalMapParams::default()
+    };
+    let mut map = LocalMap::new(params, &Vec3::zeros()).unwrap();
+    let o = v(0.05, 0.05, 0.05);
+    let (a, b) = (v(1.05, 0.05, 0.05), v(-1.55, 0.05, 0.05));
+    for _ in 0..3 {
+        map.insert_scan(&scan_to(o, &[a, b])).unwrap();
+    }
+    let before = window_states(&map);
+    let field = map.distance_slots().to_vec();
+    // b leaves the window and comes back occupied, the field with it.
+    map.recentre(&v(0.65, 0.05, 0.05)).unwrap();
+    assert_eq!(map.state(&b), VoxelState::Unknown);
+    assert!(map.recall_block_count() > 0);
+    map.recentre(&Vec3::zeros()).unwrap();
+    assert_eq!(map.state(&b), VoxelState::Occupied);
+    assert_eq!(window_states(&map), before);
+    assert_eq!(map.distance_slots(), &field[..]);
+    assert_eq!(
+        map.distance_slots(),
+        &map.recompute_distance_from_scratch()[..]
+    );
+    // A jump beyond the window and back, too.
+    map.recentre(&v(50.0, 0.0, 0.0)).unwrap();
+    assert_eq!(map.occupied_count(), 0);
+    map.recentre(&Vec3::zeros()).unwrap();
+    assert_eq!(window_states(&map), before);
+    assert_eq!(map.distance_slots(), &field[..]);
+    // A bounded recall forgets (unknown), and never invents: one block is not enough for the
+    // scan's free voxels.
+    let mut small = LocalMap::new(params, &Vec3::zeros())
+        .unwrap()
+        .with_recall_blocks(1);
+    for _ in 0..3 {
+        small.insert_scan(&scan_to(o, &[a, b])).unwrap();
+    }
+    small.recentre(&v(50.0, 0.0, 0.0)).unwrap();
+    assert_eq!(small.recall_block_count(), 1);
+    small.recentre(&Vec3::zeros()).unwrap();
+    let after = window_states(&small);
+    assert!(after.iter().any(|x| {
+        x.1 == VoxelState::Unknown
+            && before
+                .iter()
+                .any(|y| y.0 == x.0 && y.1 != VoxelState::Unknown)
+    }));
+    for (x, y) in after.iter().zip(&before) {
+        assert!(x.1 == VoxelState::Unknown || x == y, "{x:?} vs {y:?}");
+    }
+    assert_eq!(
+        small.distance_slots(),
+        &small.recompute_distance_from_scratch()[..]
+    );
 }
 
 #[test]
@@ -578,6 +657,46 @@ proptest! {
                 prop_assert!((got - expected).abs() < 1e-9, "step {step} at {c:?}: {got} vs {expected}");
             }
         }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
+
+    /// Scans, then an excursion of the window (no scans) ending where it started: every voxel
+    /// comes back as it was, and the field with it.
+    #[test]
+    fn an_excursion_without_scans_changes_nothing(seed in any::<u64>()) {
+        let params = LocalMapParams {
+            resolution_m: 0.25,
+            dims: [12, 10, 8],
+            max_distance_m: 0.7,
+            ..LocalMapParams::default()
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let center = v(0.1, -0.2, 0.3);
+        let mut map = LocalMap::new(params, &center).unwrap();
+        for _ in 0..3 {
+            let origin = center + v(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), rng.random_range(-0.3..0.3));
+            let rays = (0..rng.random_range(1..40)).map(|_| {
+                let d = v(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+                let d = if d.norm() < 1e-3 { v(1.0, 0.0, 0.0) } else { d.normalize() };
+                let kind = if rng.random_range(0..10) == 0 { ReturnKind::NoReturn } else { ReturnKind::Hit };
+                RayMeasurement { direction: d, range: rng.random_range(0.0..3.0), kind }
+            }).collect();
+            map.insert_scan(&Scan { origin, rays }).unwrap();
+        }
+        let before = window_states(&map);
+        let field = map.distance_slots().to_vec();
+        let mut at = center;
+        for _ in 0..rng.random_range(1..6) {
+            at += v(rng.random_range(-4.0..4.0), rng.random_range(-4.0..4.0), rng.random_range(-3.0..3.0));
+            map.recentre(&at).unwrap();
+            prop_assert_eq!(map.distance_slots(), &map.recompute_distance_from_scratch()[..]);
+        }
+        map.recentre(&center).unwrap();
+        prop_assert_eq!(window_states(&map), before);
+        prop_assert_eq!(map.distance_slots(), &field[..]);
     }
 }
 
