@@ -92,10 +92,9 @@ impl MapSpec {
             } else {
                 reach_up_m.clamp(least_up, WINDOW_HALF_HEIGHT_M.max(least_up))
             };
-            (
-                ((2.0 * half / resolution_m).ceil() as usize).clamp(2, 2048),
-                ((2.0 * half_up / resolution_m).ceil() as usize).clamp(2, 2048),
-            )
+            // Voxels to cover a span (a span of whole voxels up to rounding is that many).
+            let voxels = |span: f64| ((span / resolution_m - 1e-9).ceil() as usize).clamp(2, 2048);
+            (voxels(2.0 * half), voxels(2.0 * half_up))
         } else {
             (d.dims[0], d.dims[2])
         };
@@ -360,8 +359,14 @@ mod tests {
         let d = parse("static = { depth = {} }").unwrap();
         let (sensor, map) = d.sensor().unwrap();
         assert_eq!(sensor, StaticSensor::Depth(DepthCameraParams::default()));
-        assert_eq!(map.dims, [200, 200, 48]);
+        // 10 m on each side, and 4 m up and down (the D435 sees 4.8 m up within its range).
+        assert_eq!(map.dims, [200, 200, 80]);
         assert_eq!(map.resolution_m, LocalMapParams::default().resolution_m);
+        // A camera that sees less far up gets a lower window, never below the library's.
+        let low = parse("static = { depth = { vfov_rad = 0.5 } }").unwrap();
+        assert_eq!(low.sensor().unwrap().1.dims, [200, 200, 50]);
+        let flat = parse("static = { depth = { vfov_rad = 0.1 } }").unwrap();
+        assert_eq!(flat.sensor().unwrap().1.dims, [200, 200, 48]);
         let d =
             parse("static = { depth = { rate_hz = 15.0, map = { resolution_m = 0.2 } } }").unwrap();
         let (sensor, map) = d.sensor().unwrap();
@@ -372,6 +377,9 @@ mod tests {
             StaticSensor::Lidar(p) => assert_eq!(p.channels, 32),
             other => panic!("{other:?}"),
         }
+        // An explicit window stays as written.
+        let w = parse("static = { lidar = { map = { dims = [40, 40, 20] } } }").unwrap();
+        assert_eq!(w.sensor().unwrap().1.dims, [40, 40, 20]);
         assert!(problems(&d).is_empty());
         assert!(problems(&l).is_empty());
     }
