@@ -15,7 +15,7 @@ use crate::ring::{Indexer, Ring, walk};
 use crate::scan::{ReturnKind, Scan};
 use crate::traversal::{VoxelKey, VoxelTraversal, voxel_key};
 
-/// Most voxels a window may hold (16 M, about 340 MB of map state).
+/// Most voxels a window may hold (16 M, about 200 MB of map state).
 pub const MAX_WINDOW_VOXELS: usize = 1 << 24;
 
 /// Parameters of a [`LocalMap`]. Sources of the defaults in `docs/sensing.md`.
@@ -101,11 +101,30 @@ impl LocalMapParams {
     }
 }
 
-/// One voxel's state.
-#[derive(Debug, Clone, Copy, Default)]
-struct Voxel {
-    log_odds: f32,
-    known: bool,
+/// One voxel's state: its log-odds, NaN while it is unknown (four bytes: more voxels to a
+/// cache line than a separate flag would leave).
+#[derive(Debug, Clone, Copy)]
+struct Voxel(f32);
+
+impl Default for Voxel {
+    fn default() -> Self {
+        Self(f32::NAN)
+    }
+}
+
+impl Voxel {
+    /// Observed at least once (a stored log-odds is never NaN: the sensor model clamps finite
+    /// values).
+    #[inline]
+    fn known(self) -> bool {
+        !self.0.is_nan()
+    }
+
+    /// The log-odds, 0 (the prior) while unknown.
+    #[inline]
+    fn log_odds(self) -> f32 {
+        if self.known() { self.0 } else { 0.0 }
+    }
 }
 
 /// What one [`LocalMap::integrate_scan`] did.
@@ -456,13 +475,11 @@ impl LocalMap {
     /// counted into the occupancy counts and the pending box. Returns whether it flipped.
     #[inline(always)]
     fn apply(&mut self, slot: usize, hit: bool, lo: &LogOddsParams) -> bool {
-        let v = &mut self.voxels[slot];
-        let prior = if v.known { f64::from(v.log_odds) } else { 0.0 };
-        let value = lo.update(prior, hit);
-        v.log_odds = value as f32;
-        v.known = true;
-        self.settled[slot] = Some(v.log_odds) == self.floor;
-        let now = lo.is_occupied(f64::from(v.log_odds));
+        let prior = f64::from(self.voxels[slot].log_odds());
+        let value = lo.update(prior, hit) as f32;
+        self.voxels[slot] = Voxel(value);
+        self.settled[slot] = Some(value) == self.floor;
+        let now = lo.is_occupied(f64::from(value));
         if now == self.occupied[slot] {
             return false;
         }
@@ -564,6 +581,9 @@ impl LocalMap {
                 voxel_count += 1;
             }
         }
+        // The misses are found first and updated after (their states' reads do not wait on
+        // one another there).
+        let hits = self.touched.len();
         if frame.far > 0.0 {
             let (wlo, whi) = (self.ring.low, self.ring.high());
             let slack = frame.span_slack(res);
@@ -607,8 +627,7 @@ impl LocalMap {
                             let dx = (kx as f64 + 0.5) * res - o.x;
                             let p = [a[0] * dx + q[0], a[1] * dx + q[1], a[2] * dx + q[2]];
                             if frame.miss_at(&p) && self.marks[slot] < miss {
-                                voxel_count += 1;
-                                flip_count += usize::from(self.apply(slot, false, &lo));
+                                self.touched.push(slot as u32);
                             }
                         }
                         k0 += len as i64;
@@ -616,6 +635,11 @@ impl LocalMap {
                 }
             }
         }
+        for i in hits..self.touched.len() {
+            let slot = self.touched[i] as usize;
+            flip_count += usize::from(self.apply(slot, false, &lo));
+        }
+        voxel_count += self.touched.len() - hits;
         Ok(ScanUpdate {
             ray_count: frame.ray_count,
             voxel_count,
@@ -665,10 +689,8 @@ impl LocalMap {
                         continue;
                     }
                     let slot = self.ring.slot(&k);
-                    let v = &mut self.voxels[slot];
-                    if !v.known {
-                        v.known = true;
-                        v.log_odds = miss;
+                    if !self.voxels[slot].known() {
+                        self.voxels[slot] = Voxel(miss);
                         self.settled[slot] = Some(miss) == self.floor;
                         count += 1;
                     }
@@ -717,7 +739,7 @@ impl LocalMap {
         let slot = self.ring.slot(k);
         if self.occupied[slot] {
             VoxelState::Occupied
-        } else if self.voxels[slot].known {
+        } else if self.voxels[slot].known() {
             VoxelState::Free
         } else {
             VoxelState::Unknown
@@ -730,7 +752,7 @@ impl LocalMap {
             return None;
         }
         let v = self.voxels[self.ring.slot(&voxel_key(p, self.ring.res))];
-        Some(f64::from(v.log_odds))
+        Some(f64::from(v.log_odds()))
     }
 
     /// True if the voxel containing `p` is observed and free.
@@ -977,7 +999,7 @@ impl LocalMap {
                 let row = d[0] * (self.ring.axis_slot(1, y) + d[1] * sz);
                 for x in lo[0]..=hi[0] {
                     let slot = row + self.ring.axis_slot(0, x);
-                    if self.voxels[slot].known {
+                    if self.voxels[slot].known() {
                         visit(&[x, y, z], self.occupied[slot]);
                     }
                 }
@@ -1058,7 +1080,7 @@ mod tests {
         seen.into_iter()
             .map(|(k, hit)| {
                 let v = map.voxels[map.ring.slot(&k)];
-                let prior = if v.known { f64::from(v.log_odds) } else { 0.0 };
+                let prior = if v.known() { f64::from(v.log_odds()) } else { 0.0 };
                 let value = lo.update(prior, hit) as f32;
                 (k, (value, true, lo.is_occupied(f64::from(value))))
             })
@@ -1275,7 +1297,7 @@ mod tests {
             assert!(text.contains(field), "{text}");
             assert_eq!(map.occupied_count(), 0);
             assert!(
-                map.voxels.iter().all(|v| !v.known),
+                map.voxels.iter().all(|v| !v.known()),
                 "changed by a bad frame"
             );
         };
@@ -1470,7 +1492,7 @@ mod tests {
         prop_assert_eq!(&map.row_occupied, &rows);
         let floor = map.params.log_odds.clamp_min as f32;
         for (v, &settled) in map.voxels.iter().zip(&map.settled) {
-            prop_assert_eq!(settled, v.known && v.log_odds == floor);
+            prop_assert_eq!(settled, v.known() && v.log_odds() == floor);
         }
         prop_assert_eq!(map.distance_slots(), map.recompute_distance_from_scratch());
         Ok(())
@@ -1512,11 +1534,11 @@ mod tests {
                                 Some(&e) => e,
                                 None => {
                                     let b = before.voxels[s];
-                                    (b.log_odds, b.known, before.occupied[s])
+                                    (b.log_odds(), b.known(), before.occupied[s])
                                 }
                             };
-                            prop_assert_eq!(v.log_odds, lo_e, "{:?}", k);
-                            prop_assert_eq!(v.known, known_e, "{:?}", k);
+                            prop_assert_eq!(v.log_odds(), lo_e, "{:?}", k);
+                            prop_assert_eq!(v.known(), known_e, "{:?}", k);
                             prop_assert_eq!(occ, occ_e, "{:?}", k);
                         }
                     }
@@ -1574,19 +1596,19 @@ mod tests {
                     let (value, known, occ) = match decided {
                         Some(hit) => {
                             // A miss of a voxel at the lower clamp is not counted.
-                            if hit || !(b.known && b.log_odds == floor) {
+                            if hit || !(b.known() && b.log_odds() == floor) {
                                 updated += 1;
                             } else {
                                 settled_skipped += 1;
                             }
-                            let prior = if b.known { f64::from(b.log_odds) } else { 0.0 };
+                            let prior = if b.known() { f64::from(b.log_odds()) } else { 0.0 };
                             let v = lo.update(prior, hit) as f32;
                             (v, true, lo.is_occupied(f64::from(v)))
                         }
-                        None => (b.log_odds, b.known, before.occupied[s]),
+                        None => (b.log_odds(), b.known(), before.occupied[s]),
                     };
-                    prop_assert_eq!(map.voxels[s].log_odds, value, "{:?}", k);
-                    prop_assert_eq!(map.voxels[s].known, known, "{:?}", k);
+                    prop_assert_eq!(map.voxels[s].log_odds(), value, "{:?}", k);
+                    prop_assert_eq!(map.voxels[s].known(), known, "{:?}", k);
                     prop_assert_eq!(map.occupied[s], occ, "{:?}", k);
                 }
                 prop_assert_eq!(u.voxel_count, updated);
@@ -1648,10 +1670,10 @@ mod tests {
                 let c = fresh.ring.center(&k);
                 let q = to_sensor * (c - scan.origin);
                 if hits.contains(&k) {
-                    prop_assert!(v.known && v.log_odds > 0.0, "{:?}: a hit", k);
+                    prop_assert!(v.known() && v.log_odds() > 0.0, "{:?}: a hit", k);
                     continue;
                 }
-                let proj_miss = v.known;
+                let proj_miss = v.known();
                 let uf = 0.5 * w as f64 * (1.0 - q.y / q.x / tx);
                 let vf = 0.5 * h as f64 * (1.0 - q.z / q.x / ty);
                 let inside = q.x > 0.0
