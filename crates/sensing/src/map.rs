@@ -500,6 +500,19 @@ impl LocalMap {
         true
     }
 
+    /// Reads the states of the voxels `touched[from..]` (and their occupancy) in a loop that
+    /// does nothing else, so that their cache misses overlap; the updates that follow then find
+    /// them in the cache.
+    #[inline(never)]
+    fn warm_voxels(&self, from: usize) {
+        let mut any = 0u32;
+        for &slot in &self.touched[from..] {
+            let slot = slot as usize;
+            any |= self.voxels[slot].0.to_bits() | u32::from(self.occupied[slot]);
+        }
+        std::hint::black_box(any);
+    }
+
     /// Starts a frame: a new generation stamp; returns the (miss, hit) marks of this frame.
     fn next_frame(&mut self) -> (u8, u8) {
         if self.frame > u8::MAX - 3 {
@@ -635,6 +648,7 @@ impl LocalMap {
                 }
             }
         }
+        self.warm_voxels(hits);
         for i in hits..self.touched.len() {
             let slot = self.touched[i] as usize;
             flip_count += usize::from(self.apply(slot, false, &lo));
