@@ -497,8 +497,9 @@ fn min_plus<T: Sq>(out: &mut [T], input: &[T], add: T) {
 
 /// Squared distance (voxels) from the occupied voxel `k` to the nearest non-occupied voxel
 /// centre or site outside the window, exact when at most `r²` (larger values are only known to
-/// exceed `r²`): the 26 neighbours first (faces, edges, corners: distance² 1, 2, 3), then
-/// shells of growing Chebyshev radius until no closer voxel can remain.
+/// exceed `r²`): the 26 neighbours first (faces, edges, corners: distance² 1, 2, 3), the six
+/// voxels two along an axis (4), then shells of growing Chebyshev radius until no closer voxel
+/// can remain.
 fn inside_sq(ix: &Indexer, occupied: &[bool], k: &VoxelKey, r: i64) -> f64 {
     let ring = &ix.ring;
     let (lo, hi) = (ring.low, ring.high());
@@ -555,7 +556,25 @@ fn inside_sq(ix: &Indexer, occupied: &[bool], k: &VoxelKey, r: i64) -> f64 {
             return 3.0;
         }
     }
-    // The shell of radius 1 is all occupied: search from radius 2.
+    // The shell of radius 1 is all occupied: nothing is nearer than 4 now; a window face two
+    // voxels away, or a non-occupied voxel two voxels along an axis, is at 4.
+    if best <= 4.0 {
+        return best;
+    }
+    for i in 0..3 {
+        let (stride, n) = (strides[i], d[i]);
+        let below = if s[i] == 0 { n - 1 } else { s[i] - 1 };
+        let above = if s[i] + 1 == n { 0 } else { s[i] + 1 };
+        for q in [
+            slot as isize + delta[i][0] + step(below, stride, n, false),
+            slot as isize + delta[i][2] + step(above, stride, n, true),
+        ] {
+            if !occupied[q as usize] {
+                return 4.0;
+            }
+        }
+    }
+    // Search the shells from radius 2.
     for rho in 2..=r {
         if (rho * rho) as f64 >= best {
             break;

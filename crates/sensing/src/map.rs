@@ -665,18 +665,23 @@ impl LocalMap {
     /// each).
     fn mark_hits(&mut self, scan: &Scan, hit: u8, ix: &Indexer) {
         let (o, res) = (scan.origin, self.ring.res);
+        // Neighbouring pixels often end in one voxel: a voxel already marked is written again
+        // and not kept, without a branch on it.
+        let mut n = self.touched.len();
+        self.touched.resize(n + scan.rays.len(), 0);
         for ray in &scan.rays {
             if ray.kind != ReturnKind::Hit {
                 continue;
             }
             let k = voxel_key(&(o + ray.direction * ray.range), res);
-            if let Some(slot) = ix.slot_in(&k)
-                && self.marks[slot] != hit
-            {
+            if let Some(slot) = ix.slot_in(&k) {
+                let first = self.marks[slot] != hit;
                 self.marks[slot] = hit;
-                self.touched.push(slot as u32);
+                self.touched[n] = slot as u32;
+                n += usize::from(first);
             }
         }
+        self.touched.truncate(n);
     }
 
     /// Marks the unknown voxels whose centre lies within `radius` of `center` as known free
