@@ -300,7 +300,10 @@ impl Out<'_> {
                     } else {
                         i64::MIN / 2
                     };
-                    let right = self.sites.get(i + 1).map_or(i64::MAX / 2, |&n| i64::from(n));
+                    let right = self
+                        .sites
+                        .get(i + 1)
+                        .map_or(i64::MAX / 2, |&n| i64::from(n));
                     let lo = left.max(site - r).max(t0);
                     let hi = right.min(site + r).min(t1);
                     for x in lo..=hi {
@@ -674,6 +677,39 @@ mod tests {
                                 prop_assert!((got - expect).abs() < 1e-12, "{:?} wide {} rows {}: {} vs {}", k, wide, with_rows, got, expect);
                             }
                         }
+                    }
+                }
+            }
+        }
+
+        /// Nearly solid windows: the inside distances of occupied voxels (the 26 neighbours,
+        /// the six two along an axis, the shells beyond) equal the brute force everywhere.
+        #[test]
+        fn inside_distances_equal_the_brute_force(
+            dims in (7usize..11, 7usize..11, 7usize..11),
+            low in (-20i64..20, -20i64..20, -20i64..20),
+            r in 2i64..8,
+            density in 0.85f64..0.995,
+            seed in any::<u64>(),
+        ) {
+            use rand::{Rng, SeedableRng};
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let ring = Ring { dims: [dims.0, dims.1, dims.2], low: [low.0, low.1, low.2], res: 0.1 };
+            let occupied: Vec<bool> = (0..ring.len()).map(|_| rng.random_bool(density)).collect();
+            let rows: Vec<u32> = occupied
+                .chunks(dims.0)
+                .map(|row| row.iter().filter(|&&o| o).count() as u32)
+                .collect();
+            let mut field = DistanceField::new(ring.len(), r, ring.res);
+            field.recompute(&ring, &occupied, Some(&rows), &KeyBox { lo: ring.low, hi: ring.high() });
+            let (lo, hi) = (ring.low, ring.high());
+            for z in lo[2]..=hi[2] {
+                for y in lo[1]..=hi[1] {
+                    for x in lo[0]..=hi[0] {
+                        let k = [x, y, z];
+                        let got = field.value(field.code[ring.slot(&k)]);
+                        let expect = brute(&ring, &occupied, &k, r);
+                        prop_assert!((got - expect).abs() < 1e-12, "{:?}: {} vs {}", k, got, expect);
                     }
                 }
             }

@@ -1099,7 +1099,11 @@ mod tests {
         seen.into_iter()
             .map(|(k, hit)| {
                 let v = map.voxels[map.ring.slot(&k)];
-                let prior = if v.known() { f64::from(v.log_odds()) } else { 0.0 };
+                let prior = if v.known() {
+                    f64::from(v.log_odds())
+                } else {
+                    0.0
+                };
                 let value = lo.update(prior, hit) as f32;
                 (k, (value, true, lo.is_occupied(f64::from(value))))
             })

@@ -209,8 +209,7 @@ impl DepthFrame {
     /// farther out.
     #[inline]
     pub fn pixel_of(&self, p: &[f64; 3]) -> Option<usize> {
-        // Also NaN.
-        if !(p[0] > 0.0) {
+        if p[0].is_nan() || p[0] <= 0.0 {
             return None;
         }
         let inv = 1.0 / p[0];
