@@ -220,10 +220,11 @@ impl DepthFrame {
         if !(u >= -e[0] * inv && u < w + e[1] * inv && v >= -e[2] * inv && v < h + e[3] * inv) {
             return None;
         }
-        // Finite here; `as` saturates a negative value to 0, `min` the far edge.
+        // Not NaN here: truncated (`as` saturates), then clamped to the image (a value below 0
+        // to 0, one beyond the far edge to it).
         let (u, v) = (
-            (u as usize).min(self.width - 1),
-            (v as usize).min(self.height - 1),
+            (u as i64).clamp(0, self.width as i64 - 1) as usize,
+            (v as i64).clamp(0, self.height as i64 - 1) as usize,
         );
         Some(v * self.width + u)
     }
