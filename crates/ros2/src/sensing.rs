@@ -139,7 +139,7 @@ impl CloudParams {
             }
         }
         self.map
-            .params(self.max_range_m, 0.0)
+            .params(self.max_range_m)
             .validate()
             .map_err(|e| Ros2Error::invalid("cloud.map", e, "valid local map parameters"))
     }
@@ -346,9 +346,8 @@ impl CloudMap {
         v: Vec3,
     ) -> Result<(), Ros2Error> {
         if self.online.is_none() {
-            // The clouds' vertical reach is not known here: the library's window height.
             self.online = Some(OnlineMap::new(
-                self.params.map.params(self.params.max_range_m, 0.0),
+                self.params.map.params(self.params.max_range_m),
                 &p,
                 self.bounds,
                 self.radius_m,

@@ -46,9 +46,8 @@ pub struct MapSpec {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub resolution_m: Option<f64>,
     /// Voxels of the rolling window along x, y, z. Default: the sensor's range, at most
-    /// [`WINDOW_HALF_WIDTH_M`], on each side horizontally; vertically how far above and below
-    /// the sensor sees within its range, at least `LocalMapParams`' 48 voxels and at most
-    /// [`WINDOW_HALF_HEIGHT_M`] on each side.
+    /// [`WINDOW_HALF_WIDTH_M`], on each side horizontally; `LocalMapParams`' 48 voxels
+    /// vertically.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub dims: Option<[usize; 3]>,
     /// Truncation of the distance field (m).
@@ -70,37 +69,21 @@ pub struct MapSpec {
 /// narrower than what the sensor sees slows the vehicle down for nothing.
 pub const WINDOW_HALF_WIDTH_M: f64 = 10.0;
 
-/// Most half-height of the default window (m): 4 m, what the D435 sees above and below its axis
-/// out to 7.2 m (its 58° vertical field of view). A lower window forgets what the camera saw
-/// above the vehicle before it climbs there; back in the window it is unknown, and a vehicle
-/// whose top is unknown may not commit to any way out (E4 with a depth camera, decision
-/// 0052). Map work grows with the window's height.
-pub const WINDOW_HALF_HEIGHT_M: f64 = 4.0;
-
 impl MapSpec {
-    /// `LocalMapParams::default()` with these overrides, for a sensor of range `range_m` that
-    /// sees `reach_up_m` above and below itself within that range.
-    pub fn params(&self, range_m: f64, reach_up_m: f64) -> LocalMapParams {
+    /// `LocalMapParams::default()` with these overrides, for a sensor of range `range_m`.
+    pub fn params(&self, range_m: f64) -> LocalMapParams {
         let d = LocalMapParams::default();
         let resolution_m = self.resolution_m.unwrap_or(d.resolution_m);
         let half = range_m.clamp(0.0, WINDOW_HALF_WIDTH_M);
-        // Out-of-range values are the validation's; here only keep the counts finite.
-        let (across, up) = if resolution_m > 0.0 && resolution_m.is_finite() {
-            let least_up = d.dims[2] as f64 * d.resolution_m / 2.0;
-            let half_up = if reach_up_m.is_nan() {
-                least_up
-            } else {
-                reach_up_m.clamp(least_up, WINDOW_HALF_HEIGHT_M.max(least_up))
-            };
-            // Voxels to cover a span (a span of whole voxels up to rounding is that many).
-            let voxels = |span: f64| ((span / resolution_m - 1e-9).ceil() as usize).clamp(2, 2048);
-            (voxels(2.0 * half), voxels(2.0 * half_up))
+        // Out-of-range values are the validation's; here only keep the count finite.
+        let across = if resolution_m > 0.0 && resolution_m.is_finite() {
+            ((2.0 * half / resolution_m).ceil() as usize).clamp(2, 2048)
         } else {
-            (d.dims[0], d.dims[2])
+            d.dims[0]
         };
         LocalMapParams {
             resolution_m,
-            dims: self.dims.unwrap_or([across, across, up]),
+            dims: self.dims.unwrap_or([across, across, d.dims[2]]),
             max_distance_m: self.max_distance_m.unwrap_or(d.max_distance_m),
             stop_at_visited: self.stop_at_visited.unwrap_or(false),
             ..d
@@ -267,18 +250,11 @@ impl StaticSensing {
             StaticSensing::Known => None,
             StaticSensing::Depth(s) => {
                 let p = s.params();
-                {
-                    let up = p.max_depth_m * (0.5 * p.vfov_rad).sin();
-                    Some((StaticSensor::Depth(p), s.map.params(p.max_depth_m, up)))
-                }
+                Some((StaticSensor::Depth(p), s.map.params(p.max_depth_m)))
             }
             StaticSensing::Lidar(s) => {
                 let p = s.params();
-                {
-                    let steepest = p.min_elevation_rad.abs().max(p.max_elevation_rad.abs());
-                    let up = p.max_range_m * steepest.min(std::f64::consts::FRAC_PI_2).sin();
-                    Some((StaticSensor::Lidar(p), s.map.params(p.max_range_m, up)))
-                }
+                Some((StaticSensor::Lidar(p), s.map.params(p.max_range_m)))
             }
         }
     }
@@ -359,14 +335,8 @@ mod tests {
         let d = parse("static = { depth = {} }").unwrap();
         let (sensor, map) = d.sensor().unwrap();
         assert_eq!(sensor, StaticSensor::Depth(DepthCameraParams::default()));
-        // 10 m on each side, and 4 m up and down (the D435 sees 4.8 m up within its range).
-        assert_eq!(map.dims, [200, 200, 80]);
+        assert_eq!(map.dims, [200, 200, 48]);
         assert_eq!(map.resolution_m, LocalMapParams::default().resolution_m);
-        // A camera that sees less far up gets a lower window, never below the library's.
-        let low = parse("static = { depth = { vfov_rad = 0.5 } }").unwrap();
-        assert_eq!(low.sensor().unwrap().1.dims, [200, 200, 50]);
-        let flat = parse("static = { depth = { vfov_rad = 0.1 } }").unwrap();
-        assert_eq!(flat.sensor().unwrap().1.dims, [200, 200, 48]);
         let d =
             parse("static = { depth = { rate_hz = 15.0, map = { resolution_m = 0.2 } } }").unwrap();
         let (sensor, map) = d.sensor().unwrap();
@@ -377,9 +347,6 @@ mod tests {
             StaticSensor::Lidar(p) => assert_eq!(p.channels, 32),
             other => panic!("{other:?}"),
         }
-        // An explicit window stays as written.
-        let w = parse("static = { lidar = { map = { dims = [40, 40, 20] } } }").unwrap();
-        assert_eq!(w.sensor().unwrap().1.dims, [40, 40, 20]);
         assert!(problems(&d).is_empty());
         assert!(problems(&l).is_empty());
     }
