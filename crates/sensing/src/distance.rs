@@ -629,6 +629,29 @@ mod tests {
         ring.res * (d_occ.sqrt().min(rf) - d_free.sqrt().min(rf))
     }
 
+    /// A window of `dims` voxels from `low`, each occupied with probability `density`, and its
+    /// occupied count per x row.
+    fn random_window(
+        dims: (usize, usize, usize),
+        low: (i64, i64, i64),
+        density: f64,
+        seed: u64,
+    ) -> (Ring, Vec<bool>, Vec<u32>) {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let ring = Ring {
+            dims: [dims.0, dims.1, dims.2],
+            low: [low.0, low.1, low.2],
+            res: 0.1,
+        };
+        let occupied: Vec<bool> = (0..ring.len()).map(|_| rng.random_bool(density)).collect();
+        let rows: Vec<u32> = occupied
+            .chunks(dims.0)
+            .map(|row| row.iter().filter(|&&o| o).count() as u32)
+            .collect();
+        (ring, occupied, rows)
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
@@ -646,14 +669,7 @@ mod tests {
             corner in (0usize..14, 0usize..14, 0usize..10),
             size in (0i64..8, 0i64..8, 0i64..6),
         ) {
-            use rand::{Rng, SeedableRng};
-            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-            let ring = Ring { dims: [dims.0, dims.1, dims.2], low: [low.0, low.1, low.2], res: 0.1 };
-            let occupied: Vec<bool> = (0..ring.len()).map(|_| rng.random_bool(density)).collect();
-            let rows: Vec<u32> = occupied
-                .chunks(dims.0)
-                .map(|row| row.iter().filter(|&&o| o).count() as u32)
-                .collect();
+            let (ring, occupied, rows) = random_window(dims, low, density, seed);
             let c = [low.0 + corner.0 as i64, low.1 + corner.1 as i64, low.2 + corner.2 as i64];
             let target = KeyBox { lo: c, hi: [c[0] + size.0, c[1] + size.1, c[2] + size.2] };
             let inside = |k: &VoxelKey| (0..3).all(|i| k[i] >= target.lo[i] && k[i] <= target.hi[i]);
@@ -692,14 +708,7 @@ mod tests {
             density in 0.85f64..0.995,
             seed in any::<u64>(),
         ) {
-            use rand::{Rng, SeedableRng};
-            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-            let ring = Ring { dims: [dims.0, dims.1, dims.2], low: [low.0, low.1, low.2], res: 0.1 };
-            let occupied: Vec<bool> = (0..ring.len()).map(|_| rng.random_bool(density)).collect();
-            let rows: Vec<u32> = occupied
-                .chunks(dims.0)
-                .map(|row| row.iter().filter(|&&o| o).count() as u32)
-                .collect();
+            let (ring, occupied, rows) = random_window(dims, low, density, seed);
             let mut field = DistanceField::new(ring.len(), r, ring.res);
             field.recompute(&ring, &occupied, Some(&rows), &KeyBox { lo: ring.low, hi: ring.high() });
             let (lo, hi) = (ring.low, ring.high());
