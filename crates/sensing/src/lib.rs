@@ -82,7 +82,7 @@ pub use map::{LocalMap, LocalMapParams, MAX_WINDOW_VOXELS, ScanUpdate};
 pub use memory::{DEFAULT_MEMORY_CELL_M, MAX_MEMORY_CELLS, MapMemory, Unseen};
 pub use occupancy::{LogOddsParams, VoxelState, logit};
 pub use pose::Pose;
-pub use recall::{DEFAULT_RECALL_BLOCKS, RECALL_BLOCK};
+pub use recall::{RECALL_BLOCK, SUGGESTED_RECALL_BLOCKS};
 pub use scan::{RayMeasurement, ReturnKind, Scan};
 pub use sensor::RaySensor;
 pub use traversal::{VoxelKey, VoxelTraversal, voxel_key};

@@ -11,7 +11,7 @@ use crate::error::{SensingError, check_count, check_range};
 use crate::occupancy::{LogOddsParams, VoxelState};
 use crate::pose::Pose;
 use crate::projective::DepthFrame;
-use crate::recall::{DEFAULT_RECALL_BLOCKS, Recall};
+use crate::recall::Recall;
 use crate::ring::{Indexer, Ring, walk};
 use crate::scan::{ReturnKind, Scan};
 use crate::traversal::{VoxelKey, VoxelTraversal, voxel_key};
@@ -231,12 +231,13 @@ impl LocalMap {
             frame: 2,
             touched: Vec::new(),
             pending: None,
-            recall: Recall::new(DEFAULT_RECALL_BLOCKS),
+            recall: Recall::new(0),
         })
     }
 
     /// This map keeping at most `blocks` blocks of [`crate::RECALL_BLOCK`]³ voxels that left
-    /// the window (default [`DEFAULT_RECALL_BLOCKS`]; 0 forgets a voxel as it leaves). Clears
+    /// the window (e.g. [`crate::SUGGESTED_RECALL_BLOCKS`]; the default 0 forgets a voxel as it
+    /// leaves; decision 0053). Clears
     /// what was kept.
     pub fn with_recall_blocks(mut self, blocks: usize) -> Self {
         self.recall = Recall::new(blocks);
@@ -278,8 +279,8 @@ impl LocalMap {
     }
 
     /// Moves the window so that it is centred on `center` (to the voxel). Voxels that stay inside
-    /// keep their state; those that leave are kept aside and come back as they left (up to the
-    /// recall's bound, [`LocalMap::with_recall_blocks`]; beyond it unknown); only the slots that
+    /// keep their state; those that leave are forgotten (unknown when they come back) unless the
+    /// recall is on ([`LocalMap::with_recall_blocks`]: then they come back as they left); only the slots that
     /// change hands are touched, and the distance field is recomputed near the two faces that
     /// moved. Pending occupancy changes are folded into the field first.
     pub fn recentre(&mut self, center: &Vec3) -> Result<(), SensingError> {

@@ -1,14 +1,17 @@
 //! What the rolling window saw before a voxel left it, kept so that the voxel comes back as it
-//! left (decision 0052).
+//! left (decision 0053).
 //!
 //! The [`crate::LocalMap`] window is 4.8 m tall by default: a vehicle that climbs 2.5 m and comes
 //! back down finds the space it saw below unknown again, and the commit check (only known free
 //! space may be committed to) holds it in place until the camera sees that space anew, which a
 //! forward camera never does straight above or below the body. [`Recall`] keeps each leaving
 //! voxel's log-odds in blocks of [`RECALL_BLOCK`]³ voxels and hands it back when the voxel
-//! re-enters. Memory stays bounded: at most [`DEFAULT_RECALL_BLOCKS`] blocks (the oldest block
-//! goes first); a voxel forgotten so comes back unknown, as without the recall. Nothing is
-//! invented: a recalled voxel holds what the sensor reported of it.
+//! re-enters. Memory stays bounded: at most the blocks asked for (the oldest block goes first;
+//! [`SUGGESTED_RECALL_BLOCKS`] is 64 MiB); a voxel forgotten so comes back unknown, as without
+//! the recall. Nothing is invented: a recalled voxel holds what the sensor reported of it.
+//!
+//! Off by default (`LocalMap::with_recall_blocks` turns it on): in flights with the 4.8 m
+//! window it measured worse, not better (decision 0053).
 
 use std::collections::{HashMap, VecDeque};
 use std::hash::{BuildHasherDefault, Hasher};
@@ -20,9 +23,9 @@ pub const RECALL_BLOCK: i64 = 8;
 
 const BLOCK_VOXELS: usize = (RECALL_BLOCK * RECALL_BLOCK * RECALL_BLOCK) as usize;
 
-/// Most blocks kept by default: 32 768 blocks of 2 KiB (64 MiB, 16.8 M voxels: 16 800 m³ at
+/// A bound for an enabled recall: 32 768 blocks of 2 KiB (64 MiB, 16.8 M voxels: 16 800 m³ at
 /// 0.1 m, the last 175 m of a 20 × 4.8 m window's trail).
-pub const DEFAULT_RECALL_BLOCKS: usize = 1 << 15;
+pub const SUGGESTED_RECALL_BLOCKS: usize = 1 << 15;
 
 /// Unknown in a block (a log-odds is always finite).
 const NONE: f32 = f32::NAN;

@@ -10,7 +10,8 @@ use rand_chacha::ChaCha8Rng;
 use trust_geometry::{AaBox, Aabb, Cylinder, Shape, Sphere, StaticMap, Vec3};
 use trust_sensing::{
     DepthCamera, DepthCameraParams, Lidar, LidarParams, LocalMap, LocalMapParams, LogOddsParams,
-    Pose, RayMeasurement, RaySensor, ReturnKind, Scan, SensingError, Truth, VoxelState, logit,
+    Pose, RayMeasurement, RaySensor, ReturnKind, SUGGESTED_RECALL_BLOCKS, Scan, SensingError,
+    Truth, VoxelState, logit,
 };
 
 fn v(x: f64, y: f64, z: f64) -> Vec3 {
@@ -479,7 +480,9 @@ fn rolling_window_recalls_what_left_it() {
         dims: [40, 40, 20],
         ..LocalMapParams::default()
     };
-    let mut map = LocalMap::new(params, &Vec3::zeros()).unwrap();
+    let mut map = LocalMap::new(params, &Vec3::zeros())
+        .unwrap()
+        .with_recall_blocks(SUGGESTED_RECALL_BLOCKS);
     let o = v(0.05, 0.05, 0.05);
     let (a, b) = (v(1.05, 0.05, 0.05), v(-1.55, 0.05, 0.05));
     for _ in 0..3 {
@@ -631,7 +634,7 @@ proptest! {
         };
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let mut center = v(0.1, -0.2, 0.3);
-        let mut map = LocalMap::new(params, &center).unwrap();
+        let mut map = LocalMap::new(params, &center).unwrap().with_recall_blocks(SUGGESTED_RECALL_BLOCKS);
         for step in 0..6 {
             if step % 2 == 1 {
                 center += v(rng.random_range(-0.8..0.8), rng.random_range(-0.8..0.8), rng.random_range(-0.5..0.5));
@@ -669,7 +672,7 @@ proptest! {
         };
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let center = v(0.1, -0.2, 0.3);
-        let mut map = LocalMap::new(params, &center).unwrap();
+        let mut map = LocalMap::new(params, &center).unwrap().with_recall_blocks(SUGGESTED_RECALL_BLOCKS);
         for _ in 0..3 {
             let origin = center + v(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), rng.random_range(-0.3..0.3));
             let rays = (0..rng.random_range(1..40)).map(|_| {
