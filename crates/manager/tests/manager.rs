@@ -809,14 +809,9 @@ fn blind_single_branch_at_room_limits() -> Manager<StraightLine, Blind, Tvd> {
     .unwrap()
 }
 
-/// A ball rolling at a vehicle at rest, twice as fast as the vehicle can fly, its forecast growing
-/// fast: the fallback steps out of its path rather than fleeing along it (judged against
-/// forecasts that grow for ever, every option collided and fleeing, colliding latest, won).
-#[test]
-fn the_fallback_steps_out_of_a_faster_obstacles_path() {
-    let map = open_air();
-    let mut m = blind_single_branch_at_room_limits();
-    let ball = [Forecast::new(
+/// The forecast of a ball 4 m before a vehicle at rest at (50, 0, 5), rolling at it at 2 m/s.
+fn rolling_ball() -> Forecast {
+    Forecast::new(
         ObstacleShape::Sphere,
         Vec3::new(46.0, 0.0, 5.0),
         Vec3::new(2.0, 0.0, 0.0),
@@ -825,7 +820,17 @@ fn the_fallback_steps_out_of_a_faster_obstacles_path() {
         0.2,
         0.6,
     )
-    .unwrap()];
+    .unwrap()
+}
+
+/// A ball rolling at a vehicle at rest, twice as fast as the vehicle can fly, its forecast growing
+/// fast: the fallback steps out of its path rather than fleeing along it (judged against
+/// forecasts that grow for ever, every option collided and fleeing, colliding latest, won).
+#[test]
+fn the_fallback_steps_out_of_a_faster_obstacles_path() {
+    let map = open_air();
+    let mut m = blind_single_branch_at_room_limits();
+    let ball = [rolling_ball()];
     let scene = Scene::new(&map, &ball, 0.0).unwrap();
     let start = State::at_rest(0.0, Vec3::new(50.0, 0.0, 5.0));
     let r = m
@@ -1964,16 +1969,7 @@ fn a_sensed_route_aims_at_its_corner_when_a_remembered_wall_hides_the_rest() {
 #[test]
 fn the_fallback_dodges_into_known_free_space() {
     let map = open_air();
-    let ball = [Forecast::new(
-        ObstacleShape::Sphere,
-        Vec3::new(46.0, 0.0, 5.0),
-        Vec3::new(2.0, 0.0, 0.0),
-        0.0,
-        0.5,
-        0.2,
-        0.6,
-    )
-    .unwrap()];
+    let ball = [rolling_ball()];
     let scene = Scene::new(&map, &ball, 0.0).unwrap();
     let start = State::at_rest(0.0, Vec3::new(50.0, 0.0, 5.0));
     let goal = Vec3::new(95.0, 0.0, 5.0);

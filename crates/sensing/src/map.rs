@@ -358,16 +358,19 @@ impl LocalMap {
         let strides = [1, d[0], d[0] * d[1]];
         let far = self.field.beyond();
         let mut lost = false;
+        let recall = self.recall.is_on();
         let mut key = [0i64; 3];
         key[axis] = k;
         for j in 0..d[a2] {
             key[a2] = self.ring.low[a2] + (j as i64 - self.ring.low[a2]).rem_euclid(d[a2] as i64);
             for i in 0..d[a1] {
-                key[a1] =
-                    self.ring.low[a1] + (i as i64 - self.ring.low[a1]).rem_euclid(d[a1] as i64);
                 let slot = s * strides[axis] + i * strides[a1] + j * strides[a2];
-                let v = self.voxels[slot];
-                self.recall.keep(&key, v.known().then_some(v.0));
+                if recall {
+                    key[a1] =
+                        self.ring.low[a1] + (i as i64 - self.ring.low[a1]).rem_euclid(d[a1] as i64);
+                    let v = self.voxels[slot];
+                    self.recall.keep(&key, v.known().then_some(v.0));
+                }
                 self.voxels[slot] = Voxel::default();
                 self.settled[slot] = false;
                 if self.occupied[slot] {
@@ -383,9 +386,11 @@ impl LocalMap {
     }
 
     fn clear_all(&mut self, new_low: VoxelKey) {
-        for (slot, v) in self.voxels.iter().enumerate() {
-            let key = self.ring.key_of_slot(slot);
-            self.recall.keep(&key, v.known().then_some(v.0));
+        if self.recall.is_on() {
+            for (slot, v) in self.voxels.iter().enumerate() {
+                let key = self.ring.key_of_slot(slot);
+                self.recall.keep(&key, v.known().then_some(v.0));
+            }
         }
         self.voxels.fill(Voxel::default());
         self.settled.fill(false);
@@ -410,6 +415,9 @@ impl LocalMap {
     /// log-odds back; a recalled occupied voxel counts into the occupancy and the pending box,
     /// so that the distance field catches up within its reach.
     fn restore(&mut self, region: &KeyBox) {
+        if self.recall.block_count() == 0 {
+            return;
+        }
         let lo = &self.params.log_odds;
         let ring = self.ring;
         let mut gained: Vec<VoxelKey> = Vec::new();

@@ -96,6 +96,11 @@ impl Recall {
         }
     }
 
+    /// Whether anything is kept (a bound above 0).
+    pub fn is_on(&self) -> bool {
+        self.max_blocks > 0
+    }
+
     /// Blocks held.
     pub fn block_count(&self) -> usize {
         self.blocks.len()
