@@ -405,7 +405,10 @@ pub fn fly(
         busy_until: 0.0,
         worker_since: None,
         unreachable_since: None,
-        map_sensing: map_sensing::MapSensing::new(world)?,
+        map_sensing: match map_sensing::MapSensing::new(world)? {
+            Some(m) => Some(m.with_commit_margin(scenario::tracking_margin_m(world, planner))?),
+            None => None,
+        },
     };
 
     let writer = match &options.log_path {

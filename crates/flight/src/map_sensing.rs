@@ -24,7 +24,10 @@
 //!   r = 0.3 m, decisions 0047–0049) let a vehicle hovering above a slab its camera never saw
 //!   creep down onto it: each scan marked the slab's top voxels free, 0.3 m below the centre,
 //!   and the next plan sank into them (decision 0050). The price: a vehicle beside surfaces
-//!   its camera has not seen (above, below, behind) cannot commit to leave, and holds.
+//!   its camera has not seen (above, below, behind) cannot commit to leave, and holds. Where a
+//!   plan approaches unseen space it keeps the planner's tracking margin beyond the radius
+//!   ([`OnlineMap::with_commit_margin`], decision 0054): at exactly the radius the vehicle's
+//!   tracking error grazed a building face it had not seen.
 //! * **Heading.** A forward-looking camera must look where the vehicle goes: the commanded yaw
 //!   turns toward the direction of the best branch (main, else the best-ranked kept one) one
 //!   second ahead, else toward the goal, at most [`YAW_RATE_RAD_S`]. A known map keeps yaw 0.
@@ -100,6 +103,10 @@ pub struct OnlineMap {
     planner_map: Arc<StaticMap>,
     dirty: bool,
     clearance_m: f64,
+    /// The commit check's margin beyond the clearance (m; [`OnlineMap::with_commit_margin`]).
+    margin_m: f64,
+    /// How far back a stalled vehicle backs off to look ([`KnownFree`]'s `retreat_m`).
+    retreat_m: f64,
     /// The radius of the ball round the vehicle that counts as free at each scan (m): voxel
     /// centres within it have their whole box inside the body.
     body_m: f64,
@@ -143,6 +150,8 @@ impl OnlineMap {
             planner_map,
             dirty: false,
             clearance_m: radius_m,
+            margin_m: 0.0,
+            retreat_m: RETREAT_REACHES * (radius_m + blind_reach_m),
             body_m,
             reach_m,
             body: BodyBall {
@@ -236,6 +245,8 @@ impl OnlineMap {
         Arc::new(KnownFree {
             map: Arc::clone(&self.map),
             clearance_m: self.clearance_m,
+            margin_m: self.margin_m,
+            retreat_m: self.retreat_m,
             body: self.body,
             route: self.memory.as_ref().map(|memory| RouteView {
                 memory: Arc::clone(memory),
@@ -270,6 +281,28 @@ impl OnlineMap {
         Ok(self)
     }
 
+    /// Keeps committed plans `margin_m` beyond the vehicle's radius off space the sensor has
+    /// not observed free, where they approach it (`LocalMap::segment_known_free_with_margin`,
+    /// decision 0054): the flights give the planner's tracking margin, so that the vehicle's
+    /// tracking error cannot carry it into a surface it has not seen. Default 0.
+    ///
+    /// # Errors
+    /// `SensingError` for a margin that is negative or not finite.
+    pub fn with_commit_margin(
+        mut self,
+        margin_m: f64,
+    ) -> Result<Self, trust_sensing::SensingError> {
+        if !(margin_m.is_finite() && margin_m >= 0.0) {
+            return Err(trust_sensing::SensingError::OutOfRange {
+                field: "commit_margin_m".into(),
+                value: margin_m,
+                expected: "finite and >= 0",
+            });
+        }
+        self.margin_m = margin_m;
+        Ok(self)
+    }
+
     /// The surfaces seen, kept for the flight ([`OnlineMap::with_route_memory`]).
     pub fn memory(&self) -> Option<&MapMemory> {
         self.memory.as_deref()
@@ -282,6 +315,19 @@ impl OnlineMap {
 }
 
 impl MapSensing {
+    /// Keeps committed plans `margin_m` beyond the vehicle's radius off unseen space they
+    /// approach ([`OnlineMap::with_commit_margin`]).
+    ///
+    /// # Errors
+    /// `SensingError` for a margin that is negative or not finite.
+    pub fn with_commit_margin(
+        mut self,
+        margin_m: f64,
+    ) -> Result<Self, trust_sensing::SensingError> {
+        self.online = self.online.with_commit_margin(margin_m)?;
+        Ok(self)
+    }
+
     /// The map sensing of a flight through `world`; `None` for `[sensing.static] = "known"`.
     ///
     /// # Errors
@@ -424,11 +470,16 @@ impl MapSensing {
 }
 
 /// The commit check of a sensed map: a segment passes if every voxel within the vehicle's
-/// radius of it is observed free (`LocalMap::segment_known_free`); with a route memory the
-/// route is searched on its own map ([`MapMemory::route_map`]).
+/// radius of it is observed free or inside its body, and it approaches no unseen voxel closer
+/// than the radius plus the margin (`LocalMap::segment_known_free_with_margin`); with a route
+/// memory the route is searched on its own map ([`MapMemory::route_map`]).
 pub struct KnownFree {
     map: Arc<LocalMap>,
     clearance_m: f64,
+    /// Beyond the clearance where a plan approaches unseen space (m).
+    margin_m: f64,
+    /// How far back a stalled vehicle backs off to look (m).
+    retreat_m: f64,
     /// The vehicle's body at the map's last scan.
     body: BodyBall,
     route: Option<RouteView>,
@@ -443,6 +494,12 @@ struct RouteView {
     /// Unknown space beyond this stays free for the route (m).
     reach_m: f64,
 }
+
+/// How far back along its path a stalled vehicle backs off to look at space the commit check
+/// refused (`trust_manager::retreat`), in units of its radius plus the sensor's blind reach for
+/// it: 2 (1.7 m for a 0.3 m vehicle and the D435, whose field then covers ±0.9 m above and
+/// below the place it stalled at, three times the clearance).
+pub const RETREAT_REACHES: f64 = 2.0;
 
 /// How many scans between two folds of the window into the memory: 4 (0.13 s at the
 /// camera's 30 Hz, 0.4 s at the LiDAR's 10 Hz; a pass over the window costs a few
@@ -466,7 +523,11 @@ impl CommitCheck for KnownFree {
 
     fn segment_free(&self, a: &Vec3, b: &Vec3) -> bool {
         self.map
-            .segment_known_free_beside(a, b, self.clearance_m, &self.body)
+            .segment_known_free_with_margin(a, b, self.clearance_m, self.margin_m, &self.body)
+    }
+
+    fn retreat_m(&self) -> Option<f64> {
+        Some(self.retreat_m)
     }
 
     fn route_map(&self, from: &Vec3, goal: &Vec3) -> Option<Arc<StaticMap>> {

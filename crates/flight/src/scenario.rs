@@ -47,6 +47,15 @@ pub fn planner_context(world: &World) -> PlannerContext {
     }
 }
 
+/// The planner's tracking margin for `world` (m): `planner.tracking_margin_m`, else
+/// `trust_planner::tracking_margin_for` the vehicle's `a_max`, as `trust_planner::effective`
+/// sets it.
+pub fn tracking_margin_m(world: &World, planner: &trust_planner::ResolvedPlanner) -> f64 {
+    planner
+        .tracking_margin_m
+        .unwrap_or_else(|| trust_planner::tracking_margin_for(world.limits().a_max))
+}
+
 /// How much a sensed map (`[sensing.static]`) may overestimate the distance to a true static
 /// obstacle (m): half a voxel's diagonal, `√3/2` times the voxel edge (a surface anywhere in an
 /// occupied voxel, the field measured between voxel centres); 0 for a known map.

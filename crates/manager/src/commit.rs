@@ -34,6 +34,11 @@ pub trait CommitCheck: Send + Sync {
         let _ = (from, goal);
         None
     }
+    /// How far back along its path a vehicle stalled before space this check refuses backs
+    /// off to look at it (m; [`crate::retreat`]); `None` (the default) never backs off.
+    fn retreat_m(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// Time between two points of [`committed_stretch`] (s): 20 ms, the safety check's densest

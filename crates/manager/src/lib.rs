@@ -58,6 +58,7 @@ mod manager;
 mod params;
 pub mod progress;
 mod report;
+pub mod retreat;
 pub mod routing;
 pub mod safety;
 
@@ -76,6 +77,7 @@ pub use report::{
     BranchId, BranchReport, CycleTiming, Event, FallbackKind, FallbackReport, FrontendReport,
     GoalUnreachable, LimitExcess, Origin, RouteReason, STUB_FRACTION, StepReport, SwitchReason,
 };
+pub use retreat::FlownPath;
 pub use routing::{
     IN_CYCLE_CHUNKS, RECHECK_S, ROUTE_DEADLINE_FRACTION, ROUTE_WORK_PER_CYCLE, Router,
 };

@@ -229,6 +229,8 @@ pub struct Manager<F, B, H> {
     /// The kind of fallback [`Manager::committed`] is, if it is one (`None` once a branch is
     /// committed): the next fallback may continue it ([`Manager::fallback_options`]).
     committed_fallback: Option<FallbackKind>,
+    /// The path the vehicle flew ([`crate::retreat`]).
+    flown: crate::FlownPath,
     next_id: BranchId,
     cycle_count: u64,
     progress: ProgressMonitor,
@@ -300,6 +302,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             main: None,
             committed: None,
             committed_fallback: None,
+            flown: crate::FlownPath::default(),
             next_id: 0,
             progress: ProgressMonitor::default(),
             route: None,
@@ -494,6 +497,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         self.main = None;
         self.committed = None;
         self.committed_fallback = None;
+        self.flown.clear();
     }
 
     /// Runs one cycle of Algorithm 1 at time `now` with the measured vehicle state (taken at
@@ -922,6 +926,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             .progress
             .rule(&self.limits, self.params.horizon_s);
         let distance = (measured.p - goal).norm();
+        self.flown.record(&measured.p);
         let progress = self.progress_at(&measured.p, goal);
         let stall_event = self.progress.update(now, progress, distance, &rule);
         let newly_stalled = matches!(stall_event, Some(Event::Stalled { .. }));
@@ -1403,6 +1408,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         scene: &Scene<'_>,
         spans: &mut Spans,
     ) -> Option<FallbackReport> {
+        let mut retreat = false;
         if let Some(main) = main.and_then(|id| kept.iter().find(|b| b.id == id)) {
             match self.outside_known_free(&main.solution.traj, cycle) {
                 None => {
@@ -1411,9 +1417,12 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                     self.main = Some(main.id);
                     return None;
                 }
-                Some(t) => cycle
-                    .events
-                    .push(Event::NotKnownFree { branch: main.id, t }),
+                Some(t) => {
+                    cycle
+                        .events
+                        .push(Event::NotKnownFree { branch: main.id, t });
+                    retreat = cycle.stalled;
+                }
             }
         }
         let (start, reanchored) = (cycle.start, cycle.reanchored);
@@ -1422,6 +1431,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                 &start,
                 reanchored,
                 &cycle.rejected,
+                retreat,
                 scene,
                 &mut cycle.events,
             )
@@ -1683,11 +1693,18 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         start: &State,
         reanchored: bool,
         rejected: &[(FallbackKind, PolyTraj)],
+        retreat: bool,
         scene: &Scene<'_>,
         events: &mut Vec<Event>,
     ) -> Option<FallbackReport> {
         let hold_s = self.params.brake_hold();
-        let (mut options, continued) = self.fallback_options(start, reanchored, rejected, hold_s);
+        let (mut options, mut continued) =
+            self.fallback_options(start, reanchored, rejected, hold_s);
+        if retreat {
+            let back = self.retreat_options(start, reanchored, hold_s);
+            continued = continued.map(|i| i + back.len());
+            options.splice(0..0, back);
+        }
         // The options are judged against the forecasts grown for at most a quarter of the
         // horizon (the scene's forecasts already stop growing after `forecast_growth`, 0.25 s
         // by default; this cap matters when that is longer, e.g. the paper's growth for ever)
@@ -1817,6 +1834,43 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             options.extend(dashes.into_iter().map(|t| (FallbackKind::Dash, t)));
         }
         (options, continued)
+    }
+
+    /// The fallback's first options for a vehicle stalled before space its commit check
+    /// refuses ([`crate::retreat`]): the retreat under way flown on (unless re-anchored), then
+    /// manoeuvres to rest at the points of the flown path `d` and `d/2` behind it
+    /// ([`crate::CommitCheck::retreat_m`]). None without a check or a retreat distance.
+    fn retreat_options(
+        &self,
+        start: &State,
+        reanchored: bool,
+        hold_s: f64,
+    ) -> Vec<(FallbackKind, PolyTraj)> {
+        let Some(d) = self.commit_check.as_ref().and_then(|c| c.retreat_m()) else {
+            return Vec::new();
+        };
+        let mut options = Vec::new();
+        if let (Some(FallbackKind::Retreat), Some(plan)) = (
+            self.committed_fallback,
+            self.committed.as_ref().filter(|_| !reanchored),
+        ) && plan.t_end() - hold_s > start.t
+        {
+            options.push((FallbackKind::Retreat, plan.clone()));
+        }
+        for share in [1.0, 0.5] {
+            let Some(to) = self.flown.behind(share * d) else {
+                continue;
+            };
+            let away = to - start.p;
+            let distance = away.norm();
+            if distance < crate::FlownPath::STEP_M {
+                continue;
+            }
+            if let Ok(mut back) = escape_maneuvers(start, &[away], distance, &self.limits, hold_s) {
+                options.extend(back.drain(..).map(|t| (FallbackKind::Retreat, t)));
+            }
+        }
+        options
     }
 
     /// The safety verdict on a fallback option from `start` to its end.

@@ -257,6 +257,8 @@ pub enum FallbackKind {
     Escape,
     /// A dash at 0.9 `v_max` out of the way, then braking ([`crate::dash_maneuvers`]).
     Dash,
+    /// Back along the flown path to look at space the commit check refused ([`crate::retreat`]).
+    Retreat,
 }
 
 impl FallbackKind {
@@ -270,6 +272,7 @@ impl FallbackKind {
             FallbackKind::Evade => "evade",
             FallbackKind::Escape => "escape",
             FallbackKind::Dash => "dash",
+            FallbackKind::Retreat => "retreat",
         }
     }
 }

@@ -8,7 +8,9 @@ use trust_core::{
     StaticMap, TrajRequest, TrajectoryBackend, Vec3,
 };
 use trust_geometry::{AaBox, Shape};
-use trust_manager::{Event, Manager, ManagerParams, Origin, StepReport, check_trajectory};
+use trust_manager::{
+    Event, FallbackKind, Manager, ManagerParams, Origin, StepReport, check_trajectory,
+};
 use trust_minco::UtfMinco;
 use trust_topo_prm::scenes::{SceneParams, random_dynamic_scene};
 use trust_topo_prm::{DevPrm, DevPrmParams, StraightLine, Tvd};
@@ -1786,15 +1788,25 @@ fn without_a_shared_map_or_history_there_is_no_worker() {
 struct KnownUpTo {
     axis: usize,
     max: f64,
+    /// `CommitCheck::retreat_m`.
+    retreat_m: Option<f64>,
 }
 
 impl KnownUpTo {
     fn x(max: f64) -> Self {
-        Self { axis: 0, max }
+        Self {
+            axis: 0,
+            max,
+            retreat_m: None,
+        }
     }
 
     fn y(max: f64) -> Self {
-        Self { axis: 1, max }
+        Self {
+            axis: 1,
+            max,
+            retreat_m: None,
+        }
     }
 }
 
@@ -1806,6 +1818,49 @@ impl trust_manager::CommitCheck for KnownUpTo {
     fn segment_free(&self, a: &Vec3, b: &Vec3) -> bool {
         a[self.axis] <= self.max && b[self.axis] <= self.max
     }
+
+    fn retreat_m(&self) -> Option<f64> {
+        self.retreat_m
+    }
+}
+
+/// A vehicle that stalls before space its check refuses backs off along the way it came (to
+/// let its sensor see that space), when the check names a retreat distance; never without.
+#[test]
+fn a_vehicle_stalled_before_unseen_space_backs_off_to_look() {
+    let map = open_air();
+    let start = State::at_rest(0.0, Vec3::new(5.0, 0.0, 5.0));
+    let goal = Vec3::new(95.0, 0.0, 5.0);
+    let flight = |retreat_m: Option<f64>| {
+        let mut m = planner(ManagerParams::trust());
+        m.set_commit_check(Some(std::sync::Arc::new(KnownUpTo {
+            retreat_m,
+            ..KnownUpTo::x(8.0)
+        })));
+        let reports = fly(&mut m, &map, goal, start, 80, |_| vec![]);
+        let xs: Vec<f64> = reports.iter().map(|r| r.replan_start.p.x).collect();
+        let retreats = reports
+            .iter()
+            .filter(|r| {
+                r.fallback
+                    .as_ref()
+                    .is_some_and(|f| f.along == FallbackKind::Retreat)
+            })
+            .count();
+        (xs, retreats)
+    };
+    let (xs, retreats) = flight(Some(2.0));
+    let farthest = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    assert!(
+        farthest <= 8.0 && farthest > 7.0,
+        "stopped before x = 8: {farthest}"
+    );
+    assert!(retreats > 0);
+    let after = xs.iter().position(|&x| x == farthest).unwrap();
+    let back = xs[after..].iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(farthest - back >= 1.0, "backed off {} m", farthest - back);
+    let (_, retreats) = flight(None);
+    assert_eq!(retreats, 0);
 }
 
 #[test]

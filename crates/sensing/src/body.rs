@@ -111,11 +111,55 @@ impl Piece {
     }
 }
 
-/// True if every point of the cell `[lo, hi]` in `piece` (radius `r`) lies in `body`: the cell
-/// is halved `depth` more times where it straddles both.
-fn cell_in_body(lo: &Vec3, hi: &Vec3, piece: &Piece, r: f64, body: &BodyBall, depth: u32) -> bool {
+/// True if no point of the box `[lo, hi]` lies within `r` of the segment `[a, b]` and farther
+/// than `reach` from `c`: `h(p) = |p − c|² − dist(p, [a, b])²` exceeds `reach² − r²` at every
+/// such point, and `h` is convex (the largest of the functions `|p − c|² − |p − q|²`, linear
+/// in `p`, over the segment's points `q`), so the box's corners bound it. Exact where the
+/// body's surface cuts the tube at a shallow angle, where halving the box cannot resolve it.
+fn tube_beyond_excluded(
+    lo: &Vec3,
+    hi: &Vec3,
+    a: &Vec3,
+    b: &Vec3,
+    r: f64,
+    c: &Vec3,
+    reach: f64,
+) -> bool {
+    let bound = reach * reach - r * r;
+    (0..8).all(|corner: usize| {
+        let x = Vec3::from_fn(|i, _| if corner >> i & 1 == 1 { hi[i] } else { lo[i] });
+        (x - c).norm_squared() - dist_to_segment(&x, a, b).powi(2) <= bound
+    })
+}
+
+/// The segment, the clearance and the body a cell is judged for.
+struct Tube<'a> {
+    a: &'a Vec3,
+    b: &'a Vec3,
+    r: f64,
+    body: &'a BodyBall,
+    /// How far beyond the body's surface the tube may reach (m).
+    hover_m: f64,
+}
+
+/// True if every point of the cell `[lo, hi]` in `piece` (radius `tube.r`) lies in the body
+/// (grown by `tube.hover_m` for [`tube_beyond_excluded`]): the cell is halved `depth` more
+/// times where it straddles both.
+fn cell_in_body(lo: &Vec3, hi: &Vec3, piece: &Piece, tube: &Tube<'_>, depth: u32) -> bool {
+    let (r, body) = (tube.r, tube.body);
     let (m, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
-    if piece.misses(&m, &half, r) || far2_to_box(&body.center, lo, hi) <= body.radius.powi(2) {
+    if piece.misses(&m, &half, r)
+        || far2_to_box(&body.center, lo, hi) <= body.radius.powi(2)
+        || tube_beyond_excluded(
+            lo,
+            hi,
+            tube.a,
+            tube.b,
+            r,
+            &body.center,
+            body.radius + tube.hover_m,
+        )
+    {
         return true;
     }
     if depth == 0 || dist2_to_box(&body.center, lo, hi) >= body.radius.powi(2) {
@@ -125,7 +169,7 @@ fn cell_in_body(lo: &Vec3, hi: &Vec3, piece: &Piece, r: f64, body: &BodyBall, de
         let pick = |i: usize| octant >> i & 1 == 1;
         let l = Vec3::from_fn(|i, _| if pick(i) { m[i] } else { lo[i] });
         let h = Vec3::from_fn(|i, _| if pick(i) { hi[i] } else { m[i] });
-        cell_in_body(&l, &h, piece, r, body, depth - 1)
+        cell_in_body(&l, &h, piece, tube, depth - 1)
     })
 }
 
@@ -133,8 +177,9 @@ fn cell_in_body(lo: &Vec3, hi: &Vec3, piece: &Piece, r: f64, body: &BodyBall, de
 /// `body`, up to `hover_m` (conservative otherwise). The tube is the balls round the ends and
 /// the cylinder between them; a ball round an end within `hover_m` of the body's centre counts
 /// as the body (a vehicle holding its place: the plan's start and the measured position differ
-/// by the tracking error). The box is halved [`SPLIT_DEPTH`] times where a piece and the body's
-/// surface both cross it.
+/// by the tracking error), and so does the tube's part within `hover_m` of the body's surface
+/// where a convexity bound shows it (`tube_beyond_excluded`). The box is halved
+/// [`SPLIT_DEPTH`] times where a piece and the body's surface both cross it.
 pub fn tube_part_in_body(
     lo: &Vec3,
     hi: &Vec3,
@@ -155,6 +200,13 @@ pub fn tube_part_in_body(
     if dist2_to_box(&body.center, lo, hi) >= body.radius.powi(2) {
         return false;
     }
+    let tube = Tube {
+        a,
+        b,
+        r,
+        body,
+        hover_m,
+    };
     let mut pieces = Vec::with_capacity(3);
     for p in [a, b] {
         if !held(p) {
@@ -166,7 +218,36 @@ pub fn tube_part_in_body(
     }
     pieces
         .iter()
-        .all(|piece| cell_in_body(lo, hi, piece, r, body, SPLIT_DEPTH))
+        .all(|piece| cell_in_body(lo, hi, piece, &tube, SPLIT_DEPTH))
+}
+
+/// True if a plan along `[a, b]` may pass the box `[lo, hi]`, which the vehicle has not
+/// observed free, keeping `clearance` (its radius) and a tracking `margin` beyond it: the
+/// part of the box within `clearance` of the segment lies in `body` ([`tube_part_in_body`]),
+/// and the segment comes within `clearance + margin` of the box only if it comes no nearer
+/// to it than the body's centre is, up to `hover_m`. A vehicle beside unseen space may hold
+/// its place or leave it, but not approach it closer than the margin: a plan that hugs what
+/// the sensor has not seen leaves no room for the vehicle's tracking error (decision 0054).
+/// With `margin` 0 this is [`tube_part_in_body`].
+#[allow(clippy::too_many_arguments)]
+pub fn unseen_box_passable(
+    lo: &Vec3,
+    hi: &Vec3,
+    a: &Vec3,
+    b: &Vec3,
+    clearance: f64,
+    margin: f64,
+    body: &BodyBall,
+    hover_m: f64,
+) -> bool {
+    let d = segment_box_distance(a, b, lo, hi);
+    if d > clearance + margin {
+        return true;
+    }
+    if margin > 0.0 && d + hover_m < dist2_to_box(&body.center, lo, hi).sqrt() {
+        return false;
+    }
+    tube_part_in_body(lo, hi, a, b, clearance, body, hover_m)
 }
 
 #[cfg(test)]
@@ -231,6 +312,29 @@ mod tests {
     }
 
     #[test]
+    fn a_plan_rising_off_an_unseen_voxel_below_may_leave() {
+        // Hovering 3 mm off its plan above a voxel its camera never saw (the body's surface
+        // cuts it 1 mm below its top), the plan rises and slides away: the tube stays in the
+        // body there, although halving the box cannot show it (measured in a flight that
+        // stalled 50 s on it).
+        let me = body(Vec3::zeros(), 0.3);
+        let (lo, hi) = (v(-0.127, -0.057, -0.342), v(-0.027, 0.043, -0.292));
+        let a = v(-0.0001, -0.0033, 0.0004);
+        let b = v(-0.0002, -0.0056, 0.0012);
+        assert!(tube_part_in_body(&lo, &hi, &a, &b, 0.3, &me, 0.005));
+        // Sinking 1 cm towards it is refused.
+        assert!(!tube_part_in_body(
+            &lo,
+            &hi,
+            &a,
+            &v(0.0, 0.0, -0.01),
+            0.3,
+            &me,
+            0.005
+        ));
+    }
+
+    #[test]
     fn a_box_out_of_reach_needs_no_body() {
         let far = body(v(10.0, 10.0, 10.0), 0.0);
         let (lo, hi) = (v(1.0, 1.0, 1.0), v(1.1, 1.1, 1.1));
@@ -276,8 +380,67 @@ mod tests {
         assert!((segment_box_distance(&p, &p, &lo, &hi) - 2f64.sqrt()).abs() < 1e-12);
     }
 
+    #[test]
+    fn the_margin_keeps_a_plan_off_unseen_space_it_approaches() {
+        // A 0.3 m vehicle, an unseen box 2 cm beyond its clearance on +x, a 3 cm margin.
+        let me = body(v(0.0, 0.0, 0.0), 0.3);
+        let (lo, hi) = (v(0.32, -0.05, -0.05), v(0.42, 0.05, 0.05));
+        let c = me.center;
+        let pass =
+            |a: &Vec3, b: &Vec3, m: f64| unseen_box_passable(&lo, &hi, a, b, 0.3, m, &me, HOVER);
+        // Holding its place or leaving: allowed.
+        assert!(pass(&c, &c, 0.03));
+        assert!(pass(&c, &v(-0.5, 0.0, 0.0), 0.03));
+        // Along its face: no nearer to this box (the boxes ahead on the face are approached).
+        assert!(pass(&c, &v(0.0, 0.4, 0.0), 0.03));
+        // 1 cm nearer: refused with the margin, allowed without it (the tube keeps the
+        // clearance); 3 cm nearer the tube itself reaches the box.
+        let nearer = v(0.01, 0.0, 0.0);
+        assert!(!pass(&c, &nearer, 0.03));
+        assert!(pass(&c, &nearer, 0.0));
+        assert!(!pass(&c, &v(0.03, 0.0, 0.0), 0.0));
+        // Farther than clearance + margin: no question.
+        let away = body(v(-0.1, 0.0, 0.0), 0.3);
+        assert!(unseen_box_passable(
+            &lo,
+            &hi,
+            &away.center,
+            &v(-0.1, 1.0, 0.0),
+            0.3,
+            0.03,
+            &away,
+            HOVER
+        ));
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(96))]
+
+        /// With the margin, a passed box lies beyond `clearance + margin` of the segment or
+        /// no nearer to it than to the body's centre; with margin 0 the rule is the body's.
+        #[test]
+        fn the_margin_only_refuses_approaches(
+            c in prop::array::uniform3(-0.2f64..0.2),
+            d in prop::array::uniform3(-0.3f64..0.3),
+            corner in prop::array::uniform3(-0.6f64..0.5),
+            r in 0.05f64..0.4,
+            m in 0.0f64..0.05,
+        ) {
+            let me = body(v(c[0], c[1], c[2]), r);
+            let (a, b) = (me.center, me.center + v(d[0], d[1], d[2]));
+            let lo = v(corner[0], corner[1], corner[2]);
+            let hi = lo + v(0.1, 0.1, 0.1);
+            let passed = unseen_box_passable(&lo, &hi, &a, &b, r, m, &me, HOVER);
+            let seg = segment_box_distance(&a, &b, &lo, &hi);
+            if passed {
+                prop_assert!(seg > r + m || seg + HOVER >= dist2_to_box(&me.center, &lo, &hi).sqrt());
+                prop_assert!(tube_part_in_body(&lo, &hi, &a, &b, r, &me, HOVER));
+            }
+            prop_assert_eq!(
+                unseen_box_passable(&lo, &hi, &a, &b, r, 0.0, &me, HOVER),
+                tube_part_in_body(&lo, &hi, &a, &b, r, &me, HOVER)
+            );
+        }
 
         /// Sound: when the test accepts, no grid point of the box within the clearance of the
         /// segment lies outside the body (grown by the hover tolerance).

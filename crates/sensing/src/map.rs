@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 use trust_geometry::{Aabb, Esdf, StaticMap, Vec3};
 
-use crate::body::{BodyBall, HOVER_VOXELS, tube_part_in_body};
+use crate::body::{BodyBall, HOVER_VOXELS, unseen_box_passable};
 use crate::camera::DepthCamera;
 use crate::distance::{DistanceField, KeyBox, runs};
 use crate::error::{SensingError, check_count, check_range};
@@ -879,7 +879,7 @@ impl LocalMap {
     /// leaving the window, or a clearance above 16 voxels (the check would cost too much; ask
     /// the distance field instead). A negative clearance counts as 0.
     pub fn segment_known_free(&self, a: &Vec3, b: &Vec3, clearance: f64) -> bool {
-        self.segment_free_of(a, b, clearance, None)
+        self.segment_free_of(a, b, clearance, 0.0, None)
     }
 
     /// [`LocalMap::segment_known_free`] for a vehicle whose body fills `body`: a voxel not
@@ -895,10 +895,43 @@ impl LocalMap {
         clearance: f64,
         body: &BodyBall,
     ) -> bool {
-        self.segment_free_of(a, b, clearance, body.is_valid().then_some(body))
+        self.segment_known_free_with_margin(a, b, clearance, 0.0, body)
     }
 
-    fn segment_free_of(&self, a: &Vec3, b: &Vec3, clearance: f64, body: Option<&BodyBall>) -> bool {
+    /// [`LocalMap::segment_known_free_beside`] with a tracking `margin` (m) beyond the
+    /// clearance: a voxel not observed free within `clearance + margin` of the segment also
+    /// fails when the segment comes nearer to it than the body's centre is — the vehicle may
+    /// hold its place beside unseen space, or leave it, but not approach it closer than the
+    /// margin (decision 0054). False for a NaN margin; a negative one counts as 0. Without a
+    /// valid `body` every voxel within `clearance + margin` must be observed free.
+    pub fn segment_known_free_with_margin(
+        &self,
+        a: &Vec3,
+        b: &Vec3,
+        clearance: f64,
+        margin: f64,
+        body: &BodyBall,
+    ) -> bool {
+        if margin.is_nan() {
+            return false;
+        }
+        self.segment_free_of(
+            a,
+            b,
+            clearance,
+            margin.max(0.0),
+            body.is_valid().then_some(body),
+        )
+    }
+
+    fn segment_free_of(
+        &self,
+        a: &Vec3,
+        b: &Vec3,
+        clearance: f64,
+        margin: f64,
+        body: Option<&BodyBall>,
+    ) -> bool {
         if clearance.is_nan() {
             return false;
         }
@@ -907,8 +940,8 @@ impl LocalMap {
             return false;
         }
         let res = self.ring.res;
-        let r = clearance.max(0.0) / res;
-        if r > 16.0 {
+        let r = (clearance.max(0.0) + margin) / res;
+        if r.is_nan() || r > 16.0 {
             return false;
         }
         let offsets = ball_offsets(r);
@@ -926,7 +959,7 @@ impl LocalMap {
                 let centre = self.ring.center(&q);
                 let (lo, hi) = (centre - half, centre + half);
                 let hover = HOVER_VOXELS * res;
-                if !tube_part_in_body(&lo, &hi, a, b, clearance.max(0.0), body, hover) {
+                if !unseen_box_passable(&lo, &hi, a, b, clearance.max(0.0), margin, body, hover) {
                     return false;
                 }
                 cleared.push(q);
@@ -1253,6 +1286,27 @@ mod tests {
         let (map, c) = ball_known(0.4);
         assert!(!map.segment_known_free(&c, &c, 0.3));
         assert!(map.segment_known_free(&c, &c, 0.2));
+    }
+
+    #[test]
+    fn the_margin_refuses_approaching_unseen_space_not_holding_beside_it() {
+        let (map, c) = ball_known(0.55);
+        let me = BodyBall {
+            center: c,
+            radius: 0.3,
+        };
+        let ahead = c + Vec3::new(0.1, 0.0, 0.0);
+        // Without a margin the tube keeps its 0.3 m off the unknown voxels (the nearest is
+        // 0.45 m ahead of the plan's end); with 0.15 m it approaches one closer than 0.45 m.
+        assert!(map.segment_known_free_with_margin(&c, &ahead, 0.3, 0.0, &me));
+        assert!(map.segment_known_free_beside(&c, &ahead, 0.3, &me));
+        assert!(!map.segment_known_free_with_margin(&c, &ahead, 0.3, 0.15, &me));
+        // Holding its place beside them passes with any margin.
+        assert!(map.segment_known_free_with_margin(&c, &c, 0.3, 0.15, &me));
+        assert!(map.segment_known_free_with_margin(&c, &c, 0.3, 0.5, &me));
+        // A NaN margin fails; a negative one is 0.
+        assert!(!map.segment_known_free_with_margin(&c, &c, 0.3, f64::NAN, &me));
+        assert!(map.segment_known_free_with_margin(&c, &ahead, 0.3, -1.0, &me));
     }
 
     #[test]
