@@ -426,7 +426,12 @@ fn plan(
         Some(m) => {
             state.manager.set_commit_check(None);
             let p = state.vehicle.state().p;
-            m.aim(t, &p, &params.goal, &state.manager);
+            let refused = stepped.as_ref().is_ok_and(|r| {
+                r.events
+                    .iter()
+                    .any(|e| matches!(e, trust_manager::Event::NotKnownFree { .. }))
+            });
+            m.aim(t, &p, &params.goal, &state.manager, refused);
             Some(m.take_map_ms())
         }
         None => None,

@@ -63,6 +63,10 @@ use crate::FlightError;
 /// yaw rate in its autonomous modes (`MPC_YAWRAUTO_MAX`).
 pub const YAW_RATE_RAD_S: f64 = std::f64::consts::FRAC_PI_4;
 
+/// How long every plan may be refused by the commit check before the camera looks around
+/// ([`MapSensing::aim`]): 1 s.
+pub const LOOK_AROUND_AFTER_S: f64 = 1.0;
+
 /// How far ahead along the best branch the camera looks (s).
 pub const LOOK_AHEAD_S: f64 = 1.0;
 
@@ -84,6 +88,8 @@ pub struct MapSensing {
     yaw: f64,
     /// The yaw it turns toward (rad).
     target_yaw: f64,
+    /// Since when every cycle's main branch has been refused by the commit check (s).
+    refused_since: Option<f64>,
 }
 
 /// The map half of [`MapSensing`], shared with any other source of scans (the ROS 2 node's
@@ -378,6 +384,7 @@ impl MapSensing {
             scan: Scan::default(),
             next_t: 0.0,
             yaw,
+            refused_since: None,
             target_yaw: if goal.xy().norm() > 1e-9 {
                 goal.y.atan2(goal.x)
             } else {
@@ -443,8 +450,17 @@ impl MapSensing {
     }
 
     /// Points the camera after a cycle: toward the best branch one [`LOOK_AHEAD_S`] ahead of
-    /// `t`, else toward `goal` (unchanged when the vehicle is above either).
-    pub fn aim(&mut self, t: f64, p: &Vec3, goal: &Vec3, manager: &AnyManager) {
+    /// `t`, else toward `goal` (unchanged when the vehicle is above either). When the cycle's
+    /// main branch was `refused` by the commit check, and every cycle's since
+    /// [`LOOK_AROUND_AFTER_S`], it turns on instead: the space beside and behind a vehicle held
+    /// in place is what its plans need seen (a full turn in 8 s at [`YAW_RATE_RAD_S`]).
+    pub fn aim(&mut self, t: f64, p: &Vec3, goal: &Vec3, manager: &AnyManager, refused: bool) {
+        if !refused {
+            self.refused_since = None;
+        } else if t - *self.refused_since.get_or_insert(t) >= LOOK_AROUND_AFTER_S {
+            self.target_yaw = self.yaw + std::f64::consts::FRAC_PI_2;
+            return;
+        }
         let best = manager
             .main()
             .and_then(|id| manager.branches().iter().find(|b| b.id == id))

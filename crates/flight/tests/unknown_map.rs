@@ -196,6 +196,81 @@ fn the_commit_check_lets_a_vehicle_hold_its_place_and_not_creep() {
     assert!(!check.segment_free(&start, &(start + Vec3::new(2.0, 0.0, 0.0))));
 }
 
+/// The commit margin: a plan may approach unseen space no nearer than the radius plus the
+/// margin, and a vehicle may still hold its place beside it.
+#[test]
+fn the_commit_margin_keeps_plans_off_unseen_space_they_approach() {
+    use trust_core::{Aabb, Vec3};
+    use trust_flight::map_sensing::OnlineMap;
+    let bounds = Aabb::new(Vec3::zeros(), Vec3::new(20.0, 20.0, 10.0)).unwrap();
+    let params = trust_sensing::LocalMapParams::default();
+    let start = Vec3::new(10.0, 10.0, 5.0);
+    let check = |margin: f64| {
+        let mut online = OnlineMap::new(params, &start, bounds, 0.3, 0.54)
+            .unwrap()
+            .with_commit_margin(margin)
+            .unwrap();
+        online
+            .insert(&trust_sensing::Scan::default(), &start)
+            .unwrap();
+        online.commit_check()
+    };
+    // The take-off ball (1.01 m) holds a 0.3 m tube 0.5 m out, not one of 0.55 m.
+    let out = start + Vec3::new(0.5, 0.0, 0.0);
+    assert!(check(0.0).segment_free(&start, &out));
+    assert!(!check(0.25).segment_free(&start, &out));
+    assert!(check(0.25).segment_free(&start, &start));
+    for bad in [-0.01, f64::NAN, f64::INFINITY] {
+        assert!(
+            OnlineMap::new(params, &start, bounds, 0.3, 0.54)
+                .unwrap()
+                .with_commit_margin(bad)
+                .is_err(),
+            "{bad}"
+        );
+    }
+}
+
+/// A camera whose vehicle's every plan has been refused for a second turns to look around;
+/// otherwise it looks toward the goal (no branch yet).
+#[test]
+fn a_camera_held_before_refused_space_looks_around() {
+    use trust_core::Vec3;
+    let s = scene();
+    let world = World::build(&s).expect("world");
+    let manager = trust_flight::set_up(&world, &trust_flight::scenario::resolve_planner(&s))
+        .expect("set up")
+        .manager;
+    let sensing = || MapSensing::new(&world).expect("sensing").expect("sensed");
+    let (p, goal) = (Vec3::new(1.0, 2.0, 1.5), Vec3::new(1.0, 5.0, 1.5));
+    // Toward the goal (+y, 90°), turned at 45°/s for 4 s.
+    let fly = |m: &mut MapSensing, refused: &dyn Fn(f64) -> bool| {
+        let mut yaw = 0.0;
+        for k in 0..400 {
+            let t = 0.01 * f64::from(k);
+            if k % 10 == 0 {
+                m.aim(t, &p, &goal, &manager, refused(t));
+            }
+            yaw = m.turn(0.01);
+        }
+        yaw
+    };
+    let toward = fly(&mut sensing(), &|_| false);
+    assert!(
+        (toward - std::f64::consts::FRAC_PI_2).abs() < 1e-9,
+        "{toward}"
+    );
+    // Refused throughout: toward the goal for the first second, then on round: past it.
+    let around = fly(&mut sensing(), &|_| true);
+    assert!(!(-1.0..=2.0).contains(&around), "{around}");
+    // Refused only now and then: never a second in a row, so it looks toward the goal.
+    let blinking = fly(&mut sensing(), &|t| (t * 10.0).round() as i64 % 5 == 0);
+    assert!(
+        (blinking - std::f64::consts::FRAC_PI_2).abs() < 1e-9,
+        "{blinking}"
+    );
+}
+
 /// `scenarios/unknown-variants/` is the suite's static variants sensed: each file is its
 /// `scenarios/variants/` namesake, a two-line header before it and the depth camera after it.
 #[test]

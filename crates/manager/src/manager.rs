@@ -171,6 +171,11 @@ fn narrowly_unsafe(v: &SafetyVerdict, margin: f64) -> bool {
         }
 }
 
+/// How long every main branch may be refused by the commit check with the vehicle at rest
+/// before the flight counts as stalled, as a fraction of the progress monitor's window: ¼
+/// (0.5 s at E4's 4 s horizon).
+const REFUSED_STALL_FRACTION: f64 = 0.25;
+
 /// The multi-branch spatio-temporal trajectory manager (paper Sec. III-A, Algorithm 1), generic
 /// over the frontend `F`, the backend `B` and the homotopy checker `H`.
 ///
@@ -231,6 +236,9 @@ pub struct Manager<F, B, H> {
     committed_fallback: Option<FallbackKind>,
     /// The path the vehicle flew ([`crate::retreat`]).
     flown: crate::FlownPath,
+    /// Since when (the replan start's time) every main branch has been refused by the commit
+    /// check with the vehicle at rest.
+    refused_since: Option<f64>,
     next_id: BranchId,
     cycle_count: u64,
     progress: ProgressMonitor,
@@ -303,6 +311,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             committed: None,
             committed_fallback: None,
             flown: crate::FlownPath::default(),
+            refused_since: None,
             next_id: 0,
             progress: ProgressMonitor::default(),
             route: None,
@@ -498,6 +507,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         self.committed = None;
         self.committed_fallback = None;
         self.flown.clear();
+        self.refused_since = None;
     }
 
     /// Runs one cycle of Algorithm 1 at time `now` with the measured vehicle state (taken at
@@ -928,7 +938,16 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
         let distance = (measured.p - goal).norm();
         self.flown.record(&measured.p);
         let progress = self.progress_at(&measured.p, goal);
-        let stall_event = self.progress.update(now, progress, distance, &rule);
+        let mut stall_event = self.progress.update(now, progress, distance, &rule);
+        // Refused at rest for a quarter of the stall window: no plan will take it on from
+        // here, and waiting out the window only wastes it (`crate::retreat`).
+        if stall_event.is_none()
+            && self
+                .refused_since
+                .is_some_and(|since| start.t - since >= REFUSED_STALL_FRACTION * rule.window_s)
+        {
+            stall_event = self.progress.declare_stalled(now, progress, distance);
+        }
         let newly_stalled = matches!(stall_event, Some(Event::Stalled { .. }));
         events.extend(stall_event);
         let stalled = self.progress.stalled();
@@ -1415,6 +1434,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                     self.committed = Some(main.solution.traj.clone());
                     self.committed_fallback = None;
                     self.main = Some(main.id);
+                    self.refused_since = None;
                     return None;
                 }
                 Some(t) => {
@@ -1422,6 +1442,11 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                         .events
                         .push(Event::NotKnownFree { branch: main.id, t });
                     retreat = cycle.stalled;
+                    if cycle.start.v.norm() > REST_SPEED_FRACTION * self.limits.v_max {
+                        self.refused_since = None;
+                    } else if self.refused_since.is_none() {
+                        self.refused_since = Some(cycle.start.t);
+                    }
                 }
             }
         }
@@ -1838,8 +1863,9 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
 
     /// The fallback's first options for a vehicle stalled before space its commit check
     /// refuses ([`crate::retreat`]): the retreat under way flown on (unless re-anchored), then
-    /// manoeuvres to rest at the points of the flown path `d` and `d/2` behind it
-    /// ([`crate::CommitCheck::retreat_m`]). None without a check or a retreat distance.
+    /// manoeuvres to rest at the points back along the flown path `d` and `d/2` from it
+    /// horizontally ([`crate::CommitCheck::retreat_m`]). None without a check or a retreat
+    /// distance.
     fn retreat_options(
         &self,
         start: &State,
@@ -1858,7 +1884,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             options.push((FallbackKind::Retreat, plan.clone()));
         }
         for share in [1.0, 0.5] {
-            let Some(to) = self.flown.behind(share * d) else {
+            let Some(to) = self.flown.behind(&start.p, share * d) else {
                 continue;
             };
             let away = to - start.p;

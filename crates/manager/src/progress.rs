@@ -107,6 +107,37 @@ impl ProgressMonitor {
     }
 }
 
+impl ProgressMonitor {
+    /// Declares the flight stalled at time `t` with progress `progress_m` (m), whatever the
+    /// rate (the manager knows the vehicle cannot go on: its every plan is refused), and
+    /// returns [`Event::Stalled`] with the rate over the samples held; `None` if it already is
+    /// or the input is not finite.
+    pub fn declare_stalled(
+        &mut self,
+        t: f64,
+        progress_m: f64,
+        distance_to_goal_m: f64,
+    ) -> Option<Event> {
+        if self.stalled()
+            || !(t.is_finite() && progress_m.is_finite() && distance_to_goal_m.is_finite())
+        {
+            return None;
+        }
+        let (t0, p0) = self.samples.front().copied().unwrap_or((t, progress_m));
+        let span = t - t0;
+        self.stalled_at = Some((t, progress_m));
+        Some(Event::Stalled {
+            progress_mps: if span > 0.0 {
+                (progress_m - p0) / span
+            } else {
+                0.0
+            },
+            window_s: span.max(0.0),
+            distance_to_goal_m,
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -177,5 +208,25 @@ mod tests {
         };
         let e = p.validate().unwrap_err().to_string();
         assert!(e.contains("manager.progress.stall_speed_fraction"), "{e}");
+    }
+
+    #[test]
+    fn a_declared_stall_lasts_until_the_vehicle_progresses() {
+        let r = rule();
+        let mut m = ProgressMonitor::default();
+        assert!(m.update(0.0, 0.0, 50.0, &r).is_none());
+        assert!(m.update(0.3, 0.3, 49.7, &r).is_none());
+        assert!(matches!(
+            m.declare_stalled(0.5, 0.4, 49.6),
+            Some(Event::Stalled { progress_mps, .. }) if (progress_mps - 0.8).abs() < 1e-9
+        ));
+        assert!(m.stalled());
+        assert!(m.declare_stalled(0.6, 0.4, 49.6).is_none(), "once");
+        assert!(m.update(1.0, 1.0, 49.0, &r).is_none());
+        assert!(matches!(
+            m.update(1.5, 1.5, 48.5, &r),
+            Some(Event::Escaped { .. })
+        ));
+        assert!(m.declare_stalled(f64::NAN, 0.0, 1.0).is_none());
     }
 }

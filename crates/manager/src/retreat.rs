@@ -8,9 +8,9 @@
 //!
 //! The manager records the path the vehicle flew ([`FlownPath`]); when it is stalled and its
 //! main branch fails the commit check, the fallback's first options are short manoeuvres to
-//! rest at points of that path `d` and `d/2` behind the vehicle (`d` from
-//! [`crate::CommitCheck::retreat_m`]), judged like every option (clear of the forecasts, in
-//! known free space).
+//! rest at the points back along that path `d` and `d/2` from the vehicle horizontally (`d`
+//! from [`crate::CommitCheck::retreat_m`]), judged like every option (clear of the forecasts,
+//! in known free space).
 
 use std::collections::VecDeque;
 
@@ -67,24 +67,43 @@ impl FlownPath {
         }
     }
 
-    /// The point of the path `distance_m` behind its end, measured along it (the first point
-    /// if the path is shorter); `None` for an empty path or a distance that is not positive.
-    pub fn behind(&self, distance_m: f64) -> Option<Vec3> {
+    /// Walking back along the path from its end, the first point `distance_m` from `from`
+    /// horizontally (interpolated on the path), or the path's point horizontally farthest from
+    /// `from` if none is that far; `None` for an empty path or a distance that is not
+    /// positive. Horizontally: a forward camera or a spinning LiDAR sees above and below a
+    /// place from beside it, not from under or over it (a vehicle that climbed to where it
+    /// stalled sees nothing new from lower down its path).
+    pub fn behind(&self, from: &Vec3, distance_m: f64) -> Option<Vec3> {
         if distance_m.is_nan() || distance_m <= 0.0 {
             return None;
         }
-        let mut walked = 0.0;
+        let away = |p: &Vec3| (p - from).xy().norm();
         let mut points = self.points.iter().rev();
         let mut here = *points.next()?;
+        let mut farthest = here;
+        if away(&here) >= distance_m {
+            return Some(here);
+        }
         for &p in points {
-            let step = (p - here).norm();
-            if walked + step >= distance_m {
-                return Some(here + (p - here) * ((distance_m - walked) / step));
+            if away(&p) >= distance_m {
+                // The horizontal distance crosses `distance_m` on [here, p]: bisect.
+                let (mut lo, mut hi) = (0.0, 1.0);
+                for _ in 0..40 {
+                    let mid = 0.5 * (lo + hi);
+                    if away(&(here + (p - here) * mid)) >= distance_m {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                return Some(here + (p - here) * hi);
             }
-            walked += step;
+            if away(&p) > away(&farthest) {
+                farthest = p;
+            }
             here = p;
         }
-        Some(here)
+        Some(farthest)
     }
 }
 
@@ -97,23 +116,24 @@ mod tests {
     }
 
     #[test]
-    fn the_path_is_measured_back_from_its_end() {
+    fn the_retreat_point_is_found_back_along_the_path_beside_the_vehicle() {
         let mut path = FlownPath::default();
-        assert_eq!(path.behind(1.0), None);
+        let end = v(2.0, 0.0, 1.0);
+        assert_eq!(path.behind(&end, 1.0), None);
         for k in 0..=20 {
             path.record(&v(0.1 * k as f64, 0.0, 0.0));
         }
-        // Round a corner: 1 m up from (2, 0, 0).
+        // Round a corner: 1 m straight up from (2, 0, 0).
         for k in 1..=10 {
             path.record(&v(2.0, 0.0, 0.1 * k as f64));
         }
-        let p = path.behind(1.5).unwrap();
+        // 0.5 m beside the vehicle: back down the climb and 0.5 m along the first leg.
+        let p = path.behind(&end, 0.5).unwrap();
         assert!((p - v(1.5, 0.0, 0.0)).norm() < 1e-9, "{p:?}");
-        assert!((path.behind(0.25).unwrap() - v(2.0, 0.0, 0.75)).norm() < 1e-9);
-        // Longer than the path: its start.
-        assert_eq!(path.behind(100.0), Some(v(0.0, 0.0, 0.0)));
-        assert_eq!(path.behind(0.0), None);
-        assert_eq!(path.behind(f64::NAN), None);
+        // Farther than the path reaches: its farthest point.
+        assert_eq!(path.behind(&end, 100.0), Some(v(0.0, 0.0, 0.0)));
+        assert_eq!(path.behind(&end, 0.0), None);
+        assert_eq!(path.behind(&end, f64::NAN), None);
     }
 
     #[test]
@@ -130,7 +150,8 @@ mod tests {
         assert!((ends.last().unwrap() - v(2.0, 0.0, 0.0)).norm() < 0.1 + 1e-9);
         assert!(ends.iter().all(|p| p.x <= 2.0 + 0.1 + 1e-9));
         path.record(&v(2.0, 0.5, 0.0));
-        assert!((path.behind(0.5).unwrap() - v(2.0, 0.0, 0.0)).norm() < 0.11);
+        let back = path.behind(&v(2.0, 0.5, 0.0), 0.5).unwrap();
+        assert!((back - v(2.0, 0.0, 0.0)).norm() < 0.11, "{back:?}");
         // Hovering adds nothing; a non-finite position is ignored.
         let n = path.points().count();
         path.record(&v(2.0, 0.52, 0.0));
@@ -142,9 +163,9 @@ mod tests {
     fn the_path_keeps_its_newest_points() {
         let mut path = FlownPath::default();
         for k in 0..(MAX_FLOWN_POINTS + 10) {
-            path.record(&v(0.1 * k as f64, 0.0, 0.0));
+            path.record(&v(0.25 * k as f64, 0.0, 0.0));
         }
         assert_eq!(path.points().count(), MAX_FLOWN_POINTS);
-        assert!((path.points().next().unwrap().x - 1.0).abs() < 1e-9);
+        assert!((path.points().next().unwrap().x - 2.5).abs() < 1e-9);
     }
 }
