@@ -198,120 +198,37 @@ pub fn escape_maneuvers(
     limits.validate()?;
     check_positive("escape.distance_m", distance_m)?;
     check_positive("escape.hold_s", hold_s)?;
+    let (v_max, a_max) = (limits.v_max, limits.a_max);
+    // Minimum-jerk rest to rest: peak speed 1.875 d/T, peak acceleration 5.77 d/T².
+    let base = (1.875 * distance_m / v_max)
+        .max((5.77 * distance_m / a_max).sqrt())
+        .max(state.v.norm() / a_max);
     let mut out = Vec::new();
     for u in directions {
         let n = u.norm();
         if !(n.is_finite() && n > 1e-9) {
             continue;
         }
-        let end = state.p + u * (distance_m / n);
-        if let Some((piece, duration)) = to_rest(state, &end, limits) {
-            let rest = [end, Vec3::zeros(), Vec3::zeros()];
-            let hold = hermite_quintic(rest, rest, hold_s);
-            out.push(PolyTraj::new(
-                state.t,
-                vec![duration, hold_s],
-                vec![piece, hold],
-            )?);
+        let end = [state.p + u * (distance_m / n), Vec3::zeros(), Vec3::zeros()];
+        let mut duration = base;
+        for _ in 0..12 {
+            let piece = hermite_quintic([state.p, state.v, state.a], end, duration);
+            let hold = hermite_quintic(end, end, hold_s);
+            let traj = PolyTraj::new(state.t, vec![duration, hold_s], vec![piece, hold])?;
+            let within = (0..=64).all(|k| {
+                let t = state.t + duration * k as f64 / 64.0;
+                traj.velocity(t).norm() <= v_max * 1.001
+                    && traj.acceleration(t).norm() <= a_max * 1.001
+                    && traj.jerk(t).norm() <= a_max / RAMP_S
+            });
+            if within {
+                out.push(traj);
+                break;
+            }
+            duration *= 1.25;
         }
     }
     Ok(out)
-}
-
-/// Back along `points` from `state` (beyond the paper; [`crate::retreat`]): a quintic to rest at
-/// each point in turn, then a hold of `hold_s` seconds, each leg as short as
-/// [`escape_maneuvers`] makes it. The vehicle stays on the polyline (a quintic to rest from rest
-/// runs along its straight leg), so it flies back through the space it flew. Points nearer
-/// than 1 mm to the one before are skipped.
-///
-/// # Errors
-/// [`PlanError::InvalidInput`] for a non-finite state or point, no point far enough from the
-/// state, a non-positive hold, or invalid limits.
-pub fn retrace(
-    state: &State,
-    points: &[Vec3],
-    limits: &trust_core::Limits,
-    hold_s: f64,
-) -> Result<PolyTraj, PlanError> {
-    state.validate("state")?;
-    limits.validate()?;
-    check_positive("retrace.hold_s", hold_s)?;
-    if let Some((i, p)) = points
-        .iter()
-        .enumerate()
-        .find(|(_, p)| !p.iter().all(|x| x.is_finite()))
-    {
-        return Err(PlanError::invalid(
-            format!("retrace.points[{i}]"),
-            p,
-            "a finite point",
-        ));
-    }
-    let (mut durations, mut pieces) = (Vec::new(), Vec::new());
-    let mut from = *state;
-    for p in points {
-        if (p - from.p).norm() < 1e-3 {
-            continue;
-        }
-        let Some((piece, duration)) = to_rest(&from, p, limits) else {
-            return Err(PlanError::invalid(
-                "retrace.points",
-                p,
-                "a leg to rest within the limits",
-            ));
-        };
-        durations.push(duration);
-        pieces.push(piece);
-        from = State {
-            t: from.t + duration,
-            p: *p,
-            v: Vec3::zeros(),
-            a: Vec3::zeros(),
-        };
-    }
-    if pieces.is_empty() {
-        return Err(PlanError::invalid(
-            "retrace.points",
-            points,
-            "a point 1 mm or more from the state",
-        ));
-    }
-    let rest = [from.p, Vec3::zeros(), Vec3::zeros()];
-    durations.push(hold_s);
-    pieces.push(hermite_quintic(rest, rest, hold_s));
-    PolyTraj::new(state.t, durations, pieces)
-}
-
-/// A single quintic from `state` to rest at `end`, and its duration: the least of a geometric
-/// sequence (×1.25, 12 terms) from the minimum-jerk rest-to-rest time whose speed and
-/// acceleration stay within `limits` and whose jerk stays below `a_max` per [`RAMP_S`]
-/// (checked on a dense sampling); `None` if none does.
-fn to_rest(state: &State, end: &Vec3, limits: &trust_core::Limits) -> Option<([Vec3; 6], f64)> {
-    let (v_max, a_max) = (limits.v_max, limits.a_max);
-    let distance_m = (end - state.p).norm();
-    // Minimum-jerk rest to rest: peak speed 1.875 d/T, peak acceleration 5.77 d/T².
-    let mut duration = (1.875 * distance_m / v_max)
-        .max((5.77 * distance_m / a_max).sqrt())
-        .max(state.v.norm() / a_max)
-        .max(1e-3);
-    let rest = [*end, Vec3::zeros(), Vec3::zeros()];
-    for _ in 0..12 {
-        let piece = hermite_quintic([state.p, state.v, state.a], rest, duration);
-        let Ok(traj) = PolyTraj::new(state.t, vec![duration], vec![piece]) else {
-            return None;
-        };
-        let within = (0..=64).all(|k| {
-            let t = state.t + duration * k as f64 / 64.0;
-            traj.velocity(t).norm() <= v_max * 1.001
-                && traj.acceleration(t).norm() <= a_max * 1.001
-                && traj.jerk(t).norm() <= a_max / RAMP_S
-        });
-        if within {
-            return Some((piece, duration));
-        }
-        duration *= 1.25;
-    }
-    None
 }
 
 /// From position `p`, velocity `v` and acceleration `a` at `t0`: the acceleration ramps down to
@@ -618,38 +535,6 @@ mod tests {
             Vec3::zeros(),
         ];
         PolyTraj::new(t0, vec![3.0], vec![piece]).unwrap()
-    }
-
-    #[test]
-    fn a_retrace_flies_the_polyline_and_rests_at_its_end() {
-        let limits = trust_core::Limits {
-            v_max: 2.0,
-            a_max: 4.0,
-        };
-        let start = State::at_rest(1.0, Vec3::new(2.0, 0.0, 1.0));
-        let way = [
-            Vec3::new(2.0, 0.0, 1.0),
-            Vec3::new(2.0, 0.0, 0.0),
-            Vec3::new(1.0, 0.0, 0.0),
-        ];
-        let traj = retrace(&start, &way, &limits, 0.5).unwrap();
-        let end = traj.state(traj.t_end());
-        assert_relative_eq!(end.p, way[2], epsilon = 1e-9);
-        assert!(end.v.norm() < 1e-9);
-        // On the L: every sample on one of its legs, within the limits.
-        let n = 400;
-        for k in 0..=n {
-            let t = traj.t_start() + traj.duration() * f64::from(k) / f64::from(n);
-            let p = traj.position(t);
-            let on_leg = (p.x - 2.0).abs() < 1e-9 || p.z.abs() < 1e-9;
-            assert!(on_leg, "{p:?} off the path");
-            assert!(traj.velocity(t).norm() <= limits.v_max * 1.001);
-            assert!(traj.acceleration(t).norm() <= limits.a_max * 1.001);
-        }
-        let nan = [Vec3::new(f64::NAN, 0.0, 0.0)];
-        assert!(retrace(&start, &nan, &limits, 0.5).is_err());
-        assert!(retrace(&start, &[start.p], &limits, 0.5).is_err());
-        assert!(retrace(&start, &way, &limits, 0.0).is_err());
     }
 
     #[test]

@@ -64,7 +64,6 @@ pub mod safety;
 
 pub use brake::{
     brake_along, brake_straight, braking_tail, dash_maneuvers, escape_maneuvers, hermite_quintic,
-    retrace,
 };
 pub use commit::{CommitCheck, committed_stretch};
 pub use manager::{Branch, HOLD_CLEARANCE_M, MainDecision, Manager, choose_main};

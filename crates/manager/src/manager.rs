@@ -1863,9 +1863,9 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
 
     /// The fallback's first options for a vehicle stalled before space its commit check
     /// refuses ([`crate::retreat`]): the retreat under way flown on (unless re-anchored), then
-    /// the flown path retraced ([`crate::retrace`]) back to the points `d` and `d/2` from the
-    /// vehicle horizontally ([`crate::CommitCheck::retreat_m`]). None without a check or a
-    /// retreat distance.
+    /// manoeuvres to rest at the points back along the flown path `d` and `d/2` from it
+    /// horizontally ([`crate::CommitCheck::retreat_m`]). None without a check or a retreat
+    /// distance.
     fn retreat_options(
         &self,
         start: &State,
@@ -1884,12 +1884,16 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
             options.push((FallbackKind::Retreat, plan.clone()));
         }
         for share in [1.0, 0.5] {
-            let way = self.flown.back_along(&start.p, share * d);
-            let far_enough = way
-                .last()
-                .is_some_and(|to| (to - start.p).norm() >= crate::FlownPath::STEP_M);
-            if far_enough && let Ok(back) = crate::retrace(start, &way, &self.limits, hold_s) {
-                options.push((FallbackKind::Retreat, back));
+            let Some(to) = self.flown.behind(&start.p, share * d) else {
+                continue;
+            };
+            let away = to - start.p;
+            let distance = away.norm();
+            if distance < crate::FlownPath::STEP_M {
+                continue;
+            }
+            if let Ok(mut back) = escape_maneuvers(start, &[away], distance, &self.limits, hold_s) {
+                options.extend(back.drain(..).map(|t| (FallbackKind::Retreat, t)));
             }
         }
         options

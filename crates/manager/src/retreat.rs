@@ -74,32 +74,16 @@ impl FlownPath {
     /// place from beside it, not from under or over it (a vehicle that climbed to where it
     /// stalled sees nothing new from lower down its path).
     pub fn behind(&self, from: &Vec3, distance_m: f64) -> Option<Vec3> {
-        self.back_along(from, distance_m).last().copied()
-    }
-
-    /// The path from its end back to [`FlownPath::behind`]'s point, newest first, with the
-    /// points within [`SIMPLIFY_M`] of the line through their neighbours left out
-    /// (Douglas–Peucker); empty where `behind` is `None`.
-    pub fn back_along(&self, from: &Vec3, distance_m: f64) -> Vec<Vec3> {
-        let full = self.back_along_full(from, distance_m);
-        simplify(&full, SIMPLIFY_M)
-    }
-
-    fn back_along_full(&self, from: &Vec3, distance_m: f64) -> Vec<Vec3> {
         if distance_m.is_nan() || distance_m <= 0.0 {
-            return Vec::new();
+            return None;
         }
         let away = |p: &Vec3| (p - from).xy().norm();
         let mut points = self.points.iter().rev();
-        let Some(&first) = points.next() else {
-            return Vec::new();
-        };
-        let mut out = vec![first];
-        if away(&first) >= distance_m {
-            return out;
+        let mut here = *points.next()?;
+        let mut farthest = here;
+        if away(&here) >= distance_m {
+            return Some(here);
         }
-        let mut here = first;
-        let mut farthest = 0;
         for &p in points {
             if away(&p) >= distance_m {
                 // The horizontal distance crosses `distance_m` on [here, p]: bisect.
@@ -112,64 +96,15 @@ impl FlownPath {
                         lo = mid;
                     }
                 }
-                out.push(here + (p - here) * hi);
-                return out;
+                return Some(here + (p - here) * hi);
             }
-            out.push(p);
-            if away(&p) > away(&out[farthest]) {
-                farthest = out.len() - 1;
+            if away(&p) > away(&farthest) {
+                farthest = p;
             }
             here = p;
         }
-        out.truncate(farthest + 1);
-        out
+        Some(farthest)
     }
-}
-
-/// How far [`FlownPath::back_along`] lets the simplified path stray from the flown one (m):
-/// 2 cm, within every tracking margin of the presets.
-pub const SIMPLIFY_M: f64 = 0.02;
-
-/// `points` without those within `tolerance` of the segment joining the kept points around
-/// them (Douglas–Peucker); the ends are kept.
-fn simplify(points: &[Vec3], tolerance: f64) -> Vec<Vec3> {
-    if points.len() <= 2 {
-        return points.to_vec();
-    }
-    let mut keep = vec![false; points.len()];
-    keep[0] = true;
-    keep[points.len() - 1] = true;
-    let mut stack = vec![(0, points.len() - 1)];
-    while let Some((a, b)) = stack.pop() {
-        let (pa, pb) = (points[a], points[b]);
-        let far = (a + 1..b)
-            .map(|i| (i, segment_distance(&points[i], &pa, &pb)))
-            .max_by(|x, y| x.1.total_cmp(&y.1));
-        if let Some((i, d)) = far
-            && d > tolerance
-        {
-            keep[i] = true;
-            stack.push((a, i));
-            stack.push((i, b));
-        }
-    }
-    points
-        .iter()
-        .zip(keep)
-        .filter_map(|(p, k)| k.then_some(*p))
-        .collect()
-}
-
-/// Distance from `p` to the segment `[a, b]`.
-fn segment_distance(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + t * ab)).norm()
 }
 
 #[cfg(test)]
@@ -199,31 +134,6 @@ mod tests {
         assert_eq!(path.behind(&end, 100.0), Some(v(0.0, 0.0, 0.0)));
         assert_eq!(path.behind(&end, 0.0), None);
         assert_eq!(path.behind(&end, f64::NAN), None);
-    }
-
-    #[test]
-    fn the_way_back_follows_the_path_round_its_corners() {
-        let mut path = FlownPath::default();
-        for k in 0..=20 {
-            path.record(&v(0.1 * k as f64, 0.0, 0.0));
-        }
-        for k in 1..=10 {
-            path.record(&v(2.0, 0.0, 0.1 * k as f64));
-        }
-        let end = v(2.0, 0.0, 1.0);
-        let way = path.back_along(&end, 0.5);
-        // Down the climb to its foot, then along the first leg: the corner's points only
-        // (the climb's first step, 0.1 m, may fall a rounding short and go unrecorded).
-        assert!((3..=4).contains(&way.len()), "{way:?}");
-        assert!((way[0] - end).norm() < 1e-9);
-        assert!((way[way.len() - 1] - v(1.5, 0.0, 0.0)).norm() < 1e-9);
-        assert!(
-            way.iter()
-                .all(|p| p.x >= 1.5 - 1e-9 && (p.z < 1e-9 || p.x > 2.0 - 1e-9))
-        );
-        assert!(way.iter().any(|p| (p - v(2.0, 0.0, 0.0)).norm() < 0.11));
-        assert!(path.back_along(&end, -1.0).is_empty());
-        assert!(FlownPath::default().back_along(&end, 1.0).is_empty());
     }
 
     #[test]
