@@ -1442,7 +1442,7 @@ impl<F: PathFrontend + 'static, B: TrajectoryBackend + 'static, H: HomotopyCheck
                         .events
                         .push(Event::NotKnownFree { branch: main.id, t });
                     retreat = cycle.stalled;
-                    if cycle.start.v.norm() > REST_SPEED_FRACTION * self.limits.v_max {
+                    if !self.at_rest(&cycle.start) {
                         self.refused_since = None;
                     } else if self.refused_since.is_none() {
                         self.refused_since = Some(cycle.start.t);
